@@ -1,0 +1,74 @@
+"""brakesqueal: derive, linearize and analyse wobbling-disk models of disk-brake squeal.
+
+The public API follows the layers of the package:
+
+* :func:`derive_equations` — nonlinear equations of motion (paper eqs. 2-45),
+* :func:`closed_form` — closed-form ``Mbar, Dbar, Kbar`` about the trivial
+  silent motion (eqs. 47-61),
+* :class:`Parameters`, :func:`get_preset`, :func:`resolve_parameters` — validated
+  parameter sets and the paper's presets,
+* :func:`silent_motion`, :func:`linearize` — numeric silent motion and linear
+  model (eqs. 46-48).
+
+Heavy symbolic modules are imported lazily.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .errors import BrakesquealError, BrakesquealWarning, ParameterError, SilentMotionError
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "__version__",
+    "BrakesquealError",
+    "BrakesquealWarning",
+    "ParameterError",
+    "SilentMotionError",
+    "Parameters",
+    "Preset",
+    "PRESETS",
+    "get_preset",
+    "resolve_parameters",
+    "parameters_from_toml",
+    "derive_equations",
+    "closed_form",
+    "compiled_model",
+    "silent_motion",
+    "SilentMotion",
+    "linearize",
+    "LinearModel",
+    "pad_rate_eigenvalues",
+]
+
+_LAZY = {
+    "Parameters": "parameters",
+    "Preset": "parameters",
+    "PRESETS": "parameters",
+    "get_preset": "parameters",
+    "resolve_parameters": "parameters",
+    "parameters_from_toml": "parameters",
+    "derive_equations": "symbolic.model",
+    "closed_form": "symbolic.linearize",
+    "compiled_model": "numeric.compiled",
+    "silent_motion": "analysis.equilibrium",
+    "SilentMotion": "analysis.equilibrium",
+    "linearize": "analysis.linear",
+    "LinearModel": "analysis.linear",
+    "pad_rate_eigenvalues": "analysis.linear",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        import importlib
+
+        mod = importlib.import_module(f".{_LAZY[name]}", __name__)
+        return getattr(mod, name)
+    raise AttributeError(f"module 'brakesqueal' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)
