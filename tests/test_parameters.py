@@ -13,7 +13,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from brakesqueal.errors import ParameterError
-from brakesqueal.expressions import dependency_order, evaluate, names_in
+from brakesqueal.expressions import (
+    CONSTANTS,
+    FUNCTIONS,
+    dependency_order,
+    evaluate,
+    names_in,
+)
 from brakesqueal.parameters import (
     DESCRIPTIONS,
     PARAMETER_NAMES,
@@ -330,12 +336,18 @@ def test_evaluate_whitelisted_expressions(expr: str, expected: float) -> None:
     "mu.real", "(lambda: 1)()", "lambda: 1", "[x for x in (1, 2)]", "'abc'",
     "mu[0]", "open('f')", "eval('1')", "mu < 1", "mu if mu else 1", "True",
     "sqrt(x=4)", "sqrt(1, 2)", "sqrt", "mu // 2", "mu % 2", "~1", "1j", "(a := 1)",
-    "not mu", "f'{mu}'", "{1: 2}", "nope", "1 +", "",
+    "not mu", "f'{mu}'", "{1: 2}", "nope", "1 +", "", "getattr(mu)", "globals()",
+    "print(1)", "max(1, 2)", "pow(2, 3)",
 ])
 def test_evaluate_rejects_everything_else(expr: str) -> None:
     with pytest.raises(ParameterError) as excinfo:
         evaluate(expr, {"mu": 0.5}, what="tied parameter 'N0'")
     assert message(excinfo).startswith("tied parameter 'N0'")
+
+
+def test_function_whitelist_is_exactly_the_documented_one() -> None:
+    assert set(FUNCTIONS) == {"sqrt", "sin", "cos", "tan", "exp", "log", "abs"}
+    assert set(CONSTANTS) == {"pi", "inf"}
 
 
 def test_rejection_names_the_offending_piece() -> None:

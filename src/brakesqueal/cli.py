@@ -109,6 +109,23 @@ def bench_derive(
     sys.stdout.write(report(_bench(baseline=baseline), fmt.value))
 
 
+def _register_plugins() -> None:
+    """Add the commands that live in their own modules (analysis, simulation)."""
+    import importlib
+
+    for name in ("cli_stability", "cli_simulate"):
+        try:
+            mod = importlib.import_module(f".{name}", __package__)
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__package__}.{name}":
+                raise
+            continue
+        mod.register(app, bench_app)
+
+
+_register_plugins()
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point: run the CLI, turning user errors into one stderr line and exit status 2."""
     try:

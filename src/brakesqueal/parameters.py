@@ -428,7 +428,7 @@ PRESETS: dict[str, Preset] = {preset.name: preset for preset in (
         reference="paper Sec. 3.2, eqs. 56-63, Fig. 3",
         fixed={**_PAPER_SUPPORTS, "Phi": 0.32, "N0": 3000.0, "R_disk": 0.15},
         free={"mu1": 0.6, "mu2": 0.4, "k_ip": 1e8, "Omega": "16*pi"},
-        tied={"h10": "h*mu1/(mu1+mu2)", "h20": "h*mu2/(mu1+mu2)",
+        tied={"h10": "h*mu2/(mu1+mu2)", "h20": "h*mu1/(mu1+mu2)",
               "Theta": "Phi/2 + Phi/(2*R_disk**2)*(h10-h20)**2",
               "k_ip1": "k_ip", "k_ip2": "k_ip"},
         auxiliary=_AUX,

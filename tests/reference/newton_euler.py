@@ -120,7 +120,7 @@ def reference_model() -> ReferenceModel:
     pl1 = l1 * N.x - r * N.y - h10 * N.z
     pl2 = l2 * N.x - r * N.y + h20 * N.z
     h1 = -(pl1.dot(zB) + h10) / cosz
-    h2 = -(pl2.dot(zB) - h20) / cosz
+    h2 = -(pl2.dot(zB) + h20) / cosz
     h1, h2 = sp.trigsimp(h1), sp.trigsimp(h2)
     p1 = pl1 + h1 * N.z
     p2 = pl2 + h2 * N.z
@@ -211,13 +211,14 @@ def _args(model: ReferenceModel, with_q3: bool = False) -> list[sp.Symbol]:
 def _function(kind: str) -> Callable:
     """Lambdified (mpmath, cse) evaluators, built on first use and cached."""
     m = reference_model()
+    # flat output lists: lambdify's cse is much slower on nested lists
     if kind == "residual":
-        return sp.lambdify(_args(m), [list(m.psi), list(m.g)], modules="mpmath", cse=True)
+        return sp.lambdify(_args(m), list(m.psi) + list(m.g), modules="mpmath", cse=True)
     if kind == "residual_q3":
-        return sp.lambdify(_args(m, True), [list(m.psi_q3), list(m.g_q3)],
+        return sp.lambdify(_args(m, True), list(m.psi_q3) + list(m.g_q3),
                            modules="mpmath", cse=True)
     if kind == "jac":
-        return sp.lambdify(_args(m), [m.jac[k].tolist() for k in JACOBIAN_KEYS],
+        return sp.lambdify(_args(m), [e for k in JACOBIAN_KEYS for e in m.jac[k]],
                            modules="mpmath", cse=True)
     raise ValueError(kind)
 
@@ -247,18 +248,18 @@ def residuals(state: Mapping[str, float], params: Mapping[str, float]
     with mpmath.workdps(DPS):
         vals = _values(state, params)
         if "q3" in state:
-            psi, g = _function("residual_q3")(*vals, mpmath.mpf(state["q3"]))
+            out = _function("residual_q3")(*vals, mpmath.mpf(state["q3"]))
         else:
-            psi, g = _function("residual")(*vals)
-        return _to_np(psi), _to_np(g)
+            out = _function("residual")(*vals)
+        return _to_np(out[:2]), _to_np(out[2:])
 
 
 def jacobians(state: Mapping[str, float], params: Mapping[str, float]
               ) -> dict[str, np.ndarray]:
     """Exact (symbolic) 2x2 derivative blocks of psi and g, see JACOBIAN_KEYS."""
     with mpmath.workdps(DPS):
-        out = _function("jac")(*_values(state, params))
-        return {k: _to_np(v) for k, v in zip(JACOBIAN_KEYS, out)}
+        out = _to_np(_function("jac")(*_values(state, params))).reshape(-1, 2, 2)
+        return dict(zip(JACOBIAN_KEYS, out))
 
 
 def linearize(state0: Mapping[str, float], params: Mapping[str, float]
