@@ -104,6 +104,16 @@ def test_steady_spin_about_tilted_axis_needs_no_torque():
         np.testing.assert_allclose(psi, 0.0, atol=1e-20)
 
 
+def test_rotational_support_acts_about_x0_and_y1():
+    """Only the supports loaded, disk at rest relative to the spin: psi equals
+    K_m(q) q_m with K_m = diag(k_t, k_t cos q1) as in eq. (45)."""
+    p = {**PAPER, "N0": 0.0, "k1": 0.0, "k2": 0.0, "d1": 0.0, "d2": 0.0}
+    s = dict.fromkeys(ne.STATE, 0.0)
+    s.update(q1=0.4, q2=-0.25, l1=0.003, l2=-0.002)
+    psi, _ = ne.residuals(s, p)
+    np.testing.assert_allclose(psi, [p["k_t"] * 0.4, p["k_t"] * np.cos(0.4) * -0.25], rtol=1e-14)
+
+
 def test_gyroscopic_residual_at_zero_tilt():
     """psi at q = 0 for rates only and no forces: Euler's equations by hand.
     w = (dq1, dq2, Omega), alpha = (ddq1 + Omega dq2, ddq2 - Omega dq1, .)
@@ -114,6 +124,90 @@ def test_gyroscopic_residual_at_zero_tilt():
     psi, _ = ne.residuals(s, p)
     T, F, W = p["Theta"], p["Phi"], p["Omega"]
     np.testing.assert_allclose(psi, [T * 2.1 + F * W * (-1.3), T * 0.4 - F * W * 0.7], rtol=1e-14)
+
+
+def _brute_force_residuals(s, p, dps=40):
+    """Third route, purely numeric: rotation matrices, contact points from the
+    3x3 system of eq. (16), and every time derivative (H_O, p_i, h_i) by
+    central differences in time along q(t) = q + dq t + ddq t^2/2,
+    l(t) = l + dl t, dq3(t) from the constraint."""
+    with mpmath.workdps(dps):
+        P = {k: mpmath.mpf(v) for k, v in p.items()}
+        S = {k: mpmath.mpf(v) for k, v in s.items()}
+        ex, ey, ez = (mpmath.matrix([[1], [0], [0]]), mpmath.matrix([[0], [1], [0]]),
+                      mpmath.matrix([[0], [0], [1]]))
+
+        def Rx(a):
+            c, si = mpmath.cos(a), mpmath.sin(a)
+            return mpmath.matrix([[1, 0, 0], [0, c, -si], [0, si, c]])
+
+        def Ry(a):
+            c, si = mpmath.cos(a), mpmath.sin(a)
+            return mpmath.matrix([[c, 0, si], [0, 1, 0], [-si, 0, c]])
+
+        def cross(a, b):
+            return mpmath.matrix([[a[1] * b[2] - a[2] * b[1]], [a[2] * b[0] - a[0] * b[2]],
+                                  [a[0] * b[1] - a[1] * b[0]]])
+
+        def dot(a, b):
+            return sum(a[i] * b[i] for i in range(3))
+
+        I3 = mpmath.diag([P["Theta"], P["Theta"], P["Phi"]])
+
+        def kin(t):
+            q1 = S["q1"] + S["dq1"] * t + S["ddq1"] * t**2 / 2
+            q2 = S["q2"] + S["dq2"] * t + S["ddq2"] * t**2 / 2
+            dq1 = S["dq1"] + S["ddq1"] * t
+            dq2 = S["dq2"] + S["ddq2"] * t
+            A = Rx(q1) * Ry(q2)  # q3 = 0: nothing below depends on q3
+            y1, zB = Rx(q1) * ey, A * ez
+            dq3 = (P["Omega"] - dq2 * mpmath.sin(q1)) / (mpmath.cos(q1) * mpmath.cos(q2))
+            w = dq1 * ex + dq2 * y1 + dq3 * zB
+            H = A * I3 * A.T * w
+            pts = []
+            for i, (K, zoff) in enumerate(((-P["h10"], -P["h10"]), (P["h20"], P["h20"]))):
+                l = S[f"l{i + 1}"] + S[f"dl{i + 1}"] * t
+                pl = mpmath.matrix([[l], [-P["r"]], [zoff]])
+                Amat = mpmath.matrix(3, 3)
+                for j, col in enumerate((A * ex, A * ey, -ez)):
+                    for k in range(3):
+                        Amat[k, j] = col[k]
+                uvh = mpmath.lu_solve(Amat, pl - A * (K * ez))  # eq. (16)
+                pts.append((pl + uvh[2] * ez, uvh[2]))
+            return q1, q2, dq1, dq2, y1, zB, w, H, pts
+
+        eps = mpmath.mpf(10) ** (-dps // 3)
+        kp, km, k0 = kin(eps), kin(-eps), kin(mpmath.mpf(0))
+        q1, q2, dq1, dq2, y1, zB, w, H, pts = k0
+        Hdot = (kp[7] - km[7]) / (2 * eps)
+        res = Hdot + (P["k_t"] * q1 + P["d_t"] * dq1) * ex + (P["k_t"] * q2 + P["d_t"] * dq2) * y1
+        g = []
+        for i in range(2):
+            p_i, h_i = pts[i]
+            pdot = (kp[8][i][0] - km[8][i][0]) / (2 * eps)
+            hdot = (kp[8][i][1] - km[8][i][1]) / (2 * eps)
+            vr = pdot - cross(w, p_i)
+            tdir = vr / mpmath.sqrt(dot(vr, vr))
+            mu = P[f"mu{i + 1}"]
+            if i == 0:
+                Fn = (P["N0"] - P["k1"] * h_i - P["d1"] * hdot) / (dot(ez, zB) + mu * dot(ez, tdir))
+                f = Fn * zB + mu * Fn * tdir
+            else:
+                Fn = (P["N0"] + P["k2"] * h_i + P["d2"] * hdot) / (dot(ez, zB) - mu * dot(ez, tdir))
+                f = -Fn * zB + mu * Fn * tdir
+            res -= cross(p_i, f)
+            g.append(S[f"l{i + 1}"] + P[f"c_ip{i + 1}"] * (f[0] + mu * P["N0"]))
+        return np.array([float(res[0]), float(res[1])]), np.array([float(x) for x in g])
+
+
+def test_residuals_match_brute_force_numeric_route():
+    rng = np.random.default_rng(4)
+    for scale in (0.02, 0.2):
+        s = random_state(rng, scale)
+        psi, g = ne.residuals(s, PAPER)
+        psi_bf, g_bf = _brute_force_residuals(s, PAPER)
+        np.testing.assert_allclose(psi, psi_bf, rtol=1e-12, atol=1e-9)
+        np.testing.assert_allclose(g, g_bf, rtol=1e-12, atol=1e-18)
 
 
 def test_jacobians_match_finite_differences():

@@ -38,6 +38,12 @@ The result ``psi`` (2x1) and ``g`` (2x1) are sympy expressions in the plain
 symbols of :data:`STATE` and :data:`PARAMS` (q3 set to 0; ``psi_q3``/``g_q3``
 keep q3 as a symbol for the independence check).  Numerics are done with mpmath at
 ``DPS`` decimal digits and returned as float arrays.
+
+API: :func:`reference_model`, :func:`residuals`, :func:`jacobians` (exact
+symbolic derivatives, keys :data:`JACOBIAN_KEYS`), :func:`linearize`
+(quasi-static pads: dl := 0, l eliminated from g = 0 by the implicit function
+theorem), :func:`silent_motion`, and :func:`trivial_linearization_symbolic`
+(closed-form M, D, K at the zero state).
 """
 
 from __future__ import annotations
@@ -120,7 +126,7 @@ def reference_model() -> ReferenceModel:
     pl1 = l1 * N.x - r * N.y - h10 * N.z
     pl2 = l2 * N.x - r * N.y + h20 * N.z
     h1 = -(pl1.dot(zB) + h10) / cosz
-    h2 = -(pl2.dot(zB) + h20) / cosz
+    h2 = -(pl2.dot(zB) - h20) / cosz
     h1, h2 = sp.trigsimp(h1), sp.trigsimp(h2)
     p1 = pl1 + h1 * N.z
     p2 = pl2 + h2 * N.z

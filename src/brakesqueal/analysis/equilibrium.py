@@ -68,10 +68,12 @@ def _state(z: np.ndarray) -> list[float]:
     return [z[0], z[1], 0.0, 0.0, 0.0, 0.0, z[2], z[3], 0.0, 0.0]
 
 
-def _newton(model: CompiledModel, p: list[float], *, tol: float = 1e-14, max_iter: int = 60) -> tuple[np.ndarray, int]:
+def _newton(model: CompiledModel, p: list[float], *, max_iter: int = 60) -> tuple[np.ndarray, int]:
+    """Damped Newton on the scaled residuals, from ``z = 0``; returns ``(z, iterations)``."""
     z = np.zeros(4)
-    scale = np.array([max(p[2], p[15] * (abs(p[12]) + abs(p[13]))), 0.0, 1.0, 1.0])
-    scale[1] = scale[0]
+    moment_scale = max(p[2], p[15] * (abs(p[12]) + abs(p[13])))  # N m / rad
+    scale = np.array([moment_scale, moment_scale, 1.0, 1.0])  # psi in N m, g in m
+    atol = np.array([1e-18, 1e-18, 1e-21, 1e-21])  # rad, rad, m, m
 
     def f(z: np.ndarray) -> np.ndarray:
         return np.asarray(model.residuals(_state(z), p)) / scale
@@ -83,20 +85,23 @@ def _newton(model: CompiledModel, p: list[float], *, tol: float = 1e-14, max_ite
             step = np.linalg.solve(jac, -fz)
         except np.linalg.LinAlgError:
             raise SilentMotionError("the Jacobian of the silent-motion equations is singular") from None
-        lam = 1.0
-        norm0 = np.linalg.norm(fz)
-        while lam > 1e-6:
+        if not np.all(np.isfinite(step)):
+            raise SilentMotionError("Newton's method produced a non-finite step")
+        if np.all(np.abs(step) <= 1e-13 * np.abs(z) + atol):
+            return z + step, it
+        lam, norm0 = 1.0, np.linalg.norm(fz)
+        while lam > 1e-8:
             z_new = z + lam * step
             if abs(z_new[0]) < 1.2 and abs(z_new[1]) < 1.2:
                 f_new = f(z_new)
-                if np.all(np.isfinite(f_new)) and np.linalg.norm(f_new) < (1 - 1e-4 * lam) * norm0 + 1e-300:
+                if np.all(np.isfinite(f_new)) and np.linalg.norm(f_new) <= (1 - 1e-4 * lam) * norm0:
                     break
             lam /= 2
         else:
-            break
+            if norm0 <= 1e-15:
+                return z, it
+            raise SilentMotionError("Newton's method stalled")
         z, fz = z_new, f_new
-        if np.max(np.abs(lam * step) / (np.abs(z) + 1e-12)) < tol or np.linalg.norm(fz) == 0.0:
-            return z, it
     raise SilentMotionError("Newton's method did not converge")
 
 

@@ -1,0 +1,138 @@
+"""Numeric linearization (eqs. 46-48) against central finite differences of the nonlinear residuals."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from brakesqueal.analysis.equilibrium import parameter_vector, silent_motion
+from brakesqueal.analysis.linear import linearize, pad_rate_eigenvalues, state_matrix
+from brakesqueal.errors import SilentMotionError
+from brakesqueal.numeric.compiled import compiled_model
+from brakesqueal.parameters import get_preset
+
+
+def _reduced_psi(model, p, q, dq, ddq, l_guess):
+    """psi with l eliminated quasi-statically: solve g(q, dq, l, ldot=0) = 0 by Newton, then evaluate psi."""
+    l = np.array(l_guess, dtype=float)
+    for _ in range(30):
+        x = [q[0], q[1], dq[0], dq[1], ddq[0], ddq[1], l[0], l[1], 0.0, 0.0]
+        res = np.array(model.residuals(x, p))
+        jl = np.array(model.jacobians(x, p)).reshape(2, 2, 10)[1][:, 6:8]
+        step = np.linalg.solve(jl, -res[2:])
+        l = l + step
+        if np.all(np.abs(step) < 1e-22):
+            break
+    x = [q[0], q[1], dq[0], dq[1], ddq[0], ddq[1], l[0], l[1], 0.0, 0.0]
+    return np.array(model.residuals(x, p))[:2]
+
+
+def _fd_matrices(params, lm):
+    model = compiled_model()
+    p = parameter_vector(params)
+    q0, l0 = lm.q_m0, lm.silent.l0
+    steps = {"K": 1e-8, "D": 1e-6, "M": 1e-4}
+    out = {}
+    for name, idx in (("K", 0), ("D", 1), ("M", 2)):
+        cols = []
+        for j in range(2):
+            e = np.zeros(2)
+            e[j] = steps[name]
+            args_p = [q0.copy(), np.zeros(2), np.zeros(2)]
+            args_m = [q0.copy(), np.zeros(2), np.zeros(2)]
+            args_p[idx] = args_p[idx] + e
+            args_m[idx] = args_m[idx] - e
+            fp = _reduced_psi(model, p, *args_p, l0)
+            fm = _reduced_psi(model, p, *args_m, l0)
+            cols.append((fp - fm) / (2 * steps[name]))
+        out[name] = np.column_stack(cols)
+    return out
+
+
+@pytest.mark.parametrize(
+    "overrides",
+    [{}, {"mu1": 0.7, "mu2": 0.2}, {"mu1": 0.5, "mu2": 0.5, "k_ip": "inf"}],
+    ids=["fig3-default", "fig3-asymmetric", "fig3-rigid"],
+)
+def test_linearization_matches_central_differences_at_nontrivial_silent_motion(overrides):
+    base = get_preset("paper-fig3").resolve(overrides)
+    params = base.replace(h10=base.h10 * 1.3)  # break eq. (49): non-trivial silent motion
+    lm = linearize(params)
+    assert not lm.silent.trivial and np.abs(lm.q_m0).max() > 1e-8
+    fd = _fd_matrices(params, lm)
+    for name in "MDK":
+        got, want = getattr(lm, name), fd[name]
+        # central differences are accurate to ~1e-7 relative to the largest entry of each row
+        tol = 2e-6 * np.abs(want).max(axis=1, keepdims=True) + 1e-6
+        assert np.all(np.abs(got - want) <= tol), f"{name}\n{got}\n{want}"
+
+
+def test_closed_form_kernel_equals_numeric_linearization_at_trivial_point(rng):
+    m = compiled_model()
+    for mu in rng.uniform(0.1, 1.0, 3):
+        params = get_preset("paper-fig2").resolve({"mu": float(mu), "k_ip": float(rng.uniform(1e7, 1e9))})
+        lm = linearize(params)
+        mats = np.array(m.trivial_matrices(np.array(parameter_vector(params))), dtype=float).reshape(3, 2, 2)
+        for got, want in zip(mats, (lm.M, lm.D, lm.K)):
+            assert np.allclose(got, want, rtol=1e-13, atol=1e-13 * np.abs(want).max())
+
+
+def test_state_matrix_eigenvalues_solve_the_quadratic_eigenproblem(rng):
+    lm = linearize(get_preset("paper-fig2").resolve())
+    for lam in lm.eigenvalues:
+        Q = lam**2 * lm.M + lam * lm.D + lm.K
+        assert abs(np.linalg.det(Q)) <= 1e-9 * np.linalg.norm(lm.K) ** 2
+    A = state_matrix(lm.M, lm.D, lm.K)
+    assert A.shape == (4, 4) and np.allclose(A[:2, 2:], np.eye(2))
+    assert lm.eigenvalues.real[0] >= lm.eigenvalues.real[-1]
+
+
+def test_keeping_pad_rates_adds_spurious_modes_away_from_trivial_point():
+    base = get_preset("paper-fig3").resolve()
+    params = base.replace(h10=base.h10 * 1.3)
+    quasi = linearize(params).eigenvalues
+    kept = pad_rate_eigenvalues(params)
+    assert len(kept) == 6  # two extra first-order pad modes
+    fast = kept[np.argsort(-np.abs(kept))][:2]
+    assert np.all(np.abs(fast) > 1e6 * np.abs(quasi).max())  # spurious and stiff
+    slow = kept[np.argsort(np.abs(kept))][:4]
+    nearest = np.array([slow[np.argmin(np.abs(slow - lam))] for lam in quasi])
+    assert np.all(np.abs(nearest - quasi) <= 1e-6 * np.abs(quasi))  # physical modes barely move
+    assert np.all(np.abs(nearest.real - quasi.real) <= 1e-5 * np.abs(quasi.real))
+    # at the trivial point both treatments coincide exactly (no extra finite eigenvalues)
+    triv = get_preset("paper-fig3").resolve()
+    assert len(pad_rate_eigenvalues(triv)) == 4
+
+
+def test_missing_silent_motion_is_reported_with_parameter_names():
+    # nearly no rotational support against a large friction moment (eq. 49): no equilibrium near q = 0
+    params = get_preset("paper-fig2").resolve({"mu": 1.0}).replace(k_t=10.0, h10=0.03, h20=0.001)
+    with pytest.raises(SilentMotionError, match=r"no silent motion found.*mu1=1.*h10=0.03.*k_t=10"):
+        silent_motion(params)
+
+
+def test_contact_loss_is_reported_with_parameter_names():
+    import dataclasses
+
+    real = compiled_model()
+
+    def lifted(x, p):  # pad 2 pulled off the disk: negative normal force
+        c = list(real.contact(x, p))
+        c[3] = -5.0
+        return tuple(c)
+
+    model = dataclasses.replace(real, contact=lifted)
+    params = get_preset("paper-fig2").resolve()
+    with pytest.raises(SilentMotionError, match=r"pad 2 loses contact.*F_n2 = -5 N.*N0=3600.*k2=6e\+06"):
+        silent_motion(params, model=model)
+
+
+def test_trivial_silent_motion_has_preload_forces():
+    params = get_preset("paper-fig3").resolve({"mu1": 0.8, "mu2": 0.2})
+    sm = silent_motion(params)
+    assert sm.trivial and np.all(sm.q_m0 == 0)
+    assert np.allclose(sm.normal_forces, params.N0, rtol=1e-12)
+    assert np.allclose(sm.sliding_speeds, params.Omega * params.r, rtol=1e-12)
+    assert math.isfinite(linearize(params).max_real)
