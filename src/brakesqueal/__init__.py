@@ -41,6 +41,18 @@ __all__ = [
     "linearize",
     "LinearModel",
     "pad_rate_eigenvalues",
+    "simulate",
+    "Trajectory",
+    "SimulationModel",
+    "ModelSpec",
+    "Disk",
+    "Pad",
+    "Caliper",
+    "FrictionLaw",
+    "get_model",
+    "load_model",
+    "build_equations",
+    "linearize_model",
 ]
 
 _LAZY = {
@@ -58,6 +70,18 @@ _LAZY = {
     "linearize": "analysis.linear",
     "LinearModel": "analysis.linear",
     "pad_rate_eigenvalues": "analysis.linear",
+    "simulate": "simulate",
+    "Trajectory": "simulate",
+    "SimulationModel": "simulate",
+    "ModelSpec": "builder",
+    "Disk": "builder",
+    "Pad": "builder",
+    "Caliper": "builder",
+    "FrictionLaw": "builder",
+    "get_model": "builder",
+    "load_model": "builder",
+    "build_equations": "builder",
+    "linearize_model": "builder",
 }
 
 

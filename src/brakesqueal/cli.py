@@ -53,6 +53,9 @@ ParamsOpt = Annotated[Optional[str], typer.Option("--params", help="TOML paramet
 SetOpt = Annotated[
     Optional[list[str]], typer.Option("--set", help="Override NAME=VALUE (repeatable; VALUE may be 'inf').")
 ]
+ModelOpt = Annotated[
+    Optional[str], typer.Option("--model", help="Model TOML file or built-in model name (see the model builder).")
+]
 NoCacheOpt = Annotated[bool, typer.Option("--no-cache", help="Derive in-process; do not read or write the cache.")]
 
 
@@ -60,11 +63,19 @@ NoCacheOpt = Annotated[bool, typer.Option("--no-cache", help="Derive in-process;
 def derive(
     case: Annotated[Case, typer.Option("--case", help="Which parameter case to print.")] = Case.general,
     fmt: Annotated[DeriveFormat, typer.Option("--format", help="Output format.")] = DeriveFormat.text,
+    model: ModelOpt = None,
     no_cache: NoCacheOpt = False,
 ) -> None:
     """Print the closed-form Mbar, Dbar, Kbar about the trivial silent motion (eqs. 51-54, 59-61)."""
     from .numeric import cache
     from .render import render_closed_form
+
+    if model is not None:
+        from .builder import resolve_model
+        from .render import render_model_closed_form
+
+        sys.stdout.write(render_model_closed_form(resolve_model(model), fmt.value).rstrip("\n") + "\n")
+        return
 
     key, name = "closed-forms", f"{case.value}.{fmt.value}"
     text = None if no_cache else cache.read_text(key, name)
@@ -83,13 +94,26 @@ def linearize(
         Optional[list[str]], typer.Option("--set", help="Override NAME=VALUE (repeatable; VALUE may be 'inf').")
     ] = None,
     fmt: Annotated[OutFormat, typer.Option("--format", help="Output format.")] = OutFormat.text,
+    model: ModelOpt = None,
     no_cache: NoCacheOpt = False,
 ) -> None:
     """Find the silent motion, linearize (eqs. 46-48) and print M, D, K and the eigenvalues."""
     from .analysis.linear import linearize as _linearize
     from .numeric.compiled import compiled_model
-    from .parameters import resolve_parameters
+    from .parameters import parse_assignment, resolve_parameters
     from .render import render_linear_model
+
+    if model is not None:
+        from .builder import linearize_model, resolve_model
+        from .errors import ParameterError
+        from .render import render_built_linear
+
+        if preset or params:
+            raise ParameterError("--model cannot be combined with --preset or --params (use --set for its parameters)")
+        overrides = dict(parse_assignment(a) for a in (set_ or []))
+        lm_b = linearize_model(resolve_model(model), overrides, use_cache=not no_cache)
+        sys.stdout.write(render_built_linear(lm_b, fmt.value))
+        return
 
     p = resolve_parameters(preset, params, list(set_ or []))
     lm = _linearize(p, model=compiled_model(use_cache=not no_cache))
@@ -129,7 +153,7 @@ _register_plugins()
 def main(argv: list[str] | None = None) -> int:
     """Entry point: run the CLI, turning user errors into one stderr line and exit status 2."""
     try:
-        app(args=argv, prog_name="brakesqueal", standalone_mode=False)
+        rv = app(args=argv, prog_name="brakesqueal", standalone_mode=False)
     except BrakesquealError as exc:
         print(f"brakesqueal: error: {exc}", file=sys.stderr)
         return 2
@@ -144,7 +168,7 @@ def main(argv: list[str] | None = None) -> int:
     except (Abort, KeyboardInterrupt):
         print("brakesqueal: aborted", file=sys.stderr)
         return 130
-    return 0
+    return rv if isinstance(rv, int) else 0
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,0 +1,341 @@
+"""Components of a wobbling-disk model: disk, pads, calipers, friction laws.
+
+A component field is either a number or the *name* of a model parameter
+(a string); :class:`ModelSpec` keeps the default values of the named
+parameters.  Validation happens when a spec is built and names the component
+in every message.
+
+Physical conventions (see ``docs/model-builder.md``):
+
+* A pad at angle ``angle_deg`` sits at ``Rz(angle) (0, -radius, 0)``; the
+  paper's pads have angle 0.  Its tangential direction is ``Rz(angle) x0``,
+  the direction in which the disk surface moves for ``Omega > 0``.
+* ``face="upper"`` pads touch the face at ``z0 = -h_upper`` and push along
+  ``+z0``; ``"lower"`` pads touch ``z0 = +h_lower`` and push along ``-z0``.
+* A pad's mass acts only in the directions listed in ``dofs``; in the others
+  the pad is massless: along the normal its force follows from its
+  equilibrium (paper eqs. 29-30), tangentially it is quasi-static (eqs. 33-34).
+* A normal DOF needs a contact stiffness ``k_c`` (optionally ``d_c``): the
+  contact force is ``preload + k_c δ + d_c δdot`` with ``δ`` the penetration.
+* Tangential springs are pre-tensioned by ``mu(v*) preload`` (``v*`` the
+  nominal sliding speed ``Omega radius``) so that deformations are measured
+  from the silent motion, as in the paper; a caliper's tangential spring is
+  pre-tensioned likewise by the friction it carries.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from typing import Literal, Union
+
+from ..errors import ParameterError
+
+__all__ = ["Value", "FrictionLaw", "Disk", "Pad", "Caliper", "ModelSpec"]
+
+Value = Union[float, str]
+FACES = ("upper", "lower")
+LAWS = ("coulomb", "linear", "stribeck")
+_NAME = re.compile(r"^\w+$", re.ASCII)
+
+
+def _is_name(v: object) -> bool:
+    return isinstance(v, str)
+
+
+def _check_value(component: str, field_name: str, v: object, *, allow_inf: bool = False, optional: bool = False) -> None:
+    if v is None and optional:
+        return
+    if isinstance(v, str):
+        if not v.isidentifier():
+            raise ParameterError(f"{component}: {field_name} = {v!r} is neither a number nor a parameter name")
+        return
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise ParameterError(f"{component}: {field_name} must be a number or a parameter name; got {v!r}")
+    if math.isnan(v) or (math.isinf(v) and not (allow_inf and v > 0)):
+        raise ParameterError(f"{component}: {field_name} must be finite{' or +inf' if allow_inf else ''}; got {v}")
+
+
+@dataclass(frozen=True)
+class FrictionLaw:
+    """Coefficient of kinetic friction as a function of the sliding speed ``v``.
+
+    Parameters
+    ----------
+    law : {"coulomb", "linear", "stribeck"}
+        ``coulomb``: ``mu(v) = mu``.  ``linear``: ``mu(v) = mu - slope * v``
+        (the negative-slope mechanism of planar models; ``slope >= 0`` falls).
+        ``stribeck``: ``mu(v) = mu + (mu_s - mu) exp(-v / v_s)``.
+    mu : float or str
+        Kinetic coefficient (``coulomb``, ``stribeck``) or intercept at ``v = 0`` (``linear``).
+    slope : float or str, optional
+        ``-dmu/dv`` of the ``linear`` law [s/m].
+    mu_s : float or str, optional
+        Static coefficient of the ``stribeck`` law.
+    v_s : float or str, optional
+        Stribeck speed [m/s].
+    """
+
+    law: Literal["coulomb", "linear", "stribeck"] = "coulomb"
+    mu: Value = "mu"
+    slope: Value | None = None
+    mu_s: Value | None = None
+    v_s: Value | None = None
+
+    def validate(self, component: str) -> None:
+        """Check the law's fields; raise :class:`ParameterError` naming ``component``."""
+        if self.law not in LAWS:
+            raise ParameterError(f"{component}: friction law must be one of {', '.join(LAWS)}; got {self.law!r}")
+        _check_value(component, "mu", self.mu)
+        needed = {"linear": ("slope",), "stribeck": ("mu_s", "v_s"), "coulomb": ()}[self.law]
+        for name in ("slope", "mu_s", "v_s"):
+            v = getattr(self, name)
+            if name in needed and v is None:
+                raise ParameterError(f"{component}: the {self.law} friction law needs '{name}'")
+            if name not in needed and v is not None:
+                raise ParameterError(f"{component}: '{name}' does not belong to the {self.law} friction law")
+            _check_value(component, name, v, optional=True)
+        for name in ("mu", "mu_s"):
+            v = getattr(self, name)
+            if isinstance(v, (int, float)) and v < 0:
+                raise ParameterError(f"{component}: friction coefficient {name} must be in [0, inf); got {v}")
+        if isinstance(self.v_s, (int, float)) and self.v_s <= 0:
+            raise ParameterError(f"{component}: Stribeck speed v_s must be in (0, inf) m/s; got {self.v_s}")
+
+
+@dataclass(frozen=True)
+class Disk:
+    """The rigid disk: tilting DOFs ``q1, q2`` on rotational supports, constant spin ``Omega``.
+
+    ``tilting=False`` locks the tilt (the disk becomes a rotating belt for its
+    pads; used for planar pad models).  ``radius`` is the disk's outer radius,
+    used to check that pads sit on the disk.
+    """
+
+    Theta: Value = "Theta"
+    Phi: Value = "Phi"
+    k_t: Value = "k_t"
+    d_t: Value = "d_t"
+    h_upper: Value = "h10"
+    h_lower: Value = "h20"
+    Omega: Value = "Omega"
+    radius: Value = math.inf
+    tilting: bool = True
+
+    def validate(self) -> None:
+        """Check the fields; raise :class:`ParameterError` naming the disk."""
+        for f in ("Theta", "Phi", "k_t", "d_t", "h_upper", "h_lower", "Omega"):
+            _check_value("disk", f, getattr(self, f))
+        _check_value("disk", "radius", self.radius, allow_inf=True)
+
+
+@dataclass(frozen=True)
+class Pad:
+    """One brake pad in point contact with a disk face.
+
+    Parameters
+    ----------
+    name : str
+        Unique component name.
+    face : {"upper", "lower"}
+        Which disk face it touches.
+    angle_deg : float
+        Angular position around ``z0`` (0 = the paper's pads, at ``y0 = -radius``).
+    radius : float or str
+        Distance of the contact line from the axis [m].
+    k, d : float or str
+        Normal support stiffness [N/m] and damping [N s/m].
+    preload : float or str
+        Normal preload ``N0`` [N] (> 0).
+    k_ip : float or str
+        Tangential support stiffness [N/m]; ``inf`` = rigid.
+    d_ip : float or str
+        Tangential damper [N s/m]; needs a tangential DOF.
+    mass : float or str, optional
+        Pad mass [kg]; needs ``dofs``.
+    dofs : tuple of {"normal", "tangential"}
+        Directions in which the mass moves as its own DOF.
+    k_c, d_c : float or str, optional
+        Contact stiffness and damping, needed by a normal DOF.
+    friction : FrictionLaw
+        The friction law at this contact.
+    mount : str, optional
+        Name of the :class:`Caliper` carrying the pad's supports (default: ground).
+    """
+
+    name: str
+    face: Literal["upper", "lower"]
+    angle_deg: float = 0.0
+    radius: Value = "r"
+    k: Value = "k"
+    d: Value = "d"
+    preload: Value = "N0"
+    k_ip: Value = math.inf
+    d_ip: Value = 0.0
+    mass: Value | None = None
+    dofs: tuple[str, ...] = ()
+    k_c: Value | None = None
+    d_c: Value = 0.0
+    friction: FrictionLaw = field(default_factory=FrictionLaw)
+    mount: str | None = None
+
+    @property
+    def label(self) -> str:
+        """``pad 'name'`` for messages."""
+        return f"pad '{self.name}'"
+
+    def validate(self) -> None:
+        """Check the fields; raise :class:`ParameterError` naming the pad."""
+        c = self.label
+        if not _NAME.match(self.name):
+            raise ParameterError(f"{c}: a component name must be letters, digits or '_'")
+        if self.face not in FACES:
+            raise ParameterError(f"{c}: face must be 'upper' or 'lower'; got {self.face!r}")
+        if isinstance(self.angle_deg, bool) or not isinstance(self.angle_deg, (int, float)) or not math.isfinite(self.angle_deg):
+            raise ParameterError(f"{c}: angle_deg must be a finite number of degrees; got {self.angle_deg!r}")
+        for f in ("radius", "k", "d", "preload", "d_ip", "d_c"):
+            _check_value(c, f, getattr(self, f))
+        _check_value(c, "k_ip", self.k_ip, allow_inf=True)
+        _check_value(c, "mass", self.mass, optional=True)
+        _check_value(c, "k_c", self.k_c, optional=True)
+        bad = [x for x in self.dofs if x not in ("normal", "tangential")]
+        if bad or len(set(self.dofs)) != len(self.dofs):
+            raise ParameterError(f"{c}: dofs must be distinct entries of 'normal', 'tangential'; got {list(self.dofs)}")
+        if self.dofs and self.mass is None:
+            raise ParameterError(f"{c}: a DOF without mass ({', '.join(self.dofs)}): give the pad a mass")
+        if self.mass is not None and not self.dofs:
+            raise ParameterError(f"{c}: a pad mass needs at least one DOF ('normal' and/or 'tangential')")
+        if "normal" in self.dofs and self.k_c is None:
+            raise ParameterError(f"{c}: a normal DOF needs a contact stiffness k_c")
+        if "tangential" in self.dofs and isinstance(self.k_ip, float) and math.isinf(self.k_ip):
+            raise ParameterError(f"{c}: a tangential DOF without stiffness (k_ip = inf): give a finite k_ip")
+        if "tangential" not in self.dofs and self.d_ip != 0.0:
+            raise ParameterError(f"{c}: a tangential damper d_ip needs a pad mass with a tangential DOF")
+        for f in ("k", "d", "d_ip", "d_c"):
+            v = getattr(self, f)
+            if isinstance(v, (int, float)) and v < 0:
+                raise ParameterError(f"{c}: {f} must be in [0, inf); got {v}")
+        for f in ("radius", "preload", "mass", "k_c", "k_ip"):
+            v = getattr(self, f)
+            if isinstance(v, (int, float)) and not isinstance(v, bool) and v <= 0:
+                raise ParameterError(f"{c}: {f} must be in (0, inf); got {v}")
+        self.friction.validate(c)
+
+
+@dataclass(frozen=True)
+class Caliper:
+    """A rigid caliper (mounting) mass coupling the supports of the pads mounted on it.
+
+    ``dofs`` lists its translations (``"normal"`` along ``z0``, ``"tangential"``
+    along ``x0``), each with a spring ``k_n``/``k_t`` and damper ``d_n``/``d_t`` to ground.
+    """
+
+    name: str
+    mass: Value = "m_c"
+    dofs: tuple[str, ...] = ("normal", "tangential")
+    k_n: Value = "k_cn"
+    d_n: Value = 0.0
+    k_t: Value = "k_ct"
+    d_t: Value = 0.0
+
+    def validate(self) -> None:
+        """Check the fields; raise :class:`ParameterError` naming the caliper."""
+        c = f"caliper '{self.name}'"
+        if not _NAME.match(self.name):
+            raise ParameterError(f"{c}: a component name must be letters, digits or '_'")
+        if not self.dofs or any(x not in ("normal", "tangential") for x in self.dofs):
+            raise ParameterError(f"{c}: dofs must be a non-empty list of 'normal', 'tangential'")
+        for f in ("mass", "k_n", "d_n", "k_t", "d_t"):
+            _check_value(c, f, getattr(self, f))
+            v = getattr(self, f)
+            if isinstance(v, (int, float)) and (v < 0 or (f == "mass" and v == 0)):
+                raise ParameterError(f"{c}: {f} must be {'in (0, inf)' if f == 'mass' else 'in [0, inf)'}; got {v}")
+        for f, dof in (("k_n", "normal"), ("k_t", "tangential")):
+            if dof in self.dofs and getattr(self, f) == 0:
+                raise ParameterError(f"{c}: the {dof} DOF has no stiffness ({f} = 0)")
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """A complete model: disk, pads, calipers and default parameter values.
+
+    Parameters
+    ----------
+    name : str
+        Model name.
+    disk : Disk
+        The disk.
+    pads : tuple of Pad
+        At least one pad.
+    calipers : tuple of Caliper
+        Mounting masses (optional).
+    parameters : dict
+        Default value of every parameter name used by the components.
+    description, reference : str
+        Documentation: assumptions and the literature the model follows.
+    """
+
+    name: str
+    disk: Disk
+    pads: tuple[Pad, ...]
+    calipers: tuple[Caliper, ...] = ()
+    parameters: dict[str, float] = field(default_factory=dict)
+    description: str = ""
+    reference: str = ""
+
+    def __post_init__(self) -> None:
+        self.validate()
+
+    def validate(self) -> None:
+        """Check components, names and that every named parameter has a default value."""
+        if not self.pads:
+            raise ParameterError(f"model '{self.name}': needs at least one pad")
+        self.disk.validate()
+        names: set[str] = set()
+        for comp in (*self.pads, *self.calipers):
+            comp.validate()
+            if comp.name in names:
+                raise ParameterError(f"model '{self.name}': duplicate component name '{comp.name}'")
+            names.add(comp.name)
+        calipers = {c.name for c in self.calipers}
+        for p in self.pads:
+            if p.mount is not None and p.mount not in calipers:
+                raise ParameterError(f"{p.label}: mount '{p.mount}' is not a caliper of the model")
+        missing = sorted(n for n in self.parameter_names() if n not in self.parameters)
+        if missing:
+            raise ParameterError(f"model '{self.name}': no default value for parameter(s) {', '.join(missing)}")
+        unused = sorted(set(self.parameters) - set(self.parameter_names()))
+        if unused:
+            raise ParameterError(f"model '{self.name}': parameter(s) {', '.join(unused)} are not used by any component")
+        R = self.disk.radius
+        for p in self.pads:
+            r = self.parameters.get(p.radius) if _is_name(p.radius) else p.radius
+            Rv = self.parameters.get(R) if _is_name(R) else R
+            if r is not None and Rv is not None and r > Rv:
+                raise ParameterError(f"{p.label}: placed off the disk (radius {r} m > disk radius {Rv} m)")
+
+    def parameter_names(self) -> list[str]:
+        """Names of all parameters the components use, in first-use order."""
+        out: list[str] = []
+
+        def add(v: object) -> None:
+            if isinstance(v, str) and v not in out:
+                out.append(v)
+
+        d = self.disk
+        for f in ("Theta", "Phi", "k_t", "d_t", "h_upper", "h_lower", "Omega", "radius"):
+            add(getattr(d, f))
+        for p in self.pads:
+            for f in ("radius", "k", "d", "preload", "k_ip", "d_ip", "mass", "k_c", "d_c"):
+                add(getattr(p, f))
+            for f in ("mu", "slope", "mu_s", "v_s"):
+                add(getattr(p.friction, f))
+        for c in self.calipers:
+            for f in ("mass", "k_n", "d_n", "k_t", "d_t"):
+                add(getattr(c, f))
+        return out
+
+    def stiffness_names(self) -> set[str]:
+        """Parameter names used as tangential stiffnesses ``k_ip`` (they may be ``inf``)."""
+        return {p.k_ip for p in self.pads if isinstance(p.k_ip, str)}

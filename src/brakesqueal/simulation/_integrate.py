@@ -1,0 +1,360 @@
+r"""The simulation entry point :func:`simulate` and the model object it integrates."""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from types import ModuleType
+from typing import Any, Callable, Literal, Sequence
+
+import numpy as np
+
+from ..errors import ParameterError, SilentMotionError
+from ..parameters import Parameters
+from .trajectory import Trajectory
+
+__all__ = ["METHODS", "SimulationModel", "default_model", "simulate"]
+
+#: Integration methods: the compiled DOP853 (default) and SciPy's ``solve_ivp`` methods.
+METHODS: tuple[str, ...] = ("DOP853-jit", "DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
+EventMode = Literal["stop", "continue", "off"]
+_EVENT_NAMES = ("contact-loss-pad1", "contact-loss-pad2", "sliding-reversal-pad1", "sliding-reversal-pad2")
+
+
+@dataclass(frozen=True)
+class SimulationModel:
+    """A model :func:`simulate` can integrate: the compiled 2-DOF wobbling-disk model.
+
+    Attributes
+    ----------
+    name : str
+        Identifier (``"general-2dof"``).
+    kernels : module
+        numba-compiled functions ``rhs(y, l, p, out)``, ``solve_l``,
+        ``event_values``, ``post_process`` and the integrator ``dop853``
+        (see :mod:`brakesqueal.simulation._kernels`).
+    state_names : tuple of str
+        ``("q1", "q2", "dq1", "dq2")`` [rad, rad/s].
+    """
+
+    name: str
+    kernels: ModuleType
+    state_names: tuple[str, ...] = ("q1", "q2", "dq1", "dq2")
+
+    def parameter_vector(self, params: Parameters) -> np.ndarray:
+        """Parameters in the kernels' order (compliances ``1/k_ip``)."""
+        from ..analysis.equilibrium import parameter_vector
+
+        return np.asarray(parameter_vector(params), dtype=float)
+
+    def silent(self, params: Parameters) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(y_silent, l_silent, v_r_silent (6,))`` of the silent motion (eq. 46)."""
+        from ..analysis.equilibrium import silent_motion
+
+        sm = silent_motion(params)
+        y = np.array([sm.q_m0[0], sm.q_m0[1], 0.0, 0.0])
+        l = sm.l0.astype(float).copy()
+        c = np.asarray(self.kernels.contact(y, l, self.parameter_vector(params)))
+        return y, l, np.concatenate([c[1:4], c[7:10]])
+
+    def rhs(self, params: Parameters) -> Callable[[float, np.ndarray], np.ndarray]:
+        """``f(t, y)`` for SciPy (solves the pad deformations on the way, warm-started)."""
+        p = self.parameter_vector(params)
+        lbuf = np.zeros(2)
+        k = self.kernels
+
+        def fun(t: float, y: np.ndarray) -> np.ndarray:
+            out = np.empty(4)
+            k.rhs(np.ascontiguousarray(y, dtype=float), lbuf, p, out)
+            return out
+
+        return fun
+
+
+def default_model(use_cache: bool = True) -> SimulationModel:
+    """The general 2-DOF model of the paper (eq. 44 with quasi-static pads)."""
+    from ._kernels import load_kernels
+
+    return SimulationModel(name="general-2dof", kernels=load_kernels(use_cache))
+
+
+def _check_tolerances(rtol: float, atol: Any, scale_rate: float) -> np.ndarray:
+    if not (isinstance(rtol, (int, float)) and math.isfinite(rtol) and 1e-13 <= rtol <= 1e-2):
+        raise ParameterError(f"The option 'rtol' must be in [1e-13, 1e-2]; got {rtol!r}")
+    if atol is None:
+        return rtol * 1e-6 * np.array([1.0, 1.0, scale_rate, scale_rate])
+    a = np.broadcast_to(np.asarray(atol, dtype=float), (4,)).copy()
+    if not np.all(np.isfinite(a)) or np.any(a <= 0) or np.any(a > 1.0):
+        raise ParameterError(f"The option 'atol' must be in (0, 1] (scalar or 4 values); got {atol!r}")
+    return a
+
+
+def _initial_state(x0: Any, perturbation: Any, y_s: np.ndarray) -> np.ndarray:
+    if x0 is not None and perturbation is not None:
+        raise ParameterError("give either x0 (absolute initial state) or perturbation, not both")
+    if x0 is not None:
+        v = np.asarray(x0, dtype=float).ravel()
+        if v.size != 4:
+            raise ParameterError(f"The initial state x0 must have 4 values (q1, q2, dq1, dq2); got {v.size}")
+        y0 = v
+    else:
+        d = np.asarray((1e-5, 0.0) if perturbation is None else perturbation, dtype=float).ravel()
+        if d.size not in (2, 4):
+            raise ParameterError(
+                f"The perturbation must have 2 (dq1, dq2) or 4 values (dq1, dq2, dq1dot, dq2dot); got {d.size}"
+            )
+        y0 = y_s + np.concatenate([d, np.zeros(4 - d.size)])
+    if not np.all(np.isfinite(y0)):
+        raise ParameterError(f"The initial state must be finite; got {y0.tolist()}")
+    if np.any(np.abs(y0[:2]) >= 0.5 * math.pi):
+        raise ParameterError(f"The initial tilt angles must be in (-pi/2, pi/2); got {y0[:2].tolist()}")
+    return y0
+
+
+def simulate(
+    model: SimulationModel | None,
+    params: Parameters,
+    t_span: float | Sequence[float] = 0.5,
+    x0: Sequence[float] | np.ndarray | None = None,
+    *,
+    perturbation: Sequence[float] | np.ndarray | None = None,
+    method: str = "DOP853-jit",
+    rtol: float = 1e-9,
+    atol: float | Sequence[float] | None = None,
+    sample_rate: float = 44100.0,
+    events: EventMode = "stop",
+    max_step: float = math.inf,
+    max_steps: int = 50_000_000,
+    progress: Callable[[float], None] | None = None,
+) -> Trajectory:
+    r"""Integrate the nonlinear 2-DOF equations (44) of the wobbling disk.
+
+    Parameters
+    ----------
+    model : SimulationModel or None
+        The model; ``None`` is :func:`default_model` (the paper's general model).
+    params : Parameters
+        Model parameters.
+    t_span : float or (float, float)
+        End time ``t_end`` [s] (start 0) or ``(t0, t_end)``; ``t_end > t0``.
+    x0 : array_like, shape (4,), optional
+        Absolute initial state ``(q1, q2, dq1, dq2)`` [rad, rad/s].
+    perturbation : array_like, shape (2,) or (4,), optional
+        Initial deviation from the silent motion ``q_m0`` (rates zero if two
+        values).  Default when neither is given: ``(1e-5, 0)`` rad.
+    method : str
+        ``"DOP853-jit"`` (compiled Dormand–Prince 8(5,3), default) or one of
+        SciPy's ``solve_ivp`` methods ``"DOP853", "RK45", "RK23", "Radau",
+        "BDF", "LSODA"`` (same RHS, called from Python; slower).
+    rtol : float
+        Relative tolerance, in ``[1e-13, 1e-2]``.
+    atol : float or array_like (4,), optional
+        Absolute tolerance(s) in ``(0, 1]``; default ``1e-6 rtol (1, 1, w, w)``
+        with ``w = sqrt(k_t/Theta)`` [rad, rad/s].
+    sample_rate : float
+        Output samples per second [Hz] (uniform grid, dense output).
+    events : {"stop", "continue", "off"}
+        ``"stop"`` ends the run at the first contact loss (``F_n <= 0``) or
+        sliding reversal (``v_r . v_r0 <= 0``, ``v_r0`` the silent-motion
+        sliding velocity of that pad); ``"continue"`` records the event times
+        and integrates on with the same equations (documented model: bilateral
+        contact, friction direction ``v_r/|v_r|``); ``"off"`` ignores them.
+    max_step : float
+        Largest step [s].
+    max_steps : int
+        Step budget (compiled method); exceeding it ends the run with status
+        ``"failed"``.
+    progress : callable, optional
+        Called with the fraction done (0..1) while integrating.
+
+    Returns
+    -------
+    Trajectory
+        Status, message, samples and summary numbers; the partial trajectory
+        is kept when the run stops early.
+
+    Raises
+    ------
+    ParameterError
+        Bad options or initial state (non-finite, ``t_end <= t0``, tolerances
+        out of range, a pad out of contact at the initial state).
+    SilentMotionError
+        If the silent motion does not exist (needed for the reference state).
+
+    Notes
+    -----
+    The pads are massless and quasi-static: ``ldot := 0`` in the relative
+    velocities and normal-force rates, and ``l`` follows ``(q, qdot)`` through
+    ``g(q, qdot, l, ldot=0) = 0`` (Newton from the previous ``l``), exactly
+    as in the linearization.
+    """
+    model = model or default_model()
+    if method not in METHODS:
+        raise ParameterError(f"The option 'method' must be one of {', '.join(METHODS)}; got {method!r}")
+    if events not in ("stop", "continue", "off"):
+        raise ParameterError(f"The option 'events' must be one of stop, continue, off; got {events!r}")
+    if np.ndim(t_span) == 0:
+        t0, t1 = 0.0, float(t_span)  # type: ignore[arg-type]
+    else:
+        t0, t1 = (float(v) for v in t_span)  # type: ignore[union-attr]
+    if not (math.isfinite(t0) and math.isfinite(t1) and t1 > t0):
+        raise ParameterError(f"The end time must be finite and greater than the start time {t0:g} s; got {t1!r}")
+    if not (math.isfinite(sample_rate) and sample_rate > 0):
+        raise ParameterError(f"The option 'sample_rate' must be a positive number; got {sample_rate!r}")
+    n_out = int(math.floor((t1 - t0) * sample_rate + 1e-9)) + 1
+    if n_out > 50_000_000:
+        raise ParameterError(f"{n_out} output samples requested; lower sample_rate or t_end")
+    if not (max_step > 0):
+        raise ParameterError(f"The option 'max_step' must be positive; got {max_step!r}")
+    p = model.parameter_vector(params)
+    try:
+        y_s, l_s, vr0 = model.silent(params)
+    except SilentMotionError as exc:
+        raise SilentMotionError(f"cannot simulate: {exc}") from None
+    y0 = _initial_state(x0, perturbation, y_s)
+    atol_v = _check_tolerances(rtol, atol, math.sqrt(max(params.k_t, 1.0) / params.Theta))
+    k = model.kernels
+    l0 = l_s.copy()
+    f0 = np.empty(4)
+    k.rhs(y0, l0, p, f0)
+    ev0 = np.empty(4)
+    k.event_values(y0, l0, p, vr0, ev0)
+    if not np.all(np.isfinite(f0)) or not np.all(np.isfinite(ev0)):
+        raise ParameterError(f"the equations cannot be evaluated at the initial state {y0.tolist()}")
+    for i in range(2):
+        if ev0[i] <= 0:
+            raise ParameterError(
+                f"pad {i + 1} is out of contact at the initial state (F_n{i + 1} = {ev0[i]:.6g} N <= 0); "
+                "use a smaller initial perturbation"
+            )
+        if ev0[i + 2] <= 0 and events != "off":
+            raise ParameterError(f"pad {i + 1} does not slide forward at the initial state; use a smaller perturbation")
+    t_out = t0 + np.arange(n_out) / sample_rate
+    wall = time.perf_counter()
+    if method == "DOP853-jit":
+        res = _run_jit(k, y0, l0, f0, p, vr0, t0, t1, rtol, atol_v, max_step, t_out, events, max_steps, progress)
+    else:
+        res = _run_scipy(model, params, k, y0, l0, p, vr0, t0, t1, method, rtol, atol_v, max_step, t_out, events,
+                         progress)  # fmt: skip
+    wall = time.perf_counter() - wall
+    n = res["n"]
+    Y = res["Y"][:n]
+    L, C, E = k.post_process(Y, l_s, p) if n else (np.empty((0, 2)), np.empty((0, 12)), np.empty((0, 3)))
+    return Trajectory(
+        status=res["status"], message=res["message"], t=t_out[:n], y=Y, l=L, contact=C, kinetic=E,
+        params=params, q_m0=y_s[:2].copy(), method=method, rtol=rtol, atol=atol_v, t_span=(t0, t1),
+        t_event=res.get("t_event"), y_event=res.get("y_event"), event_times=res.get("event_times", {}),
+        stats={"nfev": res["nfev"], "wall_s": wall, **res.get("stats", {})}, model=model.name,
+    )  # fmt: skip
+
+
+def _dop853_tables() -> tuple[np.ndarray, ...]:
+    from scipy.integrate._ivp import dop853_coefficients as c
+
+    A = np.ascontiguousarray(c.A, dtype=float)
+    return A, np.asarray(c.B, float), np.asarray(c.C, float), np.asarray(c.E3, float), np.asarray(c.E5, float), \
+        np.ascontiguousarray(c.D, dtype=float)  # fmt: skip
+
+
+def _run_jit(k, y0, l0, f0, p, vr0, t0, t1, rtol, atol, max_step, t_out, events, max_steps, progress):  # type: ignore[no-untyped-def]
+    tables = _dop853_tables()
+    Y = np.full((t_out.size, 4), np.nan)
+    mode = {"off": 0, "stop": 1, "continue": 2}[events]
+    ev_t = np.zeros(10000)
+    ev_k = np.zeros(10000, dtype=np.int64)
+    n_ev = 0
+    y, l, f = y0.copy(), l0.copy(), f0.copy()
+    h = min(1e-7, (t1 - t0) / 10)
+    i_out = 0
+    nfev = nstep = nrej = 0
+    chunks = 50 if progress is not None else 1
+    edges = np.linspace(t0, t1, chunks + 1)
+    status, t_event, y_event, k_event = 0, None, None, -1
+    t = t0
+    for c in range(chunks):
+        out = k.dop853(y, l, f, p, vr0, t, float(edges[c + 1]), h, rtol, atol, max_step, t_out, i_out, Y,
+                       mode, ev_t, ev_k, n_ev, max_steps - nstep, *tables)  # fmt: skip
+        status, t, y, l, f, h, i_out, n_ev, fe, ns, nr, k_event, te, ye = out
+        nfev, nstep, nrej = nfev + fe, nstep + ns, nrej + nr
+        if progress is not None:
+            progress((t - t0) / (t1 - t0))
+        if status != 0:
+            if status == 1:
+                t_event, y_event = float(te), np.asarray(ye).copy()
+            break
+    recorded: dict[str, list[float]] = {}
+    for i in range(min(n_ev, ev_t.size)):
+        recorded.setdefault(_EVENT_NAMES[int(ev_k[i])], []).append(float(ev_t[i]))
+    st, msg = _status(status, t, k_event, t_event)
+    return {"status": st, "message": msg, "Y": Y, "n": i_out, "nfev": int(nfev), "t_event": t_event,
+            "y_event": y_event, "event_times": recorded, "stats": {"steps": int(nstep), "rejected": int(nrej)}}  # fmt: skip
+
+
+def _status(code: int, t: float, k_event: int, t_event: float | None) -> tuple[str, str]:
+    if code == 0:
+        return "finished", "reached the end time"
+    if code == 1:
+        pad = k_event % 2 + 1
+        if k_event < 2:
+            return "contact-loss", f"pad {pad} lost contact (F_n{pad} <= 0) at t = {t_event:.6g} s"
+        return "sliding-reversal", f"sliding at pad {pad} reversed (v_r{pad} . v_r0 <= 0) at t = {t_event:.6g} s"
+    reason = {
+        -1: "step size became too small",
+        -2: "the state became non-finite or the pad equations g = 0 could not be solved",
+        -3: "the step budget max_steps was exhausted",
+    }.get(code, f"integrator error {code}")
+    return "failed", f"integration failed at t = {t:.6g} s: {reason}"
+
+
+def _run_scipy(model, params, k, y0, l0, p, vr0, t0, t1, method, rtol, atol, max_step, t_out, events, progress):  # type: ignore[no-untyped-def]
+    from scipy.integrate import solve_ivp
+
+    lbuf = l0.copy()
+    calls = [0]
+
+    def fun(t: float, y: np.ndarray) -> np.ndarray:
+        out = np.empty(4)
+        k.rhs(np.ascontiguousarray(y, dtype=float), lbuf, p, out)
+        calls[0] += 1
+        if progress is not None and calls[0] % 2000 == 0:
+            progress((t - t0) / (t1 - t0))
+        return out
+
+    evfuns = []
+    if events != "off":
+        lev = l0.copy()
+        vals = np.empty(4)
+
+        def make(i: int) -> Callable[[float, np.ndarray], float]:
+            def ev(t: float, y: np.ndarray) -> float:
+                yy = np.ascontiguousarray(y, dtype=float)
+                k.solve_l(yy, lev, p)
+                k.event_values(yy, lev, p, vr0, vals)
+                return float(vals[i])
+
+            ev.terminal = events == "stop"  # type: ignore[attr-defined]
+            ev.direction = -1  # type: ignore[attr-defined]
+            return ev
+
+        evfuns = [make(i) for i in range(4)]
+    sol = solve_ivp(fun, (t0, t1), y0, method=method, t_eval=t_out, rtol=rtol, atol=atol, max_step=max_step,
+                    events=evfuns or None)  # fmt: skip
+    if progress is not None:
+        progress(1.0)
+    n = sol.t.size
+    Y = np.ascontiguousarray(sol.y.T)
+    t_event, y_event, k_event = None, None, -1
+    recorded: dict[str, list[float]] = {}
+    if evfuns:
+        for i, te in enumerate(sol.t_events):
+            if te.size:
+                recorded[_EVENT_NAMES[i]] = [float(v) for v in te]
+                if sol.status == 1 and (t_event is None or te[0] < t_event):
+                    t_event, y_event, k_event = float(te[0]), np.asarray(sol.y_events[i][0]), i
+    code = {0: 0, 1: 1, -1: -2}[sol.status]
+    st, msg = _status(code, float(sol.t[-1]) if n else t0, k_event, t_event)
+    if code == -2:
+        msg = f"solve_ivp ({method}) failed: {sol.message}"
+    return {"status": st, "message": msg, "Y": Y, "n": n, "nfev": int(sol.nfev), "t_event": t_event,
+            "y_event": y_event, "event_times": recorded if events == "continue" else {}}  # fmt: skip

@@ -1,0 +1,147 @@
+"""The model builder: equivalence with the engine, limits, symmetry, classic criteria, bad input."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+
+import numpy as np
+import pytest
+import symengine as se
+
+from brakesqueal.analysis.linear import linearize
+from brakesqueal.builder import (
+    MODELS, Caliper, Disk, FrictionLaw, ModelSpec, Pad, build_equations, get_model, linearize_model,
+    model_to_toml, spec_from_dict,
+)  # fmt: skip
+from brakesqueal.errors import ParameterError
+from brakesqueal.parameters import Parameters
+from brakesqueal.symbolic.model import derive_equations
+
+
+def test_two_pad_coulomb_model_reproduces_the_engine_symbolically():
+    built = build_equations(get_model("paper-2dof"))
+    eng = derive_equations("symengine")
+    ren = {se.Symbol("l1"): se.Symbol("l_1"), se.Symbol("l2"): se.Symbol("l_2"),
+           se.Symbol("c_ip1"): se.Symbol("c__k_ip1"), se.Symbol("c_ip2"): se.Symbol("c__k_ip2"),
+           se.Symbol("dl1"): 0, se.Symbol("dl2"): 0}  # fmt: skip
+    for i in range(2):
+        assert se.expand(built.R[i] - eng.psi[i].xreplace(ren)) == 0
+        assert se.expand(built.G[i] - eng.g[i].xreplace(ren)) == 0
+    assert built.coords == ("q1", "q2") and built.algebraic == ("l_1", "l_2")
+
+
+@pytest.mark.parametrize("asym", [False, True])
+def test_builder_linearization_equals_engine_numerically(asym):
+    over = {"mu1": 0.6, "mu2": 0.35, "k_ip1": 3e8, "k_ip2": 7e7, "k2": 4e6, "d2": 8.0}
+    if asym:
+        over["h10"] = 0.013  # non-trivial silent motion
+    lm_b = linearize_model(get_model("paper-2dof"), over)
+    base = {**get_model("paper-2dof").parameters, **over}
+    p = Parameters(**{k: base[k] for k in ("Theta", "Phi", "k_t", "d_t", "k1", "k2", "d1", "d2", "k_ip1", "k_ip2",
+                                          "mu1", "mu2", "h10", "h20", "r", "N0", "Omega")})  # fmt: skip
+    lm_e = linearize(p)
+    assert np.allclose(lm_b.Q0, lm_e.q_m0, rtol=1e-9, atol=1e-18)
+    for name in "MDK":
+        a, b = getattr(lm_b, name), getattr(lm_e, name)
+        assert np.allclose(a, b, rtol=1e-10, atol=1e-12 * np.abs(b).max()), name
+
+
+def _slow_eigs(lm, k=4):
+    lam = lm.eigenvalues
+    return np.sort_complex(lam[np.argsort(np.abs(lam))][:k])
+
+
+def test_extended_models_converge_to_2dof_as_pad_masses_vanish():
+    ref = np.sort_complex(linearize_model(get_model("paper-2dof")).eigenvalues)
+    errs = []
+    for m_p, k_c in ((1e-2, 1e10), (1e-4, 1e12), (1e-6, 1e14)):
+        six = linearize_model(get_model("six-dof"), {"m_p": m_p, "k_c": k_c})
+        assert six.M.shape == (6, 6)
+        errs.append(np.max(np.abs(_slow_eigs(six) - ref) / np.abs(ref)))
+    assert errs[0] > errs[1] > errs[2] and errs[2] < 1e-6, errs
+    # the real parts (stability!) converge too
+    six = linearize_model(get_model("six-dof"), {"m_p": 1e-6, "k_c": 1e14})
+    assert np.allclose(_slow_eigs(six).real, ref.real, rtol=1e-3)
+
+
+def test_eight_dof_caliper_limit():
+    """A very stiff, very light caliper makes the 8-DOF model behave like the 6-DOF one."""
+    six = linearize_model(get_model("six-dof"))
+    eight = linearize_model(get_model("eight-dof"), {"m_c": 1e-6, "k_cn": 1e14, "k_ct": 1e14})
+    assert eight.M.shape == (8, 8)
+    assert np.allclose(_slow_eigs(eight, 6), _slow_eigs(six, 6), rtol=1e-6)
+
+
+@pytest.mark.parametrize("factor", [0.97, 1.03])
+def test_mass_on_belt_recovers_negative_slope_criterion(factor):
+    """m u'' + (d_ip + N0 dmu/dv) u' + k u = 0: unstable iff d_ip < N0 * slope (ref. [1])."""
+    spec = get_model("belt")
+    v = spec.parameters
+    slope = factor * v["d_ip"] / v["N0"]
+    lm = linearize_model(spec, {"slope": slope})
+    c_eff = v["d_ip"] - v["N0"] * slope
+    expected = -c_eff / (2 * v["m"])
+    assert lm.M.shape == (1, 1)
+    assert math.isclose(lm.max_real, expected, rel_tol=1e-9)
+    assert (lm.max_real > 0) == (factor > 1)
+    assert math.isclose(abs(lm.eigenvalues[0].imag), math.sqrt(v["k_ip"] / v["m"] - expected**2), rel_tol=1e-9)
+
+
+def test_four_equal_pads_behave_symmetrically():
+    lm = linearize_model(get_model("four-pad"))
+    J = np.array([[0.0, -1.0], [1.0, 0.0]])  # a quarter turn maps the tilt (q1, q2) to (-q2, q1)
+    for m in (lm.M, lm.D, lm.K):
+        assert np.allclose(J @ m, m @ J, rtol=0, atol=1e-9 * np.abs(m).max())
+    # sanity: three pads are not symmetric under a quarter turn
+    spec = get_model("four-pad")
+    three = ModelSpec("three", spec.disk, spec.pads[:3], parameters=spec.parameters)
+    K3 = linearize_model(three).K
+    assert not np.allclose(J @ K3, K3 @ J, rtol=0, atol=1e-6 * np.abs(K3).max())
+
+
+@pytest.mark.parametrize("name", list(MODELS))
+def test_toml_round_trip(name, tmp_path):
+    spec = get_model(name)
+    text = model_to_toml(spec)
+    assert spec_from_dict(tomllib.loads(text)) == spec
+
+
+def _pad(**kw):
+    base = dict(name="a", face="upper", friction=FrictionLaw("coulomb", "mu"))
+    base.update(kw)
+    return Pad(**base)
+
+
+_NUM_DISK = Disk(Theta=0.16, Phi=0.32, k_t=1e7, d_t=0.1, h_upper=0.01, h_lower=0.01, Omega=50.0, radius=0.15)
+
+
+def _num_pad(**kw):
+    return _pad(k=6e6, d=5.0, preload=3000.0, **kw)
+
+
+BAD = [
+    (lambda: ModelSpec("m", _NUM_DISK, (_num_pad(radius=0.2),), parameters={"mu": 0.4}), "pad 'a'.*off the disk"),
+    (lambda: _pad(dofs=("tangential",)).validate(), "pad 'a'.*without mass"),
+    (lambda: _pad(mass=1.0, dofs=("tangential",)).validate(), "pad 'a'.*tangential DOF without stiffness"),
+    (lambda: _pad(friction=FrictionLaw("coulomb", -0.3)).validate(), "pad 'a'.*mu must be in \\[0, inf\\)"),
+    (lambda: _pad(friction=FrictionLaw("stribeck", 0.3)).validate(), "pad 'a'.*needs 'mu_s'"),
+    (lambda: Caliper("c", mass=1.0, k_n=0.0, k_t=1.0).validate(), "caliper 'c'.*no stiffness"),
+    (lambda: ModelSpec("m", Disk(), (_pad(), _pad()), parameters={}), "duplicate component name 'a'"),
+    (lambda: _pad(mass=1.0, dofs=("normal",)).validate(), "normal DOF needs a contact stiffness"),
+]
+
+
+@pytest.mark.parametrize("make,pattern", BAD, ids=[p for _, p in BAD])
+def test_bad_components_are_named(make, pattern):
+    with pytest.raises(ParameterError, match=pattern):
+        make()
+
+
+def test_bad_parameter_values_are_named():
+    with pytest.raises(ParameterError, match="'m_p'.*must be in \\(0, inf\\)"):
+        linearize_model(get_model("six-dof"), {"m_p": 0.0})
+    with pytest.raises(ParameterError, match="'mu1'.*\\[0, inf\\)"):
+        linearize_model(get_model("paper-2dof"), {"mu1": -0.1})
+    with pytest.raises(ParameterError, match="not a parameter of model"):
+        linearize_model(get_model("paper-2dof"), {"zzz": 1.0})

@@ -1,0 +1,75 @@
+"""The ``brakesqueal simulate`` command."""
+
+from __future__ import annotations
+
+import json
+import wave
+
+import pytest
+
+from brakesqueal.cli import main
+
+
+def test_simulate_json_outputs(tmp_path, capsys):
+    nc, png, wav = tmp_path / "sim.nc", tmp_path / "sim.png", tmp_path / "sq.wav"
+    rc = main(["simulate", "--t-end", "0.02", "--q0", "1e-5,0", "--out", str(nc), "--plot", str(png),
+               "--wav", str(wav), "--format", "json", "--no-progress"])  # fmt: skip
+    assert rc == 0
+    data = json.loads(capsys.readouterr().out)
+    for key in ("status", "frequency_hz", "growth_rate", "amplitude_final"):
+        assert key in data
+    assert data["status"] == "finished"
+    assert 1700 < data["frequency_hz"] < 1760
+    assert nc.stat().st_size > 0 and png.stat().st_size > 0
+    with wave.open(str(wav)) as w:
+        assert w.getframerate() == 44100 and w.getnframes() > 800
+
+
+def test_simulate_event_written(tmp_path, capsys):
+    nc = tmp_path / "ev.nc"
+    rc = main(["simulate", "--set", "mu=1", "--set", "h=0.05", "--t-end", "1", "--q0", "2e-3,0",
+               "--out", str(nc), "--format", "json", "--no-progress", "--sample-rate", "5000"])  # fmt: skip
+    assert rc == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["status"] == "contact-loss"
+    import xarray as xr
+
+    ds = xr.load_dataset(nc)
+    assert ds.attrs["status"] == "contact-loss" and ds.sizes["time"] > 10
+
+
+@pytest.mark.parametrize(
+    "args, match",
+    [
+        (["--t-end", "0"], "t-end"),
+        (["--t-end", "-1"], "t-end"),
+        (["--q0", "nan,0"], "finite"),
+        (["--q0", "abc"], "numbers"),
+        (["--rtol", "1"], "rtol"),
+        (["--q0", "0.05,0"], "out of contact"),
+        (["--set", "mu=-1"], "mu"),
+        (["--format", "xml"], "format"),
+    ],
+)
+def test_simulate_bad_input(args, match, capsys):
+    rc = main(["simulate", "--t-end", "0.01", "--no-progress", *args])
+    err = capsys.readouterr().err
+    assert rc == 2
+    assert err.count("\n") == 1 and match in err
+
+
+def test_solver_failure_writes_partial(tmp_path, capsys, monkeypatch):
+    import brakesqueal.simulation as sim
+
+    orig = sim.simulate
+
+    def limited(*a, **kw):
+        return orig(*a, max_steps=100, **kw)
+
+    monkeypatch.setattr(sim, "simulate", limited)
+    nc = tmp_path / "fail.nc"
+    with pytest.raises(SystemExit) as exc:
+        main(["simulate", "--t-end", "0.05", "--out", str(nc), "--format", "json", "--no-progress"])
+    assert exc.value.code == 1
+    assert json.loads(capsys.readouterr().out)["status"] == "failed"
+    assert nc.stat().st_size > 0
