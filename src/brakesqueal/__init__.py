@@ -53,6 +53,19 @@ __all__ = [
     "load_model",
     "build_equations",
     "linearize_model",
+    "stability_map",
+    "crossings",
+    "critical_speeds",
+    "critical_speeds_many",
+    "eigen_analysis",
+    "EigenAnalysis",
+    "Verdict",
+    "ParameterSpace",
+    "Axis",
+    "StabilityMap",
+    "CrossingResult",
+    "CriticalSpeedResult",
+    "open_map",
 ]
 
 _LAZY = {
@@ -82,6 +95,19 @@ _LAZY = {
     "load_model": "builder",
     "build_equations": "builder",
     "linearize_model": "builder",
+    "stability_map": "analysis.stability",
+    "crossings": "analysis.stability",
+    "critical_speeds": "analysis.stability",
+    "critical_speeds_many": "analysis.stability",
+    "eigen_analysis": "analysis.stability",
+    "EigenAnalysis": "analysis.stability",
+    "Verdict": "analysis.stability",
+    "ParameterSpace": "analysis.stability",
+    "Axis": "analysis.stability",
+    "StabilityMap": "results",
+    "CrossingResult": "results",
+    "CriticalSpeedResult": "results",
+    "open_map": "results",
 }
 
 

@@ -1,6 +1,32 @@
-"""Analysis layer: silent motion, linear models and (later) stability analysis."""
+"""Analysis layer: silent motion, linear models, eigen-analysis, stability maps, crossings, critical speeds."""
 
 from .equilibrium import SilentMotion, silent_motion
 from .linear import LinearModel, linearize, pad_rate_eigenvalues
+from .stability import (
+    Axis,
+    EigenAnalysis,
+    ParameterSpace,
+    Verdict,
+    critical_speeds,
+    critical_speeds_many,
+    crossings,
+    eigen_analysis,
+    stability_map,
+)
 
-__all__ = ["SilentMotion", "silent_motion", "LinearModel", "linearize", "pad_rate_eigenvalues"]
+__all__ = [
+    "SilentMotion",
+    "silent_motion",
+    "LinearModel",
+    "linearize",
+    "pad_rate_eigenvalues",
+    "Axis",
+    "EigenAnalysis",
+    "ParameterSpace",
+    "Verdict",
+    "critical_speeds",
+    "critical_speeds_many",
+    "crossings",
+    "eigen_analysis",
+    "stability_map",
+]

@@ -1,0 +1,99 @@
+"""Matplotlib figures of the stability analysis (Agg backend; figures are returned, never shown)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+__all__ = ["new_figure", "plot_map", "plot_path", "plot_critical_curves", "save"]
+
+
+def new_figure(ax: Any = None, size: tuple[float, float] = (6.4, 4.8)) -> tuple[Any, Any]:
+    """A new ``(figure, axes)`` pair on the Agg canvas, or the figure of ``ax``."""
+    if ax is not None:
+        return ax.figure, ax
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=size, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig, fig.add_subplot()
+
+
+def _label(name: str, units: str) -> str:
+    return f"{name} [{units}]" if units else name
+
+
+def plot_map(m: Any, ax: Any = None, *, x: str | None = None, title: str | None = None) -> Any:
+    """Plot a :class:`~brakesqueal.results.StabilityMap`: stable region, boundary, invalid points."""
+    from matplotlib.colors import ListedColormap
+
+    fig, ax = new_figure(ax)
+    outer, inner = m.dims
+    ds = m.data
+    xn = x or inner
+    yn = outer if xn == inner else inner
+    st = ds["stable"].transpose(yn, xn).values.astype(float)
+    status = ds["status"].transpose(yn, xn).values
+    xs, ys = ds[xn].values, ds[yn].values
+    z = np.where(status >= 2, np.nan, st)
+    ax.pcolormesh(xs, ys, z, cmap=ListedColormap(["#f4c7c3", "#c8e6c9"]), vmin=0, vmax=1, shading="nearest",
+                  rasterized=True)
+    if np.any(status >= 2):
+        ax.contourf(xs, ys, (status >= 2).astype(float), levels=[0.5, 1.5], colors="none", hatches=["xx"])
+    if 0 < np.nanmean(z) < 1:
+        ax.contour(xs, ys, np.nan_to_num(z, nan=0.0), levels=[0.5], colors="k", linewidths=1.2)
+    for name, setter in ((xn, ax.set_xscale), (yn, ax.set_yscale)):
+        if ds[name].attrs.get("scale") == "log":
+            setter("log")
+    ax.set_xlabel(_label(xn, ds[xn].attrs.get("units", "")))
+    ax.set_ylabel(_label(yn, ds[yn].attrs.get("units", "")))
+    from matplotlib.patches import Patch
+
+    ax.legend(handles=[Patch(color="#c8e6c9", label="stable"), Patch(color="#f4c7c3", label="unstable (squeal)")],
+              loc="best", fontsize=8)
+    ax.set_title(title or f"stability map ({ds.attrs.get('space', '')})")
+    return fig
+
+
+def plot_path(r: Any, ax: Any = None, n: int = 400) -> Any:
+    """Largest real part along a 1-D path with its crossings marked."""
+    from .analysis.maps import Axis, _numeric_point, _roots_summary
+
+    fig, ax = new_figure(ax)
+    grid = Axis(r.parameter, r.start, r.stop, n, r.log).values()
+    vals = []
+    for v in grid:
+        _, c = _numeric_point(r.space, {r.parameter: float(v)})
+        vals.append(np.nan if c is None else _roots_summary(c)[0][0])
+    ax.plot(grid, vals, "k-", lw=1)
+    ax.axhline(0, color="0.5", lw=0.8)
+    for v, d in r.crossings:
+        ax.axvline(v, color="tab:red" if d == "destabilizing" else "tab:green", ls="--", lw=1)
+    if r.log:
+        ax.set_xscale("log")
+    ax.set_yscale("symlog", linthresh=1e-2)
+    ax.set_xlabel(r.parameter)
+    ax.set_ylabel("max Re λ [1/s]")
+    return fig
+
+
+def plot_critical_curves(diff: np.ndarray, curves: dict[str, np.ndarray], ax: Any = None,
+                         restab: dict[str, np.ndarray] | None = None) -> Any:
+    """Ω_crit (and, dotted, the re-stabilising speed) versus μ1 − μ2 for several k_ip."""
+    fig, ax = new_figure(ax)
+    for i, (label, y) in enumerate(curves.items()):
+        line, = ax.plot(diff, y, "-", lw=1.5, label=f"k_ip = {label}")
+        if restab is not None and label in restab:
+            ax.plot(diff, restab[label], ":", lw=1, color=line.get_color())
+    ax.set_xlabel("μ1 − μ2 (μ1 + μ2 = 1)")
+    ax.set_ylabel("Ω_crit [rad/s]")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def save(fig: Any, path: str, dpi: int = 150) -> str:
+    """Save a figure (format from the suffix: PNG, SVG, PDF) and return the path."""
+    fig.savefig(path, dpi=dpi)
+    return path

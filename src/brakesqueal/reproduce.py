@@ -1,0 +1,136 @@
+"""Reproduce the paper's Figures 2 and 3 (PNG, NetCDF, CSV, JSON summary).
+
+* Fig. 2 — stability map over ``k_ip`` (log) and ``mu`` for ``paper-fig2``
+  (``N0 = 1800/mu``) with a dashed line of decreasing ``k_ip`` at fixed
+  ``mu`` and its exact points A (unstable → stable) and B (stable → unstable).
+* Fig. 3 — ``Ω_crit`` versus ``mu1 - mu2`` (``mu1 + mu2 = 1``) for
+  ``paper-fig3`` and several ``k_ip`` including ``inf``; the re-stabilising
+  speed the model also predicts is stored alongside.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["reproduce_fig2", "reproduce_fig3", "FIG2_MU", "FIG3_KIP"]
+
+#: mu of the dashed line in Fig. 2 (the preset's default; the line crosses the boundary twice there).
+FIG2_MU = 0.5
+#: k_ip values of Fig. 3 [N/m].
+FIG3_KIP = ("1e7", "1e8", "1e9", "inf")
+
+
+def _noop(frac: float) -> None:
+    pass
+
+
+def reproduce_fig2(out: str | Path, *, n_kip: int = 301, n_mu: int = 241, mu_line: float = FIG2_MU,
+                   progress: Callable[[float], None] = _noop) -> dict[str, Any]:
+    """Write ``fig2.png``, ``fig2.nc``, ``fig2.csv``, ``fig2.json`` to ``out``; returns the summary."""
+    from .analysis.crossings import crossings
+    from .analysis.maps import Axis, stability_map
+    from .analysis.space import ParameterSpace
+    from .plotting import save
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    space = ParameterSpace.from_preset("paper-fig2")
+    kip = Axis("k_ip", 1e5, 1e10, n_kip, True)
+    m = stability_map(space, kip, Axis("mu", 0.05, 1.0, n_mu), progress=lambda f: progress(0.8 * f))
+    line = crossings(ParameterSpace.from_preset("paper-fig2", {"mu": mu_line}), kip)
+    progress(0.9)
+    # walking along decreasing k_ip: a "destabilizing" crossing in increasing k_ip is A (unstable -> stable)
+    pts = sorted(line.crossings, key=lambda c: -c[0])
+    A = next((v for v, d in pts if d == "destabilizing"), None)
+    B = next((v for v, d in pts if d == "stabilizing" and (A is None or v < A)), None)
+    fig = m.plot(x="k_ip", title=f"Fig. 2: paper-fig2 (N0 = 1800/mu), dashed: mu = {mu_line:g}")
+    ax = fig.axes[0]
+    ax.plot([kip.stop, kip.start], [mu_line, mu_line], "k--", lw=1)
+    ax.annotate("", xy=(kip.start * 3, mu_line), xytext=(kip.start * 10, mu_line),
+                arrowprops={"arrowstyle": "->"})
+    for label, v in (("A", A), ("B", B)):
+        if v is not None:
+            ax.plot([v], [mu_line], "ko", ms=5)
+            ax.annotate(label, (v, mu_line), textcoords="offset points", xytext=(4, 6))
+    save(fig, str(out / "fig2.png"))
+    m.to_netcdf(str(out / "fig2.nc"))
+    m.to_csv(str(out / "fig2.csv"))
+    st = m.data["stable"].values
+    summary = {"figure": "fig2", "preset": "paper-fig2", "mu_line": mu_line, "A_k_ip": A, "B_k_ip": B,
+               "line_crossings": line.to_dict(), "grid": {"k_ip": [kip.start, kip.stop, n_kip, "log"],
+                                                          "mu": [0.05, 1.0, n_mu, "linear"]},
+               "stable_fraction": float(st.mean()),
+               "files": [str(out / f"fig2.{e}") for e in ("png", "nc", "csv", "json")]}
+    (out / "fig2.json").write_text(json.dumps(summary, indent=2) + "\n")
+    progress(1.0)
+    return summary
+
+
+def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[float, float] = (1.0, 1e5),
+                   progress: Callable[[float], None] = _noop) -> dict[str, Any]:
+    """Write ``fig3.png``, ``fig3.nc``, ``fig3.csv``, ``fig3.json`` to ``out``; returns the summary."""
+    import xarray as xr
+
+    from .analysis.crossings import critical_speeds_many
+    from .analysis.space import ParameterSpace
+    from .plotting import plot_critical_curves, save
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    diff = np.linspace(-0.98, 0.98, n_diff)
+    mu1, mu2 = (1 + diff) / 2, (1 - diff) / 2
+    crit, restab, ncross = {}, {}, {}
+    for q, kip in enumerate(FIG3_KIP):
+        space = ParameterSpace.from_preset("paper-fig3", {"k_ip": kip})
+        roots, dirs, counts, start = critical_speeds_many(space, {"mu1": mu1, "mu2": mu2}, *omega_range)
+        first = np.full(diff.size, np.nan)
+        second = np.full(diff.size, np.nan)
+        for i in range(diff.size):
+            k = [j for j in range(min(int(counts[i]), roots.shape[1])) if dirs[i, j] < 0]
+            if k:
+                first[i] = roots[i, k[0]]
+                later = [j for j in range(k[0] + 1, min(int(counts[i]), roots.shape[1])) if dirs[i, j] > 0]
+                if later:
+                    second[i] = roots[i, later[0]]
+        crit[kip], restab[kip], ncross[kip] = first, second, counts.copy()
+        progress((q + 1) / len(FIG3_KIP))
+    fig = plot_critical_curves(diff, crit)
+    ax = fig.axes[0]
+    ax.set_title("Fig. 3: critical speed vs friction asymmetry (paper-fig3)")
+    save(fig, str(out / "fig3.png"))
+    fig_full = plot_critical_curves(diff, crit, restab=restab)
+    fig_full.axes[0].set_yscale("log")
+    fig_full.axes[0].set_title("onset (solid) and re-stabilisation (dotted) of squeal")
+    save(fig_full, str(out / "fig3_restabilisation.png"))
+    kvals = [math.inf if k == "inf" else float(k) for k in FIG3_KIP]
+    ds = xr.Dataset(
+        {"Omega_crit": (("k_ip", "mu_diff"), np.array([crit[k] for k in FIG3_KIP]), {"units": "rad/s"}),
+         "Omega_restab": (("k_ip", "mu_diff"), np.array([restab[k] for k in FIG3_KIP]), {"units": "rad/s"}),
+         "n_crossings": (("k_ip", "mu_diff"), np.array([ncross[k] for k in FIG3_KIP], dtype=np.int32))},
+        coords={"k_ip": ("k_ip", kvals, {"units": "N/m"}), "mu_diff": ("mu_diff", diff, {"long_name": "mu1 - mu2"})},
+        attrs={"preset": "paper-fig3", "constraint": "mu1 + mu2 = 1", "omega_range": list(omega_range)})
+    ds.to_netcdf(str(out / "fig3.nc"), engine="scipy")
+    ds.to_dataframe().reset_index().to_csv(str(out / "fig3.csv"), index=False)
+    mid = int(np.argmin(np.abs(diff)))
+    summary: dict[str, Any] = {"figure": "fig3", "preset": "paper-fig3", "omega_range": list(omega_range),
+                               "files": [str(out / f) for f in ("fig3.png", "fig3_restabilisation.png",
+                                                                "fig3.nc", "fig3.csv", "fig3.json")],
+                               "curves": {}}
+    for k in FIG3_KIP:
+        c = crit[k]
+        fin = np.isfinite(c)
+        summary["curves"][k] = {
+            "Omega_crit_at_equal_mu": float(c[mid]),
+            "min_Omega_crit": float(np.nanmin(c)) if fin.any() else None,
+            "argmin_mu_diff": float(diff[np.nanargmin(c)]) if fin.any() else None,
+            "stable_throughout_for_abs_mu_diff_above": float(np.min(np.abs(diff[~fin]))) if (~fin).any() else None,
+            "Omega_restab_at_equal_mu": float(restab[k][mid]),
+        }
+    (out / "fig3.json").write_text(json.dumps(summary, indent=2) + "\n")
+    return summary

@@ -1,0 +1,186 @@
+"""Result objects of the stability analysis: conversion to xarray, files, ``.plot()``.
+
+``.plot()`` returns the matplotlib figure (Agg backend, never ``plt.show()``).
+NetCDF files are written with xarray's ``scipy`` engine (NetCDF3, no extra
+dependency); booleans are stored as ``int8`` with ``flag_values`` /
+``flag_meanings`` and restored by :func:`open_map`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+__all__ = ["StabilityMap", "CrossingResult", "CriticalSpeedResult", "open_map"]
+
+_STATUS_MEANINGS = "ok ok_nontrivial_silent_motion no_silent_motion pad_loses_contact invalid_parameters"
+
+
+def _units(name: str) -> str:
+    from .parameters import UNITS
+
+    return UNITS.get(name, {"mu": "", "k_ip": "N/m", "h": "m", "R_disk": "m"}.get(name, ""))
+
+
+@dataclass
+class StabilityMap:
+    """A stability map as an :class:`xarray.Dataset` (attribute :attr:`data`).
+
+    Variables ``max_real`` (largest Re λ [1/s]), ``stable`` (bool), ``frequency``
+    (Hz of the least-stable mode) and ``status`` (int8, see ``flag_meanings``),
+    one dimension per axis named after the parameter.
+    """
+
+    data: Any
+
+    @classmethod
+    def from_arrays(cls, space: Any, outer: Any, inner: Any, *, stable: np.ndarray, status: np.ndarray,
+                    max_real: np.ndarray, frequency: np.ndarray, method: str) -> StabilityMap:
+        import xarray as xr
+
+        dims = (outer.name, inner.name)
+        coords = {}
+        for ax in (outer, inner):
+            coords[ax.name] = xr.DataArray(ax.values(), dims=(ax.name,),
+                                           attrs={"units": _units(ax.name), "scale": "log" if ax.log else "linear"})
+        ds = xr.Dataset(
+            {
+                "max_real": (dims, max_real, {"units": "1/s", "long_name": "largest real part of the eigenvalues"}),
+                "stable": (dims, stable, {"long_name": "silent motion asymptotically stable (Hurwitz)"}),
+                "frequency": (dims, frequency, {"units": "Hz", "long_name": "frequency of the least-stable mode"}),
+                "status": (dims, status, {"flag_values": np.arange(5, dtype=np.int8),
+                                          "flag_meanings": _STATUS_MEANINGS}),
+            },
+            coords=coords,
+            attrs={"space": space.label, "settings": json.dumps({k: str(v) for k, v in space.definitions().items()}),
+                   "tied": json.dumps(dict(space.tied)), "method": method,
+                   "criterion": "Lienard-Chipart on det(lambda^2 M + lambda D + K) (exact sign test)"},
+        )
+        return cls(ds)
+
+    @property
+    def dims(self) -> tuple[str, str]:
+        """The two axis names ``(outer, inner)``."""
+        return tuple(self.data["stable"].dims)  # type: ignore[return-value]
+
+    def to_xarray(self) -> Any:
+        """The :class:`xarray.Dataset`."""
+        return self.data
+
+    def to_netcdf(self, path: str) -> None:
+        """Write NetCDF3 (scipy engine); ``stable`` is stored as int8 flags."""
+        ds = self.data.copy()
+        ds["stable"] = ds["stable"].astype(np.int8)
+        ds["stable"].attrs.update(flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="unstable stable")
+        ds.to_netcdf(path, engine="scipy")
+
+    def to_csv(self, path: str) -> None:
+        """Write a long-format CSV (one row per grid point)."""
+        self.data.to_dataframe().reset_index().to_csv(path, index=False)
+
+    def boundary(self) -> list[np.ndarray]:
+        """Stability boundary as polylines ``(n, 2)`` in (inner, outer) coordinates: the 0.5 contour of ``stable``."""
+        import contourpy
+
+        o, i = self.dims
+        z = self.data["stable"].values.astype(float)
+        z[self.data["status"].values >= 2] = np.nan
+        gen = contourpy.contour_generator(self.data[i].values, self.data[o].values, z)
+        return list(gen.lines(0.5))
+
+    def plot(self, ax: Any = None, *, x: str | None = None, title: str | None = None) -> Any:
+        """Stability map: stable region shaded, boundary drawn, invalid points hatched; returns the figure."""
+        from .plotting import plot_map
+
+        return plot_map(self, ax=ax, x=x, title=title)
+
+
+def open_map(path: str) -> StabilityMap:
+    """Read a map written by :meth:`StabilityMap.to_netcdf`."""
+    import xarray as xr
+
+    ds = xr.open_dataset(path, engine="scipy").load()
+    ds["stable"] = ds["stable"].astype(bool)
+    return StabilityMap(ds)
+
+
+@dataclass(frozen=True)
+class CrossingResult:
+    """Values along a 1-D path where the stability of the silent motion changes.
+
+    Attributes
+    ----------
+    parameter : str
+        Path parameter.
+    start, stop : float
+        Path range; ``log`` whether it is meant logarithmically (plots).
+    stable_at_start : bool
+        Verdict just after ``start``.
+    crossings : tuple of (float, str)
+        ``(value, "destabilizing" | "stabilizing")`` in increasing order.
+    method : str
+        How they were computed.
+    """
+
+    parameter: str
+    start: float
+    stop: float
+    log: bool
+    stable_at_start: bool
+    crossings: tuple[tuple[float, str], ...]
+    method: str
+    space: Any = field(default=None, repr=False, compare=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON schema of ``brakesqueal crossings --format json``."""
+        return {"parameter": self.parameter, "stable_at_start": self.stable_at_start,
+                "crossings": [{"value": v, "direction": d} for v, d in self.crossings],
+                "range": [self.start, self.stop], "method": self.method}
+
+    def to_xarray(self) -> Any:
+        """Dataset with dimension ``crossing``: ``value`` and ``direction`` (+1 stabilizing, -1 destabilizing)."""
+        import xarray as xr
+
+        return xr.Dataset({"value": ("crossing", [v for v, _ in self.crossings], {"units": _units(self.parameter)}),
+                           "direction": ("crossing", np.array([1 if d == "stabilizing" else -1
+                                                               for _, d in self.crossings], dtype=np.int8))},
+                          attrs={"parameter": self.parameter, "stable_at_start": int(self.stable_at_start)})
+
+    def text(self) -> str:
+        """Human-readable summary."""
+        lines = [f"{self.parameter} in [{self.start:g}, {self.stop:g}]: "
+                 f"{'stable' if self.stable_at_start else 'unstable'} at start ({self.method})"]
+        lines += [f"  {self.parameter} = {v:.12g}: {d}" for v, d in self.crossings] or ["  no stability change"]
+        return "\n".join(lines) + "\n"
+
+    def plot(self, ax: Any = None, n: int = 400) -> Any:
+        """Largest real part along the path (numeric linearization) with the crossings marked; returns the figure."""
+        from .plotting import plot_path
+
+        return plot_path(self, ax=ax, n=n)
+
+
+@dataclass(frozen=True)
+class CriticalSpeedResult(CrossingResult):
+    """Crossings along Ω; :attr:`Omega_crit` is the smallest destabilizing Ω (None if none)."""
+
+    @property
+    def Omega_crit(self) -> float | None:
+        """Smallest destabilizing Ω [rad/s] in the range, or None."""
+        onsets = [v for v, d in self.crossings if d == "destabilizing"]
+        return onsets[0] if onsets else None
+
+    def to_dict(self) -> dict[str, Any]:
+        d = super().to_dict()
+        d["Omega_crit"] = self.Omega_crit
+        return d
+
+    def text(self) -> str:
+        oc = self.Omega_crit
+        head = (f"Omega_crit = {oc:.12g} rad/s ({oc / (2 * math.pi):.6g} rev/s)" if oc is not None
+                else "Omega_crit = none (no destabilizing crossing in the range)")
+        return head + "\n" + super().text()
