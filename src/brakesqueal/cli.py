@@ -137,7 +137,7 @@ def _register_plugins() -> None:
     """Add the commands that live in their own modules (analysis, simulation)."""
     import importlib
 
-    for name in ("cli_stability", "cli_simulate", "cli_export"):
+    for name in ("cli_stability", "cli_simulate", "cli_export", "cli_sweep"):
         try:
             mod = importlib.import_module(f".{name}", __package__)
         except ModuleNotFoundError as exc:
