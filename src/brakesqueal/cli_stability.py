@@ -33,6 +33,18 @@ _Preset = Annotated[Optional[str], typer.Option("--preset", help="Named paramete
 _Params = Annotated[Optional[str], typer.Option("--params", help="TOML parameter file.")]
 _Set = Annotated[Optional[list[str]], typer.Option("--set", help="Override NAME=VALUE (repeatable).")]
 _Format = Annotated[_Fmt, typer.Option("--format", help="Output format.")]
+_Model = Annotated[Optional[str], typer.Option("--model", help="Model TOML file or built-in model name.")]
+
+
+def _model_space(model: str, preset: Optional[str], params: Optional[str], sets: Optional[list[str]]):  # type: ignore[no-untyped-def]
+    """A built model with ``--set`` overrides (``--preset``/``--params`` do not apply to built models)."""
+    from .builder import resolve_model
+    from .builder.analysis import ModelSpace
+    from .parameters import parse_assignment
+
+    if preset or params:
+        raise ParameterError("--model cannot be combined with --preset or --params (use --set for its parameters)")
+    return ModelSpace(resolve_model(model), dict(parse_assignment(a) for a in (sets or [])))
 
 
 def _space(preset: Optional[str], params: Optional[str], sets: Optional[list[str]]):  # type: ignore[no-untyped-def]
@@ -56,26 +68,38 @@ def _progress(label: str):  # type: ignore[no-untyped-def]
 def crossings(
     along: Annotated[str, typer.Option("--along", help="NAME=START:STOP[:log] path to search.")],
     preset: _Preset = None, params: _Params = None, set_: _Set = None, fmt: _Format = _Fmt.text,
+    model: _Model = None,
 ) -> None:
     """Every parameter value on a path where the stability of the silent motion changes (exact)."""
     from .analysis.crossings import crossings as _crossings
     from .analysis.maps import parse_axis
 
     axis = parse_axis(along, with_num=False)
-    r = _crossings(_space(preset, params, set_), axis)
+    if model is not None:
+        from .builder.analysis import model_crossings
+
+        r = model_crossings(_model_space(model, preset, params, set_), axis)
+    else:
+        r = _crossings(_space(preset, params, set_), axis)
     sys.stdout.write(json.dumps(r.to_dict(), indent=2) + "\n" if fmt == _Fmt.json else r.text())
 
 
 def critical_speed(
     range_: Annotated[str, typer.Option("--range", help="Omega range LO:HI [rad/s].")] = "1:1e5",
     preset: _Preset = None, params: _Params = None, set_: _Set = None, fmt: _Format = _Fmt.text,
+    model: _Model = None,
 ) -> None:
     """All onsets and re-stabilisations of squeal along the spin rate Omega, and Omega_crit."""
     from .analysis.crossings import critical_speeds
     from .analysis.maps import parse_axis
 
     axis = parse_axis(f"Omega={range_}:log", with_num=False)
-    r = critical_speeds(_space(preset, params, set_), axis.start, axis.stop)
+    if model is not None:
+        from .builder.analysis import model_critical_speeds
+
+        r = model_critical_speeds(_model_space(model, preset, params, set_), axis.start, axis.stop)
+    else:
+        r = critical_speeds(_space(preset, params, set_), axis.start, axis.stop)
     sys.stdout.write(json.dumps(r.to_dict(), indent=2) + "\n" if fmt == _Fmt.json else r.text())
 
 
@@ -87,6 +111,7 @@ def map_(
     preset: _Preset = None, params: _Params = None, set_: _Set = None,
     force: Annotated[bool, typer.Option("--force", help="Allow more than 1e9 points.")] = False,
     no_eigen: Annotated[bool, typer.Option("--no-eigen", help="Only classify (max_real, frequency = NaN).")] = False,
+    model: _Model = None,
 ) -> None:
     """Stability map over two parameters: NetCDF with max_real, stable, frequency, status; optional plot."""
     from .analysis.maps import parse_axis, stability_map
@@ -95,8 +120,15 @@ def map_(
     ax_x, ax_y = parse_axis(x), parse_axis(y)
     if not out.endswith(".nc"):
         raise ParameterError(f"--out must name a NetCDF file ending in .nc; got {out!r}")
-    m = stability_map(_space(preset, params, set_), ax_x, ax_y, force=force, eigen=not no_eigen,
-                      progress=_progress("map") if sys.stderr.isatty() else None)
+    prog = _progress("map") if sys.stderr.isatty() else None
+    if model is not None:
+        from .builder.analysis import model_stability_map
+
+        if ax_x.num * ax_y.num > 1e9 and not force:
+            raise ParameterError(f"the map has {ax_x.num * ax_y.num:.3g} points (> 1e9); add --force to run it")
+        m = model_stability_map(_model_space(model, preset, params, set_), ax_x, ax_y, progress=prog)
+    else:
+        m = stability_map(_space(preset, params, set_), ax_x, ax_y, force=force, eigen=not no_eigen, progress=prog)
     m.to_netcdf(out)
     msg = f"wrote {out}"
     if plot:

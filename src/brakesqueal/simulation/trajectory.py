@@ -31,10 +31,27 @@ def envelope(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return env, np.unwrap(np.angle(z[:, j]))
 
 
-def fit_growth_frequency(t: np.ndarray, x: np.ndarray, trim: float = 0.1) -> tuple[float, float]:
-    """Least-squares growth rate [1/s] of ``log(envelope)`` and frequency [Hz] of the phase.
+def _zero_crossing_frequency(t: np.ndarray, x: np.ndarray) -> float:
+    """Mean frequency [Hz] from linearly interpolated upward zero crossings (NaN if fewer than 3).
 
-    ``trim`` of the record is dropped at each end (Hilbert edge effects).
+    ``x`` must oscillate about zero (a deviation from the silent motion); no mean
+    is removed, because the mean of a growing oscillation is not its centre.
+    """
+    i = np.flatnonzero((x[:-1] < 0) & (x[1:] >= 0))
+    if i.size < 3:
+        return math.nan
+    tz = t[i] - x[i] * (t[i + 1] - t[i]) / (x[i + 1] - x[i])
+    return float((i.size - 1) / (tz[-1] - tz[0]))
+
+
+def fit_growth_frequency(t: np.ndarray, x: np.ndarray, trim: float = 0.1) -> tuple[float, float]:
+    """Least-squares growth rate [1/s] of ``log(envelope)`` and the dominant frequency [Hz].
+
+    ``trim`` of the record is dropped at each end (Hilbert edge effects).  The
+    frequency comes from interpolated zero crossings of the column with the
+    larger RMS value over the same window (unbiased for growing or decaying
+    sinusoids, unlike the slope of the Hilbert phase); the Hilbert phase is the
+    fallback when there are fewer than three crossings.
     """
     env, phase = envelope(x)
     n = t.size
@@ -44,8 +61,12 @@ def fit_growth_frequency(t: np.ndarray, x: np.ndarray, trim: float = 0.1) -> tup
     if tt.size < 4 or ok.sum() < 4:
         return math.nan, math.nan
     growth = float(np.polyfit(tt[ok], np.log(env[a:b][ok]), 1)[0])
-    freq = float(np.polyfit(tt, phase[a:b], 1)[0] / (2 * math.pi))
-    return growth, abs(freq)
+    cols = np.atleast_2d(np.asarray(x, dtype=float).T).T
+    j = int(np.argmax(np.sqrt(np.mean(cols**2, axis=0))))
+    freq = _zero_crossing_frequency(tt, cols[a:b, j])
+    if not math.isfinite(freq):
+        freq = abs(float(np.polyfit(tt, phase[a:b], 1)[0] / (2 * math.pi)))
+    return growth, freq
 
 
 @dataclass(frozen=True)
