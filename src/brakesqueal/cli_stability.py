@@ -184,6 +184,18 @@ def bench_critical_speed(
     sys.stdout.write(report(_b(n=n), fmt.value))
 
 
+def bench_model_map(
+    fmt: _Format = _Fmt.text,
+    model: Annotated[str, typer.Option("--model", help="Built-in model to map.")] = "eight-dof",
+    size: Annotated[int, typer.Option("--size", help="Grid size N for the N x N map.")] = 200,
+) -> None:
+    """Built-model stability-map throughput (batched eigenvalues) vs batched numpy.linalg.eigvals."""
+    from .bench import report
+    from .builder.analysis import bench_model_map as _b
+
+    sys.stdout.write(report(_b(model, size), fmt.value))
+
+
 def register(app: typer.Typer, bench_app: typer.Typer) -> None:
     """Add the stability commands to ``app`` and their benchmarks to ``bench_app``."""
     app.command("crossings")(crossings)
@@ -192,3 +204,4 @@ def register(app: typer.Typer, bench_app: typer.Typer) -> None:
     app.command("reproduce")(reproduce)
     bench_app.command("map")(bench_map)
     bench_app.command("critical-speed")(bench_critical_speed)
+    bench_app.command("model-map")(bench_model_map)
