@@ -447,7 +447,24 @@ PRESETS: dict[str, Preset] = {preset.name: preset for preset in (
 
 
 def get_preset(name: str) -> Preset:
-    """Return the preset called ``name``; ParameterError lists the valid names."""
+    """Return the preset called ``name``; ParameterError lists the valid names.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`PRESETS`: ``"paper-fig2"`` (Sec. 3.1, Fig. 2),
+        ``"paper-fig3"`` (Sec. 3.2, Fig. 3) or ``"minimal-model"`` (eqs. 54-55).
+
+    Returns
+    -------
+    Preset
+        The (immutable) preset; call :meth:`Preset.resolve` for parameter values.
+
+    Raises
+    ------
+    ParameterError
+        If ``name`` is not a string naming a preset.
+    """
     if isinstance(name, str) and name in PRESETS:
         return PRESETS[name]
     raise ParameterError(f"Unknown preset {name!r}; valid presets: " + ", ".join(PRESETS))
@@ -533,6 +550,20 @@ def parameters_from_toml(path: str, overrides: Mapping[str, Value] | None = None
     that preset (same rules as :meth:`Preset.resolve`); without one, all 17
     model parameters are required.  ``overrides`` apply last.
 
+    Parameters
+    ----------
+    path : str
+        Path of the TOML parameter file (see :func:`load_parameters`).
+    overrides : Mapping[str, float or str], optional
+        Values applied on top of the file's entries, in SI units: numbers or
+        constant expressions such as ``"16*pi"`` or ``"inf"``; names as the
+        file's ``[parameters]`` table allows.
+
+    Returns
+    -------
+    Parameters
+        The validated parameter set.
+
     Raises
     ------
     ParameterError
@@ -579,6 +610,21 @@ def resolve_parameters(preset: str | None, params_file: str | None, sets: list[s
     Without a preset and a file the preset ``paper-fig2`` is used.  File
     entries override the preset (the file's own or ``preset``); ``--set``
     values override both.
+
+    Parameters
+    ----------
+    preset : str or None
+        Name of a preset (``--preset``), or ``None``.
+    params_file : str or None
+        Path of a TOML parameter file (``--params``), or ``None``.
+    sets : list of str
+        ``NAME=VALUE`` assignments (``--set``), values in SI units: numbers
+        or constant expressions such as ``16*pi``.
+
+    Returns
+    -------
+    Parameters
+        The validated parameter set.
 
     Raises
     ------

@@ -30,9 +30,26 @@ def _units(name: str) -> str:
 class StabilityMap:
     """A stability map as an :class:`xarray.Dataset` (attribute :attr:`data`).
 
-    Variables ``max_real`` (largest Re λ [1/s]), ``stable`` (bool), ``frequency``
-    (Hz of the least-stable mode) and ``status`` (int8, see ``flag_meanings``),
-    one dimension per axis named after the parameter.
+    Normally built by :func:`~brakesqueal.analysis.maps.stability_map` (via
+    the classmethod ``from_arrays``) or read back with :func:`open_map`.
+
+    Attributes
+    ----------
+    data : xarray.Dataset
+        Two dimensions ``(outer, inner)``, each named after the swept
+        parameter, with coordinates carrying ``units`` (SI) and ``scale``
+        (``"linear"`` or ``"log"``) attributes.  Variables:
+
+        * ``max_real``: largest real part of the eigenvalues of eq. (47) [1/s];
+        * ``stable``: bool, silent motion asymptotically stable (Hurwitz);
+        * ``frequency``: frequency of the least-stable mode [Hz];
+        * ``status``: int8 code, ``0`` ok, ``1`` ok with a non-trivial
+          silent motion, ``2`` no silent motion, ``3`` a pad loses contact,
+          ``4`` invalid parameters (see its ``flag_meanings``); points with
+          ``status >= 2`` are never stable.
+
+        Dataset attributes: ``space`` (preset label), ``settings`` and
+        ``tied`` (JSON), ``method`` and ``criterion``.
     """
 
     data: Any
@@ -100,7 +117,25 @@ class StabilityMap:
 
 
 def open_map(path: str) -> StabilityMap:
-    """Read a map written by :meth:`StabilityMap.to_netcdf`."""
+    """Read a map written by :meth:`StabilityMap.to_netcdf`.
+
+    Parameters
+    ----------
+    path : str
+        Path of the NetCDF3 file (read with xarray's ``scipy`` engine and
+        loaded into memory, so the file is not kept open).
+
+    Returns
+    -------
+    StabilityMap
+        The map, with ``stable`` converted back from int8 flags to bool.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` does not exist.  A file that is not NetCDF3 is rejected by
+        :func:`xarray.open_dataset` with its own exception.
+    """
     import xarray as xr
 
     ds = xr.open_dataset(path, engine="scipy").load()
@@ -115,15 +150,22 @@ class CrossingResult:
     Attributes
     ----------
     parameter : str
-        Path parameter.
+        Path parameter (a settable name of the parameter space).
     start, stop : float
-        Path range; ``log`` whether it is meant logarithmically (plots).
+        Path range, in the SI unit of ``parameter``.
+    log : bool
+        Whether the path is meant logarithmically (sampling and plots).
     stable_at_start : bool
-        Verdict just after ``start``.
+        Verdict at ``start``.
     crossings : tuple of (float, str)
-        ``(value, "destabilizing" | "stabilizing")`` in increasing order.
+        ``(value, "destabilizing" | "stabilizing")`` in increasing order;
+        ``"destabilizing"`` means stable before, unstable after the value.
     method : str
-        How they were computed.
+        How they were computed (exact roots or numeric linearization).
+    space : ParameterSpace or None, optional
+        The parameter space the path lies in (default ``None``); used by
+        :meth:`plot` to evaluate the largest real part along the path.  Not
+        part of :meth:`to_dict`, the repr or comparisons.
     """
 
     parameter: str
@@ -166,7 +208,30 @@ class CrossingResult:
 
 @dataclass(frozen=True)
 class CriticalSpeedResult(CrossingResult):
-    """Crossings along Ω; :attr:`Omega_crit` is the smallest destabilizing Ω (None if none)."""
+    """Crossings along Ω; :attr:`Omega_crit` is the smallest destabilizing Ω (None if none).
+
+    Returned by :func:`~brakesqueal.analysis.crossings.critical_speeds`; the
+    critical speed is that of the paper's Fig. 3.  :meth:`to_dict` adds
+    ``Omega_crit`` and :meth:`text` starts with it.
+
+    Attributes
+    ----------
+    parameter : str
+        Always ``"Omega"``.
+    start, stop : float
+        The Ω range [rad/s].
+    log : bool
+        ``True`` (Ω paths are logarithmic).
+    stable_at_start : bool
+        Verdict at ``start``.
+    crossings : tuple of (float, str)
+        ``(Omega, "destabilizing" | "stabilizing")`` in increasing order [rad/s].
+    method : str
+        How they were computed (compiled kernel or
+        :func:`~brakesqueal.analysis.crossings.crossings`).
+    space : ParameterSpace or None, optional
+        The parameter space (default ``None``), used by :meth:`plot`.
+    """
 
     @property
     def Omega_crit(self) -> float | None:

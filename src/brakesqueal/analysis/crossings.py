@@ -96,12 +96,46 @@ def _numeric(space: ParameterSpace, axis: Axis, n: int = 801) -> tuple[bool, lis
 def crossings(space: ParameterSpace, axis: Axis) -> object:
     """Every value of ``axis.name`` in ``(start, stop)`` where stability of the silent motion changes.
 
+    Stability is that of the linearized equations (47) about the silent
+    motion (eq. 46), decided by the Liénard–Chipart criterion on the
+    characteristic quartic ``det(λ² Mbar + λ Dbar + Kbar) = a4 λ⁴ + ... + a0``.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The preset (with overrides) or complete parameter set; every other
+        settable name keeps its value in ``space`` and tied names follow.
+    axis : Axis
+        The path: ``axis.name`` must be a settable name of ``space``;
+        ``start`` and ``stop`` bound it (SI unit of the parameter).  ``log``
+        only selects where stability is sampled between candidates (geometric
+        instead of arithmetic midpoints) and the spacing of the numeric
+        fallback's grid; ``num`` is ignored.
+
     Returns
     -------
     CrossingResult
-        ``stable_at_start`` and the crossings with their direction
-        (``"destabilizing"``: stable before, unstable after, in the direction of
-        increasing parameter).
+        ``stable_at_start`` (verdict at ``start``) and the crossings with their
+        direction (``"destabilizing"``: stable before, unstable after, in the
+        direction of increasing parameter), in increasing order, and ``method``.
+
+    Raises
+    ------
+    ParameterError
+        If ``axis.name`` is tied or not a settable name of ``space``, or the
+        parameters are invalid at ``start``.
+
+    Notes
+    -----
+    When the closed-form quartic is rational in the parameter and the silent
+    motion is trivial along the whole path (eq. 49), the candidates are the
+    real roots of ``a0`` (a root ``λ = 0``) and of the Hurwitz determinant
+    ``H3 = a1 (a2 a3 - a1 a4) - a0 a3²`` (a pair ``λ = ±iω``), isolated
+    exactly; the result is then exact to rounding.  Otherwise the numeric
+    linearization is evaluated on an 801-point grid along the path, sign
+    changes of the verdict are bracketed and the crossing is polished with
+    Brent's method on the largest real part; two crossings closer together
+    than the grid spacing may then be missed.
     """
     from ..results import CrossingResult
 
@@ -127,7 +161,30 @@ def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5) -> 
     """All onsets and re-stabilisations of squeal along the spin rate Ω in ``(lo, hi)`` [rad/s].
 
     Uses the compiled Laurent-polynomial kernel when the silent motion is
-    trivial (relative accuracy ~1e-12), otherwise :func:`crossings` along Ω.
+    trivial (eq. 49) and no tied name depends on ``Omega`` (relative accuracy
+    ~1e-12, at most 16 crossings reported), otherwise :func:`crossings` along
+    a logarithmic Ω axis.  The smallest destabilizing Ω is the critical speed
+    ``Omega_crit`` of the paper's Fig. 3.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The preset (with overrides) or complete parameter set; ``Omega`` must
+        be one of its settable names (not tied).
+    lo, hi : float, optional
+        The Ω range [rad/s], ``0 < lo < hi`` (default ``1.0`` to ``1e5``).
+
+    Returns
+    -------
+    CriticalSpeedResult
+        Crossings along ``Omega`` (``log=True``); its ``Omega_crit`` is the
+        first destabilizing one, or ``None``.
+
+    Raises
+    ------
+    ParameterError
+        If ``Omega`` is tied or not settable in ``space``, the range is empty,
+        reversed or not positive, or the parameters are invalid.
     """
     from ..results import CriticalSpeedResult
 
@@ -152,9 +209,43 @@ def critical_speeds_many(space: ParameterSpace, changes: dict[str, np.ndarray], 
                          max_crossings: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Batched critical speeds over arrays of settable values (trivial silent motion required).
 
-    Returns ``(crossings, directions, counts, stable_at_start)`` as
-    :func:`~.kernels.critical_speeds_batch`; rows with a non-trivial silent
-    motion or invalid parameters raise ParameterError.
+    Each of the ``n`` points resolves ``space`` with the values of
+    ``changes`` at that index, then the compiled kernel of
+    :func:`~brakesqueal.analysis.kernels.critical_speeds_batch` finds every
+    stability change along Ω in ``(lo, hi)``.  Tied names are evaluated with
+    the space's own value of ``Omega`` (use :func:`critical_speeds` when one
+    depends on ``Omega``).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The preset (with overrides) or complete parameter set.
+    changes : dict of str to array_like
+        Settable names of ``space`` → values in their SI units; scalars and
+        1-D arrays, broadcast to a common length ``n`` (an empty dict gives
+        one point: ``space`` itself).
+    lo, hi : float, optional
+        The Ω range [rad/s], ``0 < lo < hi`` (default ``1.0`` to ``1e5``).
+    max_crossings : int, optional
+        Columns of the output arrays (default 8); further crossings are only
+        counted.
+
+    Returns
+    -------
+    crossings : ndarray, shape (n, max_crossings)
+        Ω values [rad/s] where stability changes, ascending, NaN-padded.
+    directions : ndarray of int8, shape (n, max_crossings)
+        ``-1`` destabilizing (stable below, unstable above), ``+1`` stabilizing.
+    counts : ndarray of int64, shape (n,)
+        Number of crossings found (may exceed ``max_crossings``).
+    stable_at_start : ndarray of bool, shape (n,)
+        Verdict just above ``lo``.
+
+    Raises
+    ------
+    ParameterError
+        If a name is tied or not settable, a point has invalid parameters, or
+        its silent motion is not trivial (``mu1 h10 != mu2 h20``, eq. 49).
     """
     from .equilibrium import parameter_vector
 

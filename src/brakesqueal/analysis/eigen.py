@@ -206,7 +206,33 @@ def _null_vectors(Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def eigen_analysis(model: LinearModel | Parameters) -> EigenAnalysis:
-    """Eigen-analysis of a linear model (or of ``linearize(params)``)."""
+    """Eigen-analysis of a linear model (or of ``linearize(params)``).
+
+    The eigenvalues are those of the first-order state matrix of eq. (47)
+    (:func:`~brakesqueal.analysis.linear.state_matrix`), computed with
+    :func:`scipy.linalg.eig` together with left and right eigenvectors.
+
+    Parameters
+    ----------
+    model : LinearModel or Parameters
+        A linear model ``Mbar, Dbar, Kbar`` (eq. 48), or a parameter set that
+        is first linearized about its silent motion with
+        :func:`~brakesqueal.analysis.linear.linearize`.
+
+    Returns
+    -------
+    EigenAnalysis
+        The ``2n`` eigenvalues [1/s] sorted by decreasing real part, then
+        decreasing imaginary part; mode shapes ``(n, 2n)`` (right null vectors
+        of ``λ²M + λD + K``, unit 2-norm, largest entry real positive); left
+        null vectors; and the eigenvalue condition numbers of the state matrix.
+
+    Raises
+    ------
+    SilentMotionError
+        If ``model`` is a parameter set whose silent motion does not exist or
+        where a pad loses contact.
+    """
     lm = model if isinstance(model, LinearModel) else linearize(model)
     A = state_matrix(lm.M, lm.D, lm.K)
     import scipy.linalg

@@ -133,11 +133,31 @@ def linearize(params: Parameters, *, model: CompiledModel | None = None) -> Line
 def pad_rate_eigenvalues(params: Parameters, *, model: CompiledModel | None = None) -> np.ndarray:
     """Finite eigenvalues when the pads' tangential rates ``ldot`` are kept.
 
-    The linearized ``psi`` and ``g`` form the descriptor system
-    ``E xdot = A x`` in ``x = (dq_m, dq_mdot, dl)``; ``g_dl`` (zero at the
+    The linearized ``psi`` (eq. 44) and ``g`` (eqs. 33-34) form the descriptor
+    system ``E xdot = A x`` in ``x = (dq_m, dq_mdot, dl)``; ``g_dl`` (zero at the
     trivial silent motion) turns each pad's ``l`` into a first-order state, the
-    "spurious pad mode".  Returns the finite generalized eigenvalues sorted by
-    decreasing real part.
+    "spurious pad mode".  Comparing with :func:`linearize`, which sets
+    ``ldot = 0`` (quasi-static pads), quantifies that modelling choice.
+
+    Parameters
+    ----------
+    params : Parameters
+        Model parameters.
+    model : CompiledModel, optional
+        Compiled model (default: the cached one of
+        :func:`~brakesqueal.numeric.compiled.compiled_model`).
+
+    Returns
+    -------
+    ndarray of complex, shape (m,)
+        The finite generalized eigenvalues [1/s] of ``(A, E)`` (``m <= 6``;
+        infinite ones, from a singular ``E``, are dropped), sorted by
+        decreasing real part, then decreasing imaginary part.
+
+    Raises
+    ------
+    SilentMotionError
+        If the silent motion does not exist or a pad loses contact.
     """
     import scipy.linalg
 

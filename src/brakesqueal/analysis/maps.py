@@ -33,7 +33,30 @@ MAX_POINTS = 10**9
 
 @dataclass(frozen=True)
 class Axis:
-    """One sweep axis: ``num`` points from ``start`` to ``stop``, linear or logarithmic."""
+    """One sweep axis: ``num`` points from ``start`` to ``stop``, linear or logarithmic.
+
+    Parameters
+    ----------
+    name : str
+        The parameter the axis varies: a settable name of the
+        :class:`~brakesqueal.analysis.space.ParameterSpace` (a model parameter such as ``Omega`` or
+        a preset's auxiliary name such as ``mu`` or ``k_ip``).
+    start, stop : float
+        Range of the axis in the SI unit of ``name`` (e.g. rad/s for
+        ``Omega``, N/m for ``k_ip``); finite, with ``stop > start``.
+    num : int, optional
+        Number of grid points of a map, including both ends (default 2, at
+        least 2).  Paths (:func:`~brakesqueal.analysis.crossings.crossings`) only use the range.
+    log : bool, optional
+        Logarithmic spacing (:func:`numpy.logspace`; needs ``start > 0``)
+        instead of linear (default ``False``).
+
+    Raises
+    ------
+    ParameterError
+        If a bound is not finite, the range is empty or reversed, a log axis
+        has ``start <= 0`` or ``num < 2``.
+    """
 
     name: str
     start: float

@@ -42,6 +42,8 @@ class BuiltEquations:
 
     Attributes
     ----------
+    spec : ModelSpec
+        The model the equations were assembled from.
     coords : tuple of str
         Names of the coordinates ``Q`` (``q1, q2`` of the disk, ``w_<pad>``,
         ``u_<pad>`` of pad DOFs, ``wc_<caliper>``, ``uc_<caliper>``).

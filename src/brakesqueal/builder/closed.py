@@ -15,7 +15,26 @@ __all__ = ["model_closed_form", "resolve_model"]
 
 
 def resolve_model(arg: str) -> ModelSpec:
-    """A model from a TOML file path or a built-in model name."""
+    """A model from a TOML file path or a built-in model name (the ``--model`` option).
+
+    Parameters
+    ----------
+    arg : str
+        Path of a model TOML file (used when the path exists or ends with
+        ``.toml``; see :func:`~brakesqueal.builder.toml_io.load_model`), else
+        the name of a built-in model of :data:`~brakesqueal.builder.library.MODELS`.
+
+    Returns
+    -------
+    ModelSpec
+        The validated model.
+
+    Raises
+    ------
+    ParameterError
+        If ``arg`` is neither a model file nor a built-in model name, or the
+        file cannot be read or describes an invalid model.
+    """
     if os.path.exists(arg) or arg.endswith(".toml"):
         return load_model(arg)
     if arg in MODELS:
@@ -26,8 +45,29 @@ def resolve_model(arg: str) -> ModelSpec:
 def model_closed_form(spec: ModelSpec) -> tuple[Any, Any, Any, tuple[str, ...]]:
     """SymPy ``(M, D, K, coords)`` about the zero state (the silent motion when it is trivial).
 
-    Tangential compliances are written back as ``1/k_ip``; each entry is
-    simplified with ``cancel`` and ``factor_terms``.
+    The Jacobians of the assembled residuals at ``Q = Qdot = Qddot = L = 0``,
+    with the quasi-static deformations ``L`` eliminated as in
+    :func:`~brakesqueal.builder.numeric.linearize_model` (eq. 48
+    generalized).  They are the linearization only when the zero state is
+    the silent motion, e.g. for the paper's pads when
+    ``mu1 h10 = mu2 h20`` (eq. 49).  For ``paper-2dof`` they equal the
+    ``"general"`` case of :func:`brakesqueal.symbolic.closed_form`, whose
+    special cases are eqs. (51)-(53) and (59)-(61).
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model (numeric component fields enter as numbers, named ones as
+        positive SymPy symbols of the same name).
+
+    Returns
+    -------
+    M, D, K : sympy.Matrix, shape (n, n)
+        Mass, damping and stiffness matrices.  Tangential compliances are
+        written back as ``1/k_ip``; each entry is simplified with ``cancel``
+        and ``factor_terms``.
+    coords : tuple of str
+        Names of the ``n`` coordinates (rows and columns).
     """
     import symengine as se
     import sympy as sp

@@ -108,9 +108,39 @@ class FrictionLaw:
 class Disk:
     """The rigid disk: tilting DOFs ``q1, q2`` on rotational supports, constant spin ``Omega``.
 
-    ``tilting=False`` locks the tilt (the disk becomes a rotating belt for its
-    pads; used for planar pad models).  ``radius`` is the disk's outer radius,
-    used to check that pads sit on the disk.
+    Every field except ``tilting`` is a number or the name of a model
+    parameter (default: the paper's names); the fields are checked by
+    :meth:`validate` when a :class:`ModelSpec` is built.
+
+    Parameters
+    ----------
+    Theta : float or str, optional
+        Moment of inertia about a diameter (the body axes ``x3``, ``y3``)
+        [kg m²]; ``I3 = diag(Theta, Theta, Phi)`` in eqs. (36)-(38).
+    Phi : float or str, optional
+        Moment of inertia about the disk's axis ``z3`` [kg m²].
+    k_t : float or str, optional
+        Stiffness of the rotational supports [N m/rad] (``K_m``, eq. 45).
+    d_t : float or str, optional
+        Damping of the rotational supports [N m s/rad] (``D_m``, eq. 45).
+    h_upper : float or str, optional
+        Distance ``h10`` from O to the upper surface [m]; ``"upper"`` pads
+        touch the face ``z0 = -h_upper`` (eq. 14).
+    h_lower : float or str, optional
+        Distance ``h20`` from O to the lower surface [m]; ``"lower"`` pads
+        touch the face ``z0 = +h_lower`` (eq. 15).
+    Omega : float or str, optional
+        Constant spin rate ``Omega_d`` of the non-holonomic constraint,
+        eq. (40) [rad/s].
+    radius : float or str, optional
+        Outer radius [m], only used to check that the pads sit on the disk
+        (default ``inf``: no check).
+    tilting : bool, optional
+        ``True`` (default): the tilt angles ``q1, q2`` are DOFs.  ``False``
+        locks the tilt: the disk becomes a rotating belt (speed ``Omega r``
+        at a pad's radius ``r``) for its pads (planar pad models); ``Theta``,
+        ``Phi``, ``k_t`` and ``d_t`` then do not enter the equations but
+        still need values.
     """
 
     Theta: Value = "Theta"
@@ -229,6 +259,30 @@ class Caliper:
 
     ``dofs`` lists its translations (``"normal"`` along ``z0``, ``"tangential"``
     along ``x0``), each with a spring ``k_n``/``k_t`` and damper ``d_n``/``d_t`` to ground.
+    The normal and tangential supports of every pad whose ``mount`` names the
+    caliper act between the pad and the caliper instead of ground; a pad at
+    ``angle_deg`` sees the tangential translation projected on its own
+    tangent.  The coordinates are ``wc_<name>`` and ``uc_<name>`` [m].
+
+    Parameters
+    ----------
+    name : str
+        Unique component name (letters, digits, ``_``), referenced by the
+        ``mount`` field of a :class:`Pad`.
+    mass : float or str, optional
+        Caliper mass [kg] (> 0; default parameter ``m_c``).
+    dofs : tuple of {"normal", "tangential"}, optional
+        Translations that are DOFs (non-empty; default both).
+    k_n : float or str, optional
+        Normal spring to ground [N/m] (default parameter ``k_cn``; must not be
+        0 with a normal DOF).
+    d_n : float or str, optional
+        Normal damper to ground [N s/m] (default 0).
+    k_t : float or str, optional
+        Tangential spring to ground [N/m] (default parameter ``k_ct``; must not
+        be 0 with a tangential DOF).
+    d_t : float or str, optional
+        Tangential damper to ground [N s/m] (default 0).
     """
 
     name: str

@@ -130,7 +130,25 @@ MODELS = {
 
 
 def get_model(name: str) -> ModelSpec:
-    """A built-in model by name (see the module table)."""
+    """A built-in model by name (see the module table).
+
+    Parameters
+    ----------
+    name : str
+        One of the keys of :data:`MODELS`: ``"paper-2dof"``, ``"minimal"``,
+        ``"in-plane-pad"``, ``"six-dof"``, ``"eight-dof"``, ``"four-pad"``
+        or ``"belt"``.
+
+    Returns
+    -------
+    ModelSpec
+        A newly built model with its default parameter values (SI units).
+
+    Raises
+    ------
+    ParameterError
+        If ``name`` is not a built-in model; the message lists the valid names.
+    """
     try:
         return MODELS[name]()
     except KeyError:

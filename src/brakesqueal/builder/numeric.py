@@ -38,6 +38,29 @@ class CompiledBuiltModel:
     ``residuals(x, p)`` returns ``R`` then ``G``; ``jacobians(x, p)`` their
     derivatives with respect to ``x = (Q, Qdot, Qddot, L)`` row-major;
     ``contact(x, p)`` the normal force and sliding speed of every pad.
+    With ``n`` coordinates and ``m`` quasi-static deformations, ``x`` has
+    ``3n + m`` entries; ``p`` holds the values of :attr:`param_names`, with
+    every tangential stiffness ``k_ip`` replaced by its compliance ``1/k_ip``
+    (0 for a rigid support).  Created by :func:`compile_model`.
+
+    Attributes
+    ----------
+    spec : ModelSpec
+        The compiled model.
+    coords : tuple of str
+        Names of the coordinates ``Q`` (see :class:`~brakesqueal.builder.assemble.BuiltEquations`).
+    algebraic : tuple of str
+        Names of the quasi-static tangential deformations ``L``.
+    param_names : tuple of str
+        Parameter names in :meth:`ModelSpec.parameter_names` order (the order of ``p``).
+    residuals : callable
+        ``residuals(x, p)`` → ``n + m`` floats: ``R`` then ``G``.
+    jacobians : callable
+        ``jacobians(x, p)`` → ``(n + m) * (3n + m)`` floats: ``d(R, G)/dx``, row-major.
+    contact : callable
+        ``contact(x, p)`` → ``(F_n [N], |v_r| [m/s])`` per pad, in ``spec.pads`` order.
+    source : str
+        The generated Python source (what the on-disk cache stores).
     """
 
     spec: ModelSpec
@@ -107,7 +130,29 @@ def _compile_cached(key: str, spec: ModelSpec, use_cache: bool) -> CompiledBuilt
 
 
 def compile_model(spec: ModelSpec, *, use_cache: bool = True) -> CompiledBuiltModel:
-    """Generate (or load from the cache) the numeric code of a model."""
+    """Generate (or load from the cache) the numeric code of a model.
+
+    The equations are assembled with
+    :func:`~brakesqueal.builder.assemble.build_equations` (symengine), their
+    Jacobian with respect to ``x`` is formed symbolically and the three
+    functions are generated with common-subexpression elimination.  Results
+    are also memoized in the process, keyed by a hash of the model
+    description and ``use_cache``.
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+    use_cache : bool, optional
+        Read and write the generated source in the on-disk cache
+        (:mod:`brakesqueal.numeric.cache`; default ``True``).  ``False``
+        generates in-process and leaves the cache untouched.
+
+    Returns
+    -------
+    CompiledBuiltModel
+        The compiled residuals, Jacobians and contact quantities.
+    """
     return _compile_cached(spec_key(spec), spec, use_cache)
 
 
@@ -127,10 +172,31 @@ def _roles(spec: ModelSpec) -> dict[str, str]:
 def model_values(spec: ModelSpec, overrides: Mapping[str, Any] | None = None) -> dict[str, float]:
     """Validated parameter values of a model: its defaults with ``overrides`` applied.
 
+    A parameter's role is the component field that first uses it; it
+    decides the allowed range: ``(0, inf)`` for ``Theta``, ``Phi``, ``Omega``,
+    ``radius``, ``preload``, ``mass``, ``k_c``, ``v_s`` and ``k_ip``;
+    ``[0, inf)`` for the other stiffnesses, dampers and friction coefficients;
+    any finite value for the rest (``h_upper``, ``h_lower``, ``slope``); only
+    a ``k_ip`` or ``radius`` may be ``+inf`` and nothing may be NaN.
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model; ``spec.parameters`` holds the defaults.
+    overrides : Mapping[str, float or str], optional
+        New values by parameter name, in SI units: numbers or constant
+        expressions such as ``"16*pi"`` or ``"inf"``.
+
+    Returns
+    -------
+    dict of str to float
+        Every parameter of the model, in the order of ``spec.parameters``.
+
     Raises
     ------
     ParameterError
-        Unknown names, or a value outside the range its role allows (named).
+        Unknown names, an expression that cannot be evaluated, or a value
+        outside the range its role allows (named).
     """
     values = dict(spec.parameters)
     for k, v in (overrides or {}).items():
@@ -163,7 +229,30 @@ def _pvec(cm: CompiledBuiltModel, values: Mapping[str, float]) -> list[float]:
 
 @dataclass(frozen=True)
 class BuiltLinearModel:
-    """Linear model ``M dQddot + D dQdot + K dQ = 0`` of a built model about its silent motion."""
+    """Linear model ``M dQddot + D dQdot + K dQ = 0`` of a built model about its silent motion.
+
+    The generalization of eq. (47) to any number of coordinates; created by
+    :func:`linearize_model`.
+
+    Attributes
+    ----------
+    spec : ModelSpec
+        The model.
+    values : dict of str to float
+        The parameter values used (see :func:`model_values`).
+    coords : tuple of str
+        Names of the ``n`` coordinates ``Q``.
+    Q0 : ndarray, shape (n,)
+        Coordinates at the silent motion (tilts [rad], pad and caliper
+        displacements [m]).
+    L0 : ndarray, shape (m,)
+        Quasi-static tangential pad deformations at the silent motion [m].
+    normal_forces : ndarray, shape (n_pads,)
+        Normal contact force of every pad at the silent motion [N], in
+        ``spec.pads`` order.
+    M, D, K : ndarray, shape (n, n)
+        Mass, damping and stiffness matrices (eq. 48 with ``L`` eliminated).
+    """
 
     spec: ModelSpec
     values: dict[str, float]
@@ -240,10 +329,33 @@ def linearize_model(
 ) -> BuiltLinearModel:
     """Silent motion and linearization of a built model (eqs. 46-48 generalized).
 
+    The silent motion solves ``R(Q0, 0, 0, L0) = 0``, ``G(Q0, 0, L0) = 0`` by a
+    damped Newton iteration from zero; the quasi-static deformations ``L``
+    are then eliminated (implicit function theorem):
+    ``M = R_Qddot``, ``D = R_Qdot - R_L G_L^-1 G_Qdot``,
+    ``K = R_Q - R_L G_L^-1 G_Q``.
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+    overrides : Mapping[str, float or str], optional
+        Parameter values replacing the model's defaults (see :func:`model_values`).
+    use_cache : bool, optional
+        Use the on-disk code cache (default ``True``; see :func:`compile_model`).
+
+    Returns
+    -------
+    BuiltLinearModel
+        Silent motion and ``M``, ``D``, ``K``.
+
     Raises
     ------
+    ParameterError
+        If an override is unknown or a value is out of range.
     SilentMotionError
-        When the silent motion is not found or a pad loses contact there.
+        When the silent motion is not found, or a pad loses contact
+        (normal force <= 0) or does not slide there.
     """
     cm = compile_model(spec, use_cache=use_cache)
     values = model_values(spec, overrides)

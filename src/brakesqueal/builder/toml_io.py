@@ -52,7 +52,35 @@ def _fields(cls: type, data: Mapping[str, Any], where: str) -> dict[str, Any]:
 
 
 def spec_from_dict(data: Mapping[str, Any], *, source: str = "model") -> ModelSpec:
-    """Build a :class:`ModelSpec` from a dictionary (the TOML layout)."""
+    """Build a :class:`ModelSpec` from a dictionary (the TOML layout).
+
+    Parameters
+    ----------
+    data : Mapping[str, Any]
+        Keys ``name``, ``description``, ``reference`` (strings),
+        ``parameters`` (name → number or constant expression string such as
+        ``"16*pi"`` or ``"inf"``, SI units), ``disk`` (fields of
+        :class:`Disk`), ``pads`` (required: a list of tables of :class:`Pad`
+        fields, each with ``name``, ``face`` and an optional ``friction``
+        table of :class:`FrictionLaw` fields) and ``calipers`` (optional list
+        of tables of :class:`Caliper` fields).  In component fields a string
+        is a parameter name, except ``"inf"``.
+    source : str, optional
+        How to name the data in error messages (default ``"model"``;
+        :func:`load_model` passes the file).
+
+    Returns
+    -------
+    ModelSpec
+        The validated model.
+
+    Raises
+    ------
+    ParameterError
+        Unknown or missing keys, a value that is not a table where one is
+        needed, an expression that cannot be evaluated, or a model that fails
+        validation; the message names ``source`` and the key.
+    """
     unknown = sorted(set(data) - set(_TOP))
     if unknown:
         raise ParameterError(f"{source}: unknown key(s) {', '.join(unknown)}; valid keys: {', '.join(_TOP)}")
@@ -96,7 +124,21 @@ def _plain(v: Any) -> Any:
 
 
 def spec_to_dict(spec: ModelSpec) -> dict[str, Any]:
-    """The dictionary (TOML layout) of a spec; ``spec_from_dict`` reads it back."""
+    """The dictionary (TOML layout) of a spec; ``spec_from_dict`` reads it back.
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+
+    Returns
+    -------
+    dict
+        Keys ``name``, ``description``, ``reference``, ``parameters``,
+        ``disk``, ``pads`` and ``calipers``; every component field that is not
+        ``None`` is present, infinite numbers are written ``"inf"`` and tuples
+        as lists (plain JSON/TOML types).
+    """
 
     def comp(obj: Any) -> dict[str, Any]:
         out = {}
@@ -116,7 +158,25 @@ def spec_to_dict(spec: ModelSpec) -> dict[str, Any]:
 
 
 def load_model(path: str) -> ModelSpec:
-    """Read a model TOML file; errors name the file and the key."""
+    """Read a model TOML file; errors name the file and the key.
+
+    Parameters
+    ----------
+    path : str
+        Path of the TOML file (layout in the module docstring and
+        :func:`spec_from_dict`).
+
+    Returns
+    -------
+    ModelSpec
+        The validated model.
+
+    Raises
+    ------
+    ParameterError
+        If the file cannot be read, is not valid TOML, or describes an
+        invalid model.
+    """
     try:
         with open(path, "rb") as fh:
             data = tomllib.load(fh)
@@ -143,7 +203,22 @@ def _toml_value(v: Any) -> str:
 
 
 def model_to_toml(spec: ModelSpec) -> str:
-    """A TOML model file for ``spec`` (round-trips through :func:`load_model`)."""
+    """A TOML model file for ``spec`` (round-trips through :func:`load_model`).
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+
+    Returns
+    -------
+    str
+        The TOML text: top-level ``name``, ``description``, ``reference``,
+        then ``[parameters]``, ``[disk]``, one ``[[pads]]`` table per pad
+        (friction as an inline table) and one ``[[calipers]]`` table per
+        caliper.  Floats are written with ``repr`` (exact round trip),
+        infinity as ``"inf"``.
+    """
     d = spec_to_dict(spec)
     lines = [f"name = {_toml_value(d['name'])}", f"description = {_toml_value(d['description'])}",
              f"reference = {_toml_value(d['reference'])}", "", "[parameters]"]  # fmt: skip

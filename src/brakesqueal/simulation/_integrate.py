@@ -73,7 +73,22 @@ class SimulationModel:
 
 
 def default_model(use_cache: bool = True) -> SimulationModel:
-    """The general 2-DOF model of the paper (eq. 44 with quasi-static pads)."""
+    """The general 2-DOF model of the paper (eq. 44 with quasi-static pads).
+
+    Parameters
+    ----------
+    use_cache : bool, optional
+        Keep the generated kernel source in the package cache (see
+        :mod:`brakesqueal.numeric.cache`), where numba also caches its machine
+        code (default ``True``).  ``False`` writes the source to a temporary
+        directory for this process only.
+
+    Returns
+    -------
+    SimulationModel
+        The model ``"general-2dof"`` with its numba-compiled kernels, ready
+        for :func:`simulate`.
+    """
     from ._kernels import load_kernels
 
     return SimulationModel(name="general-2dof", kernels=load_kernels(use_cache))

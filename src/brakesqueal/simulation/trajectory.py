@@ -20,7 +20,21 @@ def envelope(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
     The envelope is ``sqrt(sum_k |analytic(x_k)|^2)`` (a whirl of constant
     radius has a constant envelope); the phase is that of the column with the
-    larger RMS value.
+    larger RMS value.  Each column's mean is removed before the Hilbert
+    transform (:func:`scipy.signal.hilbert`).
+
+    Parameters
+    ----------
+    x : ndarray, shape (n,) or (n, k)
+        Uniformly sampled signals, one per column (e.g. the tilt deviations
+        ``q_m - q_m0`` [rad]); a 1-D array is one signal.
+
+    Returns
+    -------
+    envelope : ndarray, shape (n,)
+        Combined envelope, in the unit of ``x``.
+    phase : ndarray, shape (n,)
+        Unwrapped phase of the analytic signal of the dominant column [rad].
     """
     from scipy.signal import hilbert
 
@@ -52,6 +66,25 @@ def fit_growth_frequency(t: np.ndarray, x: np.ndarray, trim: float = 0.1) -> tup
     larger RMS value over the same window (unbiased for growing or decaying
     sinusoids, unlike the slope of the Hilbert phase); the Hilbert phase is the
     fallback when there are fewer than three crossings.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Uniform sample times [s].
+    x : ndarray, shape (n,) or (n, k)
+        Deviations from the silent motion (oscillating about zero), one signal
+        per column; see :func:`envelope`.
+    trim : float, optional
+        Fraction of the record dropped at each end (default 0.1, i.e. the
+        central 80 % is fitted).
+
+    Returns
+    -------
+    growth : float
+        Exponential growth rate of the envelope [1/s] (negative: decaying).
+    frequency : float
+        Dominant frequency [Hz].  Both are NaN when fewer than four samples
+        with a positive envelope remain in the window.
     """
     env, phase = envelope(x)
     n = t.size

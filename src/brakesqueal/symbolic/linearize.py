@@ -46,10 +46,23 @@ _GROUPS = {"q": (0, 1), "dq": (2, 3), "ddq": (4, 5), "l": (6, 7), "dl": (8, 9)}
 def jacobian_blocks(eq: SymbolicEquations) -> dict[str, Any]:
     """Exact symbolic Jacobians of ``psi`` and ``g`` by variable group.
 
+    The partial derivatives of eq. (48), taken for the full state before any
+    operating point is substituted, plus those with respect to the pads'
+    tangential deformations ``l`` and rates ``ldot``.
+
+    Parameters
+    ----------
+    eq : SymbolicEquations
+        The nonlinear equations (:func:`~brakesqueal.symbolic.model.derive_equations`).
+
     Returns
     -------
     dict
-        ``{"psi_q": 2×2, "psi_dq": ..., "g_dl": 2×2}`` in the backend of ``eq``.
+        The nine blocks of :data:`BLOCKS`, ``{"psi_q": 2×2, "psi_dq": ..., "g_dl": 2×2}``:
+        block ``<r>_<grp>`` is ``d r / d grp`` for the residual ``r`` in
+        ``psi`` (eq. 44), ``g`` (eqs. 33-34) and the group ``grp`` in ``q``
+        ``(q1, q2)``, ``dq``, ``ddq``, ``l`` ``(l1, l2)``, ``dl``; matrices of
+        the backend of ``eq``, functions of the state and parameters.
     """
     sm = get_backend(eq.backend)  # type: ignore[arg-type]
     out = {}
@@ -61,7 +74,22 @@ def jacobian_blocks(eq: SymbolicEquations) -> dict[str, Any]:
 
 
 def trivial_blocks(eq: SymbolicEquations) -> dict[str, Any]:
-    """Jacobian blocks evaluated at the trivial silent motion (all states zero)."""
+    """Jacobian blocks evaluated at the trivial silent motion (all states zero).
+
+    The trivial silent motion ``q_m0 = 0``, ``l0 = 0`` exists when
+    ``mu1 h10 = mu2 h20`` (eq. 49); the blocks are then those of eq. (48).
+
+    Parameters
+    ----------
+    eq : SymbolicEquations
+        The nonlinear equations.
+
+    Returns
+    -------
+    dict
+        The blocks of :func:`jacobian_blocks` with every state symbol set to
+        0: 2 × 2 matrices of the parameters only.
+    """
     zero = {s: 0 for s in eq.state_vector}
     return {k: v.subs(zero) for k, v in jacobian_blocks(eq).items()}
 
@@ -70,6 +98,26 @@ def linear_matrices(blocks: dict[str, Any], sm: Any) -> tuple[Any, Any, Any]:
     """``(Mbar, Dbar, Kbar)`` from Jacobian blocks (quasi-static pads).
 
     Works for symbolic blocks (backend ``sm``) evaluated at the silent motion.
+    The pads' deformations ``l`` are eliminated through ``g = 0``:
+    ``Mbar = psi_ddq``, ``Dbar = psi_dq - psi_l g_l^-1 g_dq`` and
+    ``Kbar = psi_q - psi_l g_l^-1 g_q`` (eq. 48 with ``l`` eliminated; the
+    ``dl`` blocks are not used).  ``g_l^-1`` is written out as the adjugate
+    over the determinant (skipped when ``g_l`` is the identity).
+
+    Parameters
+    ----------
+    blocks : dict
+        Jacobian blocks as returned by :func:`jacobian_blocks` or
+        :func:`trivial_blocks`; needs ``psi_q``, ``psi_dq``, ``psi_ddq``,
+        ``psi_l``, ``g_q``, ``g_dq`` and a 2 × 2 ``g_l``.
+    sm : module
+        The symbolic backend of the blocks (``symengine`` or ``sympy``), as
+        returned by :func:`~brakesqueal.symbolic.backend.get_backend`.
+
+    Returns
+    -------
+    Mbar, Dbar, Kbar : Matrix
+        The 2 × 2 matrices of eq. (47), unsimplified.
     """
     g_l = blocks["g_l"]
     if g_l == sm.eye(2):

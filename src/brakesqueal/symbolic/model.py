@@ -56,8 +56,9 @@ class SymbolicEquations:
         2 × 1 residual of eq. (44).
     g : Matrix
         2 × 1 residual of the pads' tangential equilibria (eqs. 33-34).
-    reduced : ReducedEquations
-        The matrices ``M_m, C_m, D_m, K_m, f_m`` of eq. (45).
+    reduced : ReducedEquations or None
+        The matrices ``M_m, C_m, D_m, K_m, f_m`` of eq. (45); ``None`` when
+        derived without Kronecker products (``kronecker=False``).
     pads : tuple of PadContact
         Contact quantities (constraint substituted).
     state : dict
@@ -66,6 +67,10 @@ class SymbolicEquations:
         Parameter symbols by the names of :data:`PARAMETER_SYMBOLS`.
     backend : str
         ``"symengine"`` or ``"sympy"``.
+    kinematics : CardanKinematics
+        Direction cosines, rotational Jacobians and Hessians of the disk
+        (eqs. 2-11), with ``q3 = 0`` substituted unless derived with
+        ``keep_q3=True``.
     """
 
     psi: Any
