@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import SilentMotionError
 from ..numeric.compiled import CompiledModel, compiled_model
+from ..numeric.newton import damped_newton
 from ..parameters import Parameters
 
 __all__ = ["SilentMotion", "silent_motion", "parameter_vector"]
@@ -68,41 +69,21 @@ def _state(z: np.ndarray) -> list[float]:
     return [z[0], z[1], 0.0, 0.0, 0.0, 0.0, z[2], z[3], 0.0, 0.0]
 
 
-def _newton(model: CompiledModel, p: list[float], *, max_iter: int = 60) -> tuple[np.ndarray, int]:
+def _newton(model: CompiledModel, p: list[float]) -> tuple[np.ndarray, int]:
     """Damped Newton on the scaled residuals, from ``z = 0``; returns ``(z, iterations)``."""
-    z = np.zeros(4)
     moment_scale = max(p[2], p[15] * (abs(p[12]) + abs(p[13])))  # N m / rad
     scale = np.array([moment_scale, moment_scale, 1.0, 1.0])  # psi in N m, g in m
-    atol = np.array([1e-18, 1e-18, 1e-21, 1e-21])  # rad, rad, m, m
 
     def f(z: np.ndarray) -> np.ndarray:
         return np.asarray(model.residuals(_state(z), p)) / scale
 
-    fz = f(z)
-    for it in range(1, max_iter + 1):
-        jac = np.asarray(model.jacobians(_state(z), p)).reshape(4, 10)[:, _EQ_IDX] / scale[:, None]
-        try:
-            step = np.linalg.solve(jac, -fz)
-        except np.linalg.LinAlgError:
-            raise SilentMotionError("the Jacobian of the silent-motion equations is singular") from None
-        if not np.all(np.isfinite(step)):
-            raise SilentMotionError("Newton's method produced a non-finite step")
-        if np.all(np.abs(step) <= 1e-13 * np.abs(z) + atol):
-            return z + step, it
-        lam, norm0 = 1.0, np.linalg.norm(fz)
-        while lam > 1e-8:
-            z_new = z + lam * step
-            if abs(z_new[0]) < 1.2 and abs(z_new[1]) < 1.2:
-                f_new = f(z_new)
-                if np.all(np.isfinite(f_new)) and np.linalg.norm(f_new) <= (1 - 1e-4 * lam) * norm0:
-                    break
-            lam /= 2
-        else:
-            if norm0 <= 1e-15:
-                return z, it
-            raise SilentMotionError("Newton's method stalled")
-        z, fz = z_new, f_new
-    raise SilentMotionError("Newton's method did not converge")
+    def jac(z: np.ndarray) -> np.ndarray:
+        return np.asarray(model.jacobians(_state(z), p)).reshape(4, 10)[:, _EQ_IDX] / scale[:, None]
+
+    return damped_newton(
+        f, jac, np.zeros(4), atol=np.array([1e-18, 1e-18, 1e-21, 1e-21]), max_iter=60,
+        admissible=lambda z: abs(z[0]) < 1.2 and abs(z[1]) < 1.2,
+    )  # fmt: skip
 
 
 def silent_motion(params: Parameters, *, model: CompiledModel | None = None) -> SilentMotion:

@@ -18,7 +18,7 @@ from ..numeric.compiled import CompiledModel, compiled_model
 from ..parameters import Parameters
 from .equilibrium import SilentMotion, parameter_vector, silent_motion
 
-__all__ = ["LinearModel", "linearize", "jacobian_blocks_at", "pad_rate_eigenvalues", "state_matrix"]
+__all__ = ["ModalMixin", "LinearModel", "linearize", "jacobian_blocks_at", "pad_rate_eigenvalues", "state_matrix"]
 
 _COLS = {"q": slice(0, 2), "dq": slice(2, 4), "ddq": slice(4, 6), "l": slice(6, 8), "dl": slice(8, 10)}
 
@@ -39,8 +39,39 @@ def jacobian_blocks_at(model: CompiledModel, x: list[float], p: list[float]) -> 
     return {f"{res}_{grp}": jac[i][:, sl] for i, res in enumerate(("psi", "g")) for grp, sl in _COLS.items()}
 
 
+class ModalMixin:
+    """State matrix, sorted eigenvalues and stability margin of ``M qddot + D qdot + K q = 0``.
+
+    Mixed into the linear-model dataclasses, which provide ``M``, ``D``, ``K``
+    (``n × n`` arrays) and a private list ``_eig`` used as a cache.
+    """
+
+    M: np.ndarray
+    D: np.ndarray
+    K: np.ndarray
+    _eig: list[Any]
+
+    @property
+    def A(self) -> np.ndarray:
+        """First-order state matrix (``2n × 2n``) for the state ``(dq, dqdot)``."""
+        return state_matrix(self.M, self.D, self.K)
+
+    @property
+    def eigenvalues(self) -> np.ndarray:
+        """Eigenvalues of :attr:`A` [1/s], sorted by decreasing real part, then imaginary part."""
+        if not self._eig:
+            lam = np.linalg.eigvals(self.A)
+            self._eig.append(lam[np.lexsort((-lam.imag, -lam.real))])
+        return self._eig[0]
+
+    @property
+    def max_real(self) -> float:
+        """Largest real part of the eigenvalues [1/s] (> 0: the silent motion is unstable)."""
+        return float(self.eigenvalues.real.max())
+
+
 @dataclass(frozen=True)
-class LinearModel:
+class LinearModel(ModalMixin):
     """Linear model about a silent motion (eq. 47).
 
     Attributes
@@ -65,23 +96,6 @@ class LinearModel:
         """Silent-motion tilt angles [rad]."""
         return self.silent.q_m0
 
-    @property
-    def A(self) -> np.ndarray:
-        """First-order state matrix (4 × 4) for the state ``(dq_m, dq_mdot)``."""
-        return state_matrix(self.M, self.D, self.K)
-
-    @property
-    def eigenvalues(self) -> np.ndarray:
-        """Eigenvalues of :attr:`A` [1/s], sorted by decreasing real part, then imaginary part."""
-        if not self._eig:
-            lam = np.linalg.eigvals(self.A)
-            self._eig.append(lam[np.lexsort((-lam.imag, -lam.real))])
-        return self._eig[0]
-
-    @property
-    def max_real(self) -> float:
-        """Largest real part of the eigenvalues [1/s] (> 0: the silent motion is unstable)."""
-        return float(self.eigenvalues.real.max())
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary (the ``brakesqueal linearize --format json`` schema)."""

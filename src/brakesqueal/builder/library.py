@@ -38,7 +38,7 @@ def paper_parameters() -> dict[str, float]:
 def _paper_pads(*, kip: bool = True, mass: bool = False, mount: str | None = None) -> tuple[Pad, Pad]:
     extra: dict = {}
     if mass:
-        extra = {"mass": "m_p", "dofs": ("normal", "tangential"), "k_c": "k_c", "d_c": 0.0}
+        extra = {"mass": "m_p", "dofs": ("normal", "tangential"), "k_c": "k_c", "d_c": "d_c", "d_ip": "d_ip"}
     return (
         Pad("1", "upper", radius="r", k="k1", d="d1", preload="N0", k_ip="k_ip1" if kip else math.inf,
             friction=FrictionLaw("coulomb", "mu1"), mount=mount, **extra),
@@ -86,7 +86,7 @@ def _in_plane_pad() -> ModelSpec:
 
 
 def _six_dof() -> ModelSpec:
-    par = {**paper_parameters(), **_pad_values(), "m_p": 0.5, "k_c": 1e9}
+    par = {**paper_parameters(), **_pad_values(), "m_p": 0.5, "k_c": 1e9, "d_c": 20.0, "d_ip": 10.0}
     return ModelSpec("six-dof", Disk(), _paper_pads(mass=True), parameters=par,
                      description="Pads of mass m_p with a normal DOF (contact stiffness k_c) and a tangential "
                      "DOF (spring k_ip): 2 disk + 2x2 pad DOFs.",
@@ -94,8 +94,9 @@ def _six_dof() -> ModelSpec:
 
 
 def _eight_dof() -> ModelSpec:
-    par = {**paper_parameters(), **_pad_values(), "m_p": 0.5, "k_c": 1e9, "m_c": 3.0, "k_cn": 5e7, "k_ct": 5e7}
-    cal = Caliper("caliper", mass="m_c", k_n="k_cn", k_t="k_ct")
+    par = {**paper_parameters(), **_pad_values(), "m_p": 0.5, "k_c": 1e9, "d_c": 20.0, "d_ip": 10.0, "m_c": 3.0, "k_cn": 5e7,
+           "k_ct": 5e7, "d_cn": 100.0, "d_ct": 100.0}
+    cal = Caliper("caliper", mass="m_c", k_n="k_cn", d_n="d_cn", k_t="k_ct", d_t="d_ct")
     return ModelSpec("eight-dof", Disk(), _paper_pads(mass=True, mount="caliper"), calipers=(cal,), parameters=par,
                      description="six-dof with both pads' supports on a floating caliper of mass m_c that moves "
                      "normal and tangential on springs k_cn, k_ct: 8 DOFs.",

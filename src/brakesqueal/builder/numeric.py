@@ -19,6 +19,8 @@ from ..errors import ParameterError, SilentMotionError
 from ..expressions import evaluate
 from ..numeric import cache
 from ..numeric.compiled import _load
+from ..numeric.newton import damped_newton
+from ..analysis.linear import ModalMixin
 from .components import ModelSpec
 from .toml_io import spec_to_dict
 
@@ -228,7 +230,7 @@ def _pvec(cm: CompiledBuiltModel, values: Mapping[str, float]) -> list[float]:
 
 
 @dataclass(frozen=True)
-class BuiltLinearModel:
+class BuiltLinearModel(ModalMixin):
     """Linear model ``M dQddot + D dQdot + K dQ = 0`` of a built model about its silent motion.
 
     The generalization of eq. (47) to any number of coordinates; created by
@@ -265,25 +267,6 @@ class BuiltLinearModel:
     K: np.ndarray
     _eig: list[Any] = field(default_factory=list, repr=False, compare=False)
 
-    @property
-    def A(self) -> np.ndarray:
-        """First-order state matrix (``2n × 2n``)."""
-        from ..analysis.linear import state_matrix
-
-        return state_matrix(self.M, self.D, self.K)
-
-    @property
-    def eigenvalues(self) -> np.ndarray:
-        """Eigenvalues sorted by decreasing real part [1/s]."""
-        if not self._eig:
-            lam = np.linalg.eigvals(self.A)
-            self._eig.append(lam[np.lexsort((-lam.imag, -lam.real))])
-        return self._eig[0]
-
-    @property
-    def max_real(self) -> float:
-        """Largest real part of the eigenvalues [1/s]."""
-        return float(self.eigenvalues.real.max())
 
 
 def _x(cm: CompiledBuiltModel, Q: np.ndarray, L: np.ndarray) -> list[float]:
@@ -294,7 +277,6 @@ def _x(cm: CompiledBuiltModel, Q: np.ndarray, L: np.ndarray) -> list[float]:
 def _silent(cm: CompiledBuiltModel, p: list[float], values: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray, int]:
     n, m = cm.n, cm.m
     cols = list(range(n)) + list(range(3 * n, 3 * n + m))
-    z = np.zeros(n + m)
 
     def F(z: np.ndarray) -> np.ndarray:
         return np.asarray(cm.residuals(_x(cm, z[:n], z[n:]), p), dtype=float)
@@ -302,26 +284,13 @@ def _silent(cm: CompiledBuiltModel, p: list[float], values: Mapping[str, float])
     def J(z: np.ndarray) -> np.ndarray:
         return np.asarray(cm.jacobians(_x(cm, z[:n], z[n:]), p), dtype=float).reshape(n + m, 3 * n + m)[:, cols]
 
-    J0 = J(z)
-    row = np.maximum(np.abs(J0).max(axis=1), 1e-300)
-    f = F(z) / row
-    for it in range(1, 80):
-        step = np.linalg.solve(J(z) / row[:, None], -f)
-        if np.all(np.abs(step) <= 1e-13 * np.abs(z) + 1e-20):
-            return z + step, z[:0], it
-        lam, norm0 = 1.0, np.linalg.norm(f)
-        while lam > 1e-8:
-            zn = z + lam * step
-            fn = F(zn) / row
-            if np.all(np.isfinite(fn)) and np.linalg.norm(fn) <= (1 - 1e-4 * lam) * norm0:
-                break
-            lam /= 2
-        else:
-            if norm0 <= 1e-15:
-                return z, z[:0], it
-            raise SilentMotionError(f"no silent motion found for model '{cm.spec.name}' (Newton stalled)")
-        z, f = zn, fn
-    raise SilentMotionError(f"no silent motion found for model '{cm.spec.name}' (Newton did not converge)")
+    z0 = np.zeros(n + m)
+    row = np.maximum(np.abs(J(z0)).max(axis=1), 1e-300)
+    try:
+        z, it = damped_newton(lambda z: F(z) / row, lambda z: J(z) / row[:, None], z0, atol=1e-20, max_iter=80)
+    except SilentMotionError as exc:
+        raise SilentMotionError(f"no silent motion found for model '{cm.spec.name}' ({exc})") from None
+    return z, z[:0], it
 
 
 def linearize_model(
