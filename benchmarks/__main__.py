@@ -32,7 +32,7 @@ def main() -> int:
             return proc.returncode
         data = json.loads(proc.stdout)
         results[target] = data
-        for rec in data if isinstance(data, list) else [data]:
+        for rec in [data, *data.get("more", [])]:
             print(f"  {rec['metric']}: {rec['value']:.4g} {rec['unit']} (baseline {rec['baseline']:.4g}) "
                   f"ratio {rec['ratio']:.1f}x")
     for script in sorted(here.glob("bench_*.py")):

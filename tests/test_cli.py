@@ -134,3 +134,13 @@ def test_negative_thickness_sum_is_rejected(tmp_path, cache):
     f.write_text(text.replace("h10 = 0.01", "h10 = -0.02"))
     res = run("linearize", "--params", str(f), cache=cache)
     assert res.returncode == 2 and "h10" in res.stderr and "h20" in res.stderr
+
+
+def test_bench_derive_json_is_one_object_with_the_required_keys(cache):
+    res = run("bench", "derive", "--no-baseline", "--format", "json", cache=cache)
+    assert res.returncode == 0, res.stderr
+    data = json.loads(res.stdout)
+    assert {"metric", "value", "unit", "baseline", "ratio"} <= set(data)
+    assert data["unit"] == "s" and 0 < data["value"] < 60 and data["baseline"] is None
+    kron = data["more"][0]
+    assert "Kronecker" in kron["metric"] and kron["ratio"] == pytest.approx(kron["baseline"] / kron["value"])

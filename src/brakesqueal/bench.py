@@ -55,11 +55,20 @@ def best_time(fn: Callable[[], Any], *, repeat: int = 5, min_time: float = 0.0) 
     return best
 
 
+def _finite(d: dict[str, Any]) -> dict[str, Any]:
+    """Non-finite numbers (e.g. a skipped baseline) become ``None`` so the JSON stays valid."""
+    return {k: (None if isinstance(v, float) and v != v or v in (float("inf"), float("-inf")) else v)
+            for k, v in d.items()}  # fmt: skip
+
+
 def report(results: list[BenchResult], fmt: str) -> str:
-    """Render results as JSON (one object, or a list when several) or as a text table."""
+    """Render results as a text table, or as JSON: one object with the keys ``metric``, ``value``,
+    ``unit``, ``baseline``, ``ratio`` (and ``details``) for the headline result, the others in ``more``."""
     if fmt == "json":
-        data = [asdict(r) for r in results]
-        return json.dumps(data[0] if len(data) == 1 else data, indent=2) + "\n"
+        data = _finite(asdict(results[0]))
+        if len(results) > 1:
+            data["more"] = [_finite(asdict(r)) for r in results[1:]]
+        return json.dumps(data, indent=2, allow_nan=False) + "\n"
     lines = [f"{'metric':58s} {'value':>12s} {'baseline':>12s} {'unit':>10s} {'ratio':>9s}"]
     for r in results:
         lines.append(f"{r.metric:58s} {r.value:12.4g} {r.baseline:12.4g} {r.unit:>10s} {r.ratio:8.1f}x")
