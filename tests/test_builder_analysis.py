@@ -94,3 +94,60 @@ def test_cli_accepts_model_files(tmp_path):
 def test_cli_model_errors_are_one_line(args, needle, tmp_path):
     res = _cli(*args, tmp_path=tmp_path)
     assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1 and needle in res.stderr, res.stderr
+
+
+@pytest.mark.parametrize(
+    "model,x,y",
+    [
+        ("eight-dof", Axis("k_c", 1e8, 1e10, 31, log=True), Axis("k_cn", 1e6, 1e9, 23, log=True)),
+        ("eight-dof", Axis("k_ip1", 1e6, 1e10, 29, log=True), Axis("m_p", 0.1, 2.0, 17)),
+        ("six-dof", Axis("k_ip2", 1e5, 1e10, 25, log=True), Axis("d1", 0.0, 100.0, 21)),
+        ("six-dof", Axis("N0", 1e3, 2e4, 25, log=True), Axis("d_c", 0.0, 200.0, 21)),
+        ("paper-2dof", Axis("k_ip1", 1e5, 1e10, 40, log=True), Axis("k1", 1e6, 1e7, 15)),
+    ],
+)
+def test_routh_classification_equals_eigenvalue_verdicts(model, x, y):
+    """The eigenvalue-free fast path (interpolated characteristic polynomial + Routh) vs batched eigenvalues."""
+    space = ModelSpace(get_model(model))
+    ref = model_stability_map(space, x, y, eigen=True).data
+    fast = model_stability_map(space, x, y, eigen=False).data
+    assert "Routh" in fast.attrs["method"]
+    assert ref["stable"].values.any() and not ref["stable"].values.all(), "the map must contain a boundary"
+    differ = ref["stable"].values != fast["stable"].values
+    # only points where the eigenvalue verdict itself is within rounding of the boundary may differ
+    margin = np.abs(ref["max_real"].values)
+    assert not np.any(differ & (margin > 1e-6)), margin[differ]
+    assert np.array_equal(ref["status"].values, fast["status"].values)
+
+
+def test_routh_classification_near_the_boundary():
+    """Points placed just off a boundary (found by bisection on eigenvalues) are classified correctly."""
+    from scipy.optimize import brentq
+
+    spec = get_model("eight-dof")
+    space = ModelSpace(spec)
+
+    def mr(kc):
+        return linearize_model(spec, {"k_c": kc, "k_cn": 5e7}).max_real
+
+    grid = np.geomspace(1e8, 1e10, 60)
+    vals = np.array([mr(v) for v in grid])
+    i = int(np.flatnonzero(np.sign(vals[:-1]) != np.sign(vals[1:]))[0])
+    root = brentq(mr, grid[i], grid[i + 1], xtol=1e-6)
+    pts = np.array([root * (1 - 1e-4), root * (1 + 1e-4)])
+    from brakesqueal.builder.fastmap import classify
+    from brakesqueal.builder.analysis import _matrices_at_zero, _params, _vectorized
+    from brakesqueal.builder.numeric import compile_model
+
+    cm = compile_model(spec)
+    vec = _vectorized(cm)
+
+    def mats(xv, yv):
+        pp = _params(space, cm, {"k_c": xv, "k_cn": yv}, xv.size)
+        return _matrices_at_zero(space, cm, vec, pp, xv.size)[:3]
+
+    xs = np.concatenate([np.geomspace(1e8, 1e10, 9), pts])
+    xs.sort()
+    verdict = classify(mats, xs, np.array([5e7, 5.1e7]), x_log=True, y_log=True)[0]
+    expect = np.array([mr(v) < 0 for v in xs])
+    assert np.array_equal(verdict, expect)

@@ -66,6 +66,12 @@ __all__ = [
     "CrossingResult",
     "CriticalSpeedResult",
     "open_map",
+    "run_sweep",
+    "sweep_status",
+    "open_sweep",
+    "load_study",
+    "Study",
+    "SweepStatus",
 ]
 
 _LAZY = {
@@ -108,6 +114,12 @@ _LAZY = {
     "CrossingResult": "results",
     "CriticalSpeedResult": "results",
     "open_map": "results",
+    "run_sweep": "sweep",
+    "sweep_status": "sweep",
+    "open_sweep": "sweep",
+    "load_study": "sweep",
+    "Study": "sweep",
+    "SweepStatus": "sweep",
 }
 
 
@@ -116,7 +128,7 @@ def __getattr__(name: str) -> Any:
         import importlib
 
         mod = importlib.import_module(f".{_LAZY[name]}", __name__)
-        return getattr(mod, name)
+        return getattr(mod, "sweep" if name == "run_sweep" else name)
     raise AttributeError(f"module 'brakesqueal' has no attribute {name!r}")
 
 

@@ -126,7 +126,8 @@ def map_(
 
         if ax_x.num * ax_y.num > 1e9 and not force:
             raise ParameterError(f"the map has {ax_x.num * ax_y.num:.3g} points (> 1e9); add --force to run it")
-        m = model_stability_map(_model_space(model, preset, params, set_), ax_x, ax_y, progress=prog)
+        m = model_stability_map(_model_space(model, preset, params, set_), ax_x, ax_y, eigen=not no_eigen,
+                                progress=prog)
     else:
         m = stability_map(_space(preset, params, set_), ax_x, ax_y, force=force, eigen=not no_eigen, progress=prog)
     m.to_netcdf(out)
@@ -187,9 +188,9 @@ def bench_critical_speed(
 def bench_model_map(
     fmt: _Format = _Fmt.text,
     model: Annotated[str, typer.Option("--model", help="Built-in model to map.")] = "eight-dof",
-    size: Annotated[int, typer.Option("--size", help="Grid size N for the N x N map.")] = 200,
+    size: Annotated[int, typer.Option("--size", help="Grid size N for the N x N map.")] = 1000,
 ) -> None:
-    """Built-model stability-map throughput (batched eigenvalues) vs batched numpy.linalg.eigvals."""
+    """Built-model map throughput (Routh classification, eigenvalue path) vs batched numpy.linalg.eigvals."""
     from .bench import report
     from .builder.analysis import bench_model_map as _b
 

@@ -83,27 +83,23 @@ def _invalid(spec: ModelSpec, arrays: Mapping[str, np.ndarray]) -> np.ndarray:
     return bad
 
 
-def _batch(space: ModelSpace, grid: Mapping[str, np.ndarray], shape: tuple[int, ...]) -> dict[str, np.ndarray]:
-    """max_real, frequency, status for every point of a grid given as broadcastable arrays."""
-    spec = space.spec
-    cm = compile_model(spec)
-    vec = _vectorized(cm)
-    n, m = cm.n, cm.m
-    base = model_values(spec, space.overrides)
-    size = int(np.prod(shape))
-    vals = {k: np.broadcast_to(np.asarray(grid[k], float), shape).ravel() if k in grid else np.full(size, v)
-            for k, v in base.items()}  # fmt: skip
-    status = np.zeros(size, np.int8)
-    kip = spec.stiffness_names()
+def _params(space: ModelSpace, cm: Any, grid: Mapping[str, np.ndarray], size: int) -> list[Any]:
+    """Parameter vector (compliances for tangential stiffnesses) for ``size`` points."""
+    base = model_values(space.spec, space.overrides)
+    vals = {k: np.broadcast_to(np.asarray(grid[k], float), (size,)) if k in grid else v for k, v in base.items()}
+    kip = space.spec.stiffness_names()
     with np.errstate(divide="ignore", invalid="ignore"):
-        p = [np.where(np.isinf(vals[k]), 0.0, 1.0 / vals[k]) if k in kip else vals[k] for k in cm.param_names]
-    status[_invalid(spec, {k: vals[k] for k in grid})] = INVALID
+        return [np.where(np.isinf(vals[k]), 0.0, 1.0 / np.asarray(vals[k], float)) if k in kip else vals[k]
+                for k in cm.param_names]  # fmt: skip
+
+
+def _matrices_at_zero(space: ModelSpace, cm: Any, vec: Any, p: list[Any], size: int) -> tuple[np.ndarray, ...]:
+    """Batched ``M, D, K`` about the zero state (quasi-static pads eliminated) and the residuals there."""
+    n, m = cm.n, cm.m
     x0 = [0.0] * (3 * n + m)
     res = np.stack([np.broadcast_to(r, (size,)) for r in vec.residuals(x0, p)], axis=-1)
     jac = np.stack([np.broadcast_to(np.asarray(j, float), (size,)) for j in vec.jacobians(x0, p)], axis=-1)
     jac = jac.reshape(size, n + m, 3 * n + m)
-    scale = np.abs(jac).max(axis=2) + 1e-300
-    trivial = np.all(np.abs(res) <= 1e-12 * scale, axis=1) & (status == OK)
     M, D, K = jac[:, :n, 2 * n:3 * n], jac[:, :n, n:2 * n], jac[:, :n, :n]
     if m:
         with np.errstate(all="ignore"):
@@ -111,6 +107,24 @@ def _batch(space: ModelSpace, grid: Mapping[str, np.ndarray], shape: tuple[int, 
         P = np.swapaxes(P, 1, 2)
         D = D - P @ jac[:, n:, n:2 * n]
         K = K - P @ jac[:, n:, :n]
+    scale = np.abs(jac).max(axis=2) + 1e-300
+    return M, D, K, res, scale
+
+
+def _batch(space: ModelSpace, grid: Mapping[str, np.ndarray], shape: tuple[int, ...]) -> dict[str, np.ndarray]:
+    """max_real, frequency, status for every point of a grid given as broadcastable arrays."""
+    spec = space.spec
+    cm = compile_model(spec)
+    vec = _vectorized(cm)
+    size = int(np.prod(shape))
+    flat = {k: np.broadcast_to(np.asarray(v, float), shape).ravel() for k, v in grid.items()}
+    status = np.zeros(size, np.int8)
+    status[_invalid(spec, flat)] = INVALID
+    p = _params(space, cm, flat, size)
+    M, D, K, res, scale = _matrices_at_zero(space, cm, vec, p, size)
+    trivial = np.all(np.abs(res) <= 1e-12 * scale, axis=1) & (status == OK)
+    n = cm.n
+    vals = flat
     max_real = np.full(size, np.nan)
     freq = np.full(size, np.nan)
     idx = np.flatnonzero(trivial)
@@ -135,9 +149,26 @@ def _batch(space: ModelSpace, grid: Mapping[str, np.ndarray], shape: tuple[int, 
     return {"max_real": max_real.reshape(shape), "frequency": freq.reshape(shape), "status": status.reshape(shape)}
 
 
-def model_stability_map(space: ModelSpace, x: Any, y: Any, *, chunk_points: int = 20000,
+def model_stability_map(space: ModelSpace, x: Any, y: Any, *, eigen: bool = True, chunk_points: int = 20000,
                         progress: Callable[[float], None] | None = None) -> Any:
     """Stability map of a built model over two of its parameters.
+
+    Parameters
+    ----------
+    space : ModelSpace
+        The model and its fixed parameter overrides.
+    x, y : brakesqueal.analysis.maps.Axis
+        Horizontal (inner) and vertical (outer) axes, each a parameter of the model.
+    eigen : bool
+        ``True``: batched eigenvalues give ``max_real`` and ``frequency`` too.
+        ``False``: only the verdict, from the eigenvalue-free Routh classification of
+        :mod:`.fastmap` where the silent motion is trivial (``max_real`` and
+        ``frequency`` are NaN there); falls back to eigenvalues when the
+        characteristic polynomial has no low-degree structure in the axes.
+    chunk_points : int
+        Points per batch of the eigenvalue path.
+    progress : callable, optional
+        Called with the completed fraction.
 
     Returns
     -------
@@ -149,22 +180,68 @@ def model_stability_map(space: ModelSpace, x: Any, y: Any, *, chunk_points: int 
     for ax in (x, y):
         space.check_axis(ax.name)
     xs, ys = x.values(), y.values()
-    out = {k: np.empty((ys.size, xs.size), dt) for k, dt in (("max_real", float), ("frequency", float),
-                                                            ("status", np.int8))}  # fmt: skip
+    shape = (ys.size, xs.size)
+    out = {"max_real": np.full(shape, np.nan), "frequency": np.full(shape, np.nan),
+           "status": np.zeros(shape, np.int8)}  # fmt: skip
+    stable = np.zeros(shape, bool)
+    fast = None if eigen else _fast_classify(space, x, y, xs, ys)
+    method = "batched eigenvalues (built model)"
+    if fast is not None:
+        stable, todo = fast
+        method = "Routh test on the interpolated characteristic polynomial (built model)"
+    else:
+        todo = np.ones(shape, bool)
     rows = max(1, chunk_points // xs.size)
     for j0 in range(0, ys.size, rows):
-        yy = ys[j0:j0 + rows]
-        r = _batch(space, {x.name: xs[None, :], y.name: yy[:, None]}, (yy.size, xs.size))
-        for k in out:
-            out[k][j0:j0 + rows] = r[k]
+        sl = slice(j0, j0 + rows)
+        if todo[sl].any():
+            yy = ys[sl]
+            r = _batch(space, {x.name: xs[None, :], y.name: yy[:, None]}, (yy.size, xs.size))
+            mask = todo[sl]
+            for k in out:
+                out[k][sl][mask] = r[k][mask]
+            stable[sl][mask] = (r["max_real"][mask] < 0) & (r["status"][mask] <= NONTRIVIAL)
         if progress:
             progress(min(1.0, (j0 + rows) / ys.size))
-    stable = (out["max_real"] < 0) & (out["status"] <= NONTRIVIAL)
+    if fast is not None:
+        out["status"][~todo] = OK
     sm = StabilityMap.from_arrays(space, y, x, stable=stable, status=out["status"], max_real=out["max_real"],
-                                  frequency=out["frequency"], method="batched eigenvalues (built model)")  # fmt: skip
-    sm.data.attrs["criterion"] = "largest real part of the eigenvalues of the state matrix"
+                                  frequency=out["frequency"], method=method)  # fmt: skip
+    sm.data.attrs["criterion"] = ("Routh test of det(lambda^2 M + lambda D + K)" if fast is not None
+                                  else "largest real part of the eigenvalues of the state matrix")  # fmt: skip
     sm.data.attrs["model"] = json.dumps(space.spec.name)
     return sm
+
+
+def _fast_classify(space: ModelSpace, x: Any, y: Any, xs: np.ndarray, ys: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray] | None:
+    """Routh verdicts where the silent motion is trivial; ``todo`` marks the points left to the eigen path."""
+    from . import fastmap
+
+    cm = compile_model(space.spec)
+    vec = _vectorized(cm)
+    shape = (ys.size, xs.size)
+    X, Y = np.broadcast_arrays(xs[None, :], ys[:, None])
+    flat = {x.name: X.ravel(), y.name: Y.ravel()}
+    size = X.size
+    bad = _invalid(space.spec, flat)
+    p = _params(space, cm, flat, size)
+    x0 = [0.0] * (3 * cm.n + cm.m)
+    res = np.stack([np.broadcast_to(r, (size,)) for r in vec.residuals(x0, p)], axis=-1)
+    trivial = (np.abs(res).max(axis=1) == 0.0) & ~bad
+    todo = ~trivial.reshape(shape)
+    if not trivial.any():
+        return None
+
+    def mats(xv: np.ndarray, yv: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        pp = _params(space, cm, {x.name: xv, y.name: yv}, xv.size)
+        M, D, K, _, _ = _matrices_at_zero(space, cm, vec, pp, xv.size)
+        return M, D, K
+
+    verdict = fastmap.classify(mats, xs, ys, x_log=x.log, y_log=y.log)
+    if verdict is None:
+        return None
+    return verdict & ~todo, todo
 
 
 def _max_real_along(space: ModelSpace, name: str, values: np.ndarray) -> np.ndarray:
@@ -213,18 +290,21 @@ def model_critical_speeds(space: ModelSpace, lo: float, hi: float, *, samples: i
     return _path_crossings(space, name, lo, hi, True, samples, CriticalSpeedResult)
 
 
-def bench_model_map(model: str = "eight-dof", size: int = 200) -> list[Any]:
-    """Throughput of :func:`model_stability_map` on a built model vs. batched ``numpy.linalg.eigvals``.
+def bench_model_map(model: str = "eight-dof", size: int = 1000) -> list[Any]:
+    """Throughput of built-model maps vs. batched ``numpy.linalg.eigvals``, measured in one run.
 
-    The baseline computes the eigenvalues of the same number of random
-    ``2n × 2n`` matrices with one batched NumPy call, in the same run.
+    Two paths are timed on a ``size × size`` map over two axes that keep the
+    silent motion trivial: the eigenvalue-free Routh classification
+    (``eigen=False``) and the batched-eigenvalue Dataset path (on a smaller
+    map).  The baseline is one batched ``numpy.linalg.eigvals`` call on as many
+    random ``2n × 2n`` matrices.
 
     Parameters
     ----------
     model : str
-        Built-in model name (its axes ``k_c`` and ``k_cn``/``k_c`` keep the silent motion trivial).
+        Built-in model name.
     size : int
-        The map is ``size × size`` points.
+        The classification map is ``size × size`` points.
 
     Returns
     -------
@@ -238,20 +318,31 @@ def bench_model_map(model: str = "eight-dof", size: int = 200) -> list[Any]:
     spec = get_model(model)
     space = ModelSpace(spec)
     names = [k for k in ("k_c", "k_cn", "k_ip1", "k1") if k in spec.parameters][:2]
-    x = Axis(names[0], spec.parameters[names[0]] / 10, spec.parameters[names[0]] * 10, size, log=True)
-    y = Axis(names[1], spec.parameters[names[1]] / 10, spec.parameters[names[1]] * 10, size, log=True)
-    model_stability_map(space, Axis(x.name, x.start, x.stop, 4, True), Axis(y.name, y.start, y.stop, 4, True))
+
+    def axes(num: int) -> tuple[Any, Any]:
+        a, b = (spec.parameters[k] for k in names)
+        return Axis(names[0], a / 10, a * 10, num, log=True), Axis(names[1], b / 10, b * 10, num, log=True)
+
+    model_stability_map(space, *axes(8), eigen=False)  # compile and warm up
     t0 = time.perf_counter()
-    m = model_stability_map(space, x, y)
-    t_map = time.perf_counter() - t0
+    fast = model_stability_map(space, *axes(size), eigen=False)
+    t_fast = time.perf_counter() - t0
+    small = max(2, size // 5)
+    t0 = time.perf_counter()
+    eig = model_stability_map(space, *axes(small), eigen=True)
+    t_eig_map = time.perf_counter() - t0
     n2 = 2 * compile_model(spec).n
-    A = np.random.default_rng(0).normal(size=(size * size, n2, n2))
+    nb = min(small * small, 40000)
+    A = np.random.default_rng(0).normal(size=(nb, n2, n2))
     t0 = time.perf_counter()
     np.linalg.eigvals(A)
-    t_eig = time.perf_counter() - t0
-    pts = size * size
-    trivial = float((m.data["status"].values == OK).mean())
-    return [BenchResult(f"built-model map ({model}, {n2}x{n2} state matrix), batched eigenvalues", pts / t_map,
-                        "points/s", pts / t_eig, t_eig / t_map,
-                        {"points": pts, "axes": f"{x.name} x {y.name}", "trivial_fraction": trivial,
-                         "baseline": "one batched numpy.linalg.eigvals call on as many random matrices"})]  # fmt: skip
+    base = nb / (time.perf_counter() - t0)
+    rate_fast, rate_eig = size * size / t_fast, small * small / t_eig_map
+    return [
+        BenchResult(f"built-model map ({model}, {n2}x{n2} state matrix), Routh classification", rate_fast,
+                    "points/s", base, rate_fast / base,
+                    {"points": size * size, "axes": " x ".join(names), "method": fast.data.attrs["method"],
+                     "baseline": "one batched numpy.linalg.eigvals call on random matrices of the same size"}),
+        BenchResult(f"built-model map ({model}), batched-eigenvalue Dataset path", rate_eig, "points/s", base,
+                    rate_eig / base, {"points": small * small, "method": eig.data.attrs["method"]}),
+    ]  # fmt: skip

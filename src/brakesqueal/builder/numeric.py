@@ -287,7 +287,8 @@ def _silent(cm: CompiledBuiltModel, p: list[float], values: Mapping[str, float])
     z0 = np.zeros(n + m)
     row = np.maximum(np.abs(J(z0)).max(axis=1), 1e-300)
     try:
-        z, it = damped_newton(lambda z: F(z) / row, lambda z: J(z) / row[:, None], z0, atol=1e-20, max_iter=80)
+        z, it = damped_newton(lambda z: F(z) / row, lambda z: J(z) / row[:, None], z0, atol=1e-20, max_iter=80,
+                              ftol=1e-15)
     except SilentMotionError as exc:
         raise SilentMotionError(f"no silent motion found for model '{cm.spec.name}' ({exc})") from None
     return z, z[:0], it

@@ -19,6 +19,7 @@ def damped_newton(
     atol: np.ndarray | float,
     rtol: float = 1e-13,
     max_iter: int = 80,
+    ftol: float = 0.0,
     admissible: Callable[[np.ndarray], bool] | None = None,
 ) -> tuple[np.ndarray, int]:
     """Solve ``f(z) = 0`` by Newton's method with backtracking on ``|f|``.
@@ -36,6 +37,9 @@ def damped_newton(
         Relative step tolerance.
     max_iter : int
         Maximum number of Newton steps.
+    ftol : float
+        Also converged when ``max |f(z)| <= ftol`` after a step (the residual is at
+        rounding level although the step is not yet below ``atol``).
     admissible : callable, optional
         Trial points for which it returns False are rejected (the step is halved).
 
@@ -76,4 +80,6 @@ def damped_newton(
                 return z, it
             raise SilentMotionError("Newton's method stalled")
         z, fz = z_new, f_new
+        if ftol > 0 and np.max(np.abs(fz)) <= ftol:
+            return z, it
     raise SilentMotionError("Newton's method did not converge")

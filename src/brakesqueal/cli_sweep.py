@@ -1,0 +1,88 @@
+"""``brakesqueal sweep`` (parameter studies on Dask) and ``brakesqueal bench sweep``.
+
+Registered by :mod:`brakesqueal.cli` through :func:`register`; dask, zarr and
+xarray are imported inside the commands.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from enum import Enum
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+__all__ = ["register"]
+
+
+class _Fmt(str, Enum):
+    text = "text"
+    json = "json"
+
+
+def sweep(
+    study: Annotated[str, typer.Argument(help="Study file (TOML): model, axes or samples, quantities.")],
+    out: Annotated[Optional[str], typer.Option("--out", help="Zarr store (default: [output] store, "
+                                                             "else STUDY.zarr).")] = None,
+    workers: Annotated[Optional[int], typer.Option("--workers", help="Start a local Dask cluster with N "
+                                                                     "worker processes.")] = None,
+    scheduler: Annotated[Optional[str], typer.Option("--scheduler", help="Address of an existing Dask "
+                                                                         "scheduler (tcp://host:8786).")] = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace an existing store.")] = False,
+    status: Annotated[bool, typer.Option("--status", help="Only report completed and missing chunks.")] = False,
+    progress: Annotated[Optional[bool], typer.Option("--progress/--no-progress",
+                                                     help="Progress bar with ETA (default: if stderr is a "
+                                                          "terminal).")] = None,
+    fmt: Annotated[_Fmt, typer.Option("--format", help="Output format.")] = _Fmt.text,
+) -> None:
+    """Run a parameter study in chunks (resumable) into a Zarr store; --status reports its progress."""
+    from .errors import ParameterError
+    from .sweep import sweep as _sweep, sweep_status
+    from .sweep.runner import default_store
+    from .sweep.study import load_study
+
+    st = load_study(study)
+    if status:
+        s = sweep_status(st, store=out)
+        sys.stdout.write(json.dumps(s.to_dict(), indent=2) + "\n" if fmt == _Fmt.json else s.text())
+        return
+    store = Path(out) if out else default_store(st)
+    if store is None:  # pragma: no cover - a file study always has a default store
+        raise ParameterError("no store: give --out")
+    before = sweep_status(st, store=store) if store.exists() and not overwrite else None
+    show = sys.stderr.isatty() if progress is None else progress
+    ds = _sweep(st, store=store, workers=workers, scheduler=scheduler, overwrite=overwrite, progress=show)
+    reused = len(before.completed) if before else 0
+    stable = float(ds["stable"].mean().compute())
+    dims = " x ".join(f"{k}={v}" for k, v in zip(st.dims, st.shape))
+    summary = {"store": str(store), "dims": dict(zip(st.dims, st.shape)), "points": st.n_points,
+               "chunks": st.n_chunks, "computed_chunks": st.n_chunks - reused, "reused_chunks": reused,
+               "stable_fraction": stable, "variables": list(ds.data_vars)}
+    if fmt == _Fmt.json:
+        sys.stdout.write(json.dumps(summary, indent=2) + "\n")
+    else:
+        sys.stdout.write(f"wrote {store}: {dims} ({st.n_points} points, {st.n_chunks} chunks: "
+                         f"{st.n_chunks - reused} computed, {reused} reused); {100 * stable:.1f}% stable\n")
+
+
+def bench_sweep(
+    fmt: Annotated[_Fmt, typer.Option("--format", help="Output format.")] = _Fmt.text,
+    points: Annotated[int, typer.Option("--points", help="Points of the scaling study (3-D, verdict only).")]
+    = 20_000_000,
+    large: Annotated[bool, typer.Option("--large/--no-large", help="Also run the 1e8-point 3-D study in a "
+                                                                    "subprocess and report its peak memory.")]
+    = True,
+) -> None:
+    """Sweep throughput in-process vs. LocalCluster with 1 and 2 workers; peak memory of a 1e8-point study."""
+    from .bench import report
+    from .sweep.bench import bench_sweep as _b
+
+    sys.stdout.write(report(_b(points=points, large=large), fmt.value))
+
+
+def register(app: typer.Typer, bench_app: typer.Typer) -> None:
+    """Add ``sweep`` to ``app`` and ``sweep`` to ``bench_app``."""
+    app.command("sweep")(sweep)
+    bench_app.command("sweep")(bench_sweep)

@@ -1,0 +1,18 @@
+"""Parameter studies at scale: N-D grids or random / Latin-hypercube samples, chunked, on Dask, resumable.
+
+* :func:`sweep` — run a study (in-process, ``workers=N`` local Dask cluster,
+  ``scheduler=ADDRESS`` or ``client=``) into a Zarr store and return an
+  :class:`xarray.Dataset` with named dimensions;
+* :func:`sweep_status` — completed / missing / corrupt chunks of a store;
+* :func:`load_study` / :class:`Study` — the validated study file;
+* :func:`open_sweep` — open a store.
+
+See ``docs/sweeps.md`` for the study-file format.
+"""
+
+from __future__ import annotations
+
+from .runner import SweepStatus, open_sweep, sweep, sweep_status
+from .study import QUANTITIES, Study, load_study
+
+__all__ = ["QUANTITIES", "Study", "SweepStatus", "load_study", "open_sweep", "sweep", "sweep_status"]

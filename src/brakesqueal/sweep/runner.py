@@ -1,0 +1,400 @@
+"""Running a study: in-process, on a local Dask cluster or on an existing one; resume; status.
+
+Chunks are tasks for Dask (``dask.delayed`` with the synchronous scheduler
+in-process; ``Client.submit`` + ``as_completed`` on a cluster, with a bounded
+number of chunks in flight).  The calling process is the only writer: each
+finished chunk is written to its own region of the Zarr store and then marked
+complete (:mod:`.store`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import math
+import sys
+import time
+from collections.abc import Iterator
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+import numpy as np
+
+from ..errors import ParameterError
+from .compute import FLOAT_QUANTITIES, ChunkSpec, compute_chunk
+from .store import open_store, study_attrs, variable_attrs, verified_chunks, write_chunk
+from .study import Study, load_study
+
+__all__ = ["sweep", "sweep_status", "open_sweep", "SweepStatus", "default_store", "local_cluster"]
+
+_WORKER_ENV = {"OMP_WAIT_POLICY": "passive", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
+               "MKL_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1"}
+
+
+def default_store(study: Study) -> Path | None:
+    """The study's store: ``[output] store``, else ``STUDY.zarr`` beside a study file, else None."""
+    if study.store:
+        return Path(study.store)
+    if study.source != "<dict>":
+        return Path(study.source).with_suffix(".zarr")
+    return None
+
+
+def _coords(study: Study, chunk: int) -> dict[str, np.ndarray]:
+    region = study.region(chunk)
+    if study.kind == "grid":
+        return {a.name: a.values[r] for a, r in zip(study.axes, region)}
+    return {n: v[region[0]] for n, v in study.samples().items()}
+
+
+# ---------------------------------------------------------------- progress
+class _Progress:
+    """Text progress bar with rate and ETA on a stream (drawn only when enabled)."""
+
+    def __init__(self, study: Study, todo: list[int], done: int, stream: TextIO | None) -> None:
+        self.stream, self.total = stream, study.n_chunks
+        self.done, self.points_left = done, sum(study.chunk_points(c) for c in todo)
+        self.points_done, self.t0 = 0, time.perf_counter()
+        self._draw()
+
+    def update(self, points: int) -> None:
+        self.done += 1
+        self.points_done += points
+        self.points_left -= points
+        self._draw()
+
+    def _draw(self) -> None:
+        if self.stream is None:
+            return
+        frac = self.done / max(self.total, 1)
+        el = time.perf_counter() - self.t0
+        rate = self.points_done / el if el > 0 and self.points_done else 0.0
+        eta = _hms(self.points_left / rate) if rate > 0 else "--:--:--"
+        n = int(30 * frac)
+        self.stream.write(f"\rsweep [{'#' * n}{'.' * (30 - n)}] {100 * frac:5.1f}% {self.done}/{self.total} chunks"
+                          f"  {rate:9.3g} points/s  ETA {eta}")
+        if self.done >= self.total:
+            self.stream.write("\n")
+        self.stream.flush()
+
+
+def _hms(s: float) -> str:
+    s = int(round(s))
+    return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}"
+
+
+# ---------------------------------------------------------------- executors
+@contextlib.contextmanager
+def _client(workers: int | None, scheduler: str | None, client: Any, timeout: float) -> Iterator[Any]:
+    """``None`` (in-process) or a ``distributed.Client``."""
+    if sum(x is not None for x in (workers, scheduler, client)) > 1:
+        raise ParameterError("give at most one of --workers, --scheduler (or client=)")
+    if client is not None:
+        yield client
+        return
+    if scheduler is not None:
+        from distributed import Client
+
+        try:
+            c = Client(scheduler, timeout=f"{timeout}s", set_as_default=False)
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:
+            msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise ParameterError(f"cannot reach the Dask scheduler at '{scheduler}' within {timeout:g} s: "
+                                 f"{msg}") from None
+        try:
+            yield c
+        finally:
+            c.close()
+        return
+    if workers is not None:
+        if not isinstance(workers, int) or workers < 1:
+            raise ParameterError(f"--workers must be a positive integer; got {workers!r}")
+        from distributed import Client
+
+        cluster = local_cluster(workers)
+        c = Client(cluster, set_as_default=False)
+        try:
+            yield c
+        finally:
+            c.close()
+            cluster.close()
+        return
+    yield None
+
+
+def local_cluster(workers: int) -> Any:
+    """A ``LocalCluster`` of single-threaded worker processes set up for the compiled kernels.
+
+    Two defaults of distributed are changed for these workers (measured on the
+    eigenvalue path): the statistical task profiler is off (it samples the
+    running task's stack every 10 ms and cost about 35 % here) and
+    ``MALLOC_TRIM_THRESHOLD_`` is left unset (with it glibc ``mmap``s every large
+    temporary array: about 15 %).  For an existing cluster, set
+    ``distributed.worker.profile.enabled: false`` in its Dask configuration.
+    """
+    import dask
+    from distributed import LocalCluster
+
+    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+                          "distributed.worker.profile.enabled": False}):
+        return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                            silence_logs=logging.ERROR, env=_WORKER_ENV)
+
+
+def _results(study: Study, spec: ChunkSpec, todo: list[int], client: Any) -> Iterator[tuple[int, dict[str, Any]]]:
+    """Compute the chunks ``todo``; yields ``(chunk, result)`` as they finish."""
+    if not todo:
+        return
+    if client is None:
+        import dask
+
+        for c in todo:
+            task = dask.delayed(compute_chunk, pure=False)(spec, _coords(study, c))
+            yield c, task.compute(scheduler="synchronous")
+        return
+    from distributed import as_completed
+
+    limit = 2 * max(1, sum(client.nthreads().values())) + 1
+    pending = iter(todo)
+    owner: dict[str, int] = {}
+
+    def submit() -> Any:
+        c = next(pending, None)
+        if c is None:
+            return None
+        f = client.submit(compute_chunk, spec, _coords(study, c), key=f"brakesqueal-sweep-{spec.key[:16]}-{c}",
+                          retries=1)
+        owner[f.key] = c
+        return f
+
+    first = [f for f in (submit() for _ in range(limit)) if f is not None]
+    ac = as_completed(first, loop=client.loop)
+    for fut in ac:
+        c = owner.pop(fut.key)
+        res = fut.result()
+        fut.release()
+        yield c, res
+        nxt = submit()
+        if nxt is not None:
+            ac.add(nxt)
+
+
+# ---------------------------------------------------------------- API
+def sweep(study: Any, *, store: str | Path | None = None, workers: int | None = None, scheduler: str | None = None,
+          client: Any = None, overwrite: bool = False, progress: bool | TextIO = False,
+          scheduler_timeout: float = 5.0) -> Any:
+    """Run a parameter study and return its results as an :class:`xarray.Dataset`.
+
+    Parameters
+    ----------
+    study : str, Path, dict or Study
+        A study file (TOML), its content as a dict, or a loaded :class:`Study`.
+    store : str or Path, optional
+        Zarr store to write (and resume).  Default: ``[output] store`` of the
+        study, else ``STUDY.zarr`` beside the study file; a dict study without
+        either is computed in memory (no resume).
+    workers : int, optional
+        Start a local Dask cluster with this many single-threaded worker processes.
+    scheduler : str, optional
+        Address of an existing Dask distributed scheduler (``tcp://host:8786``).
+    client : distributed.Client, optional
+        Use this client (notebooks).
+    overwrite : bool
+        Replace an existing store (otherwise a store of the same study is
+        resumed and one of a different study is an error).
+    progress : bool or text stream
+        Draw a progress bar with ETA (on stderr for ``True``).
+    scheduler_timeout : float
+        Seconds to wait for ``scheduler``.
+
+    Returns
+    -------
+    xarray.Dataset
+        One dimension per axis (or ``sample``), variables ``stable``, ``status``
+        and the requested quantities; lazily backed by the store when there is one.
+
+    Raises
+    ------
+    ParameterError
+        Bad study, unreachable scheduler, or a store of a different study.
+    """
+    st = load_study(study)
+    path = Path(store) if store is not None else default_store(st)
+    spec = ChunkSpec.from_study(st)
+    stream = sys.stderr if progress is True else (progress or None)
+    if path is None:
+        return _in_memory(st, spec, workers, scheduler, client, stream, scheduler_timeout)
+    path = path.resolve()
+    with _client(workers, scheduler, client, scheduler_timeout) as cl:
+        g = open_store(path, st, overwrite=overwrite)
+        good, _ = verified_chunks(g, path, st)
+        todo = [c for c in range(st.n_chunks) if c not in good]
+        bar = _Progress(st, todo, len(good), stream)
+        for c, res in _results(st, spec, todo, cl):
+            write_chunk(g, path, st, c, res)
+            bar.update(st.chunk_points(c))
+    return open_sweep(path)
+
+
+def _in_memory(st: Study, spec: ChunkSpec, workers: Any, scheduler: Any, client: Any, stream: Any,
+               timeout: float) -> Any:
+    import xarray as xr
+
+    data: dict[str, np.ndarray] = {"stable": np.zeros(st.shape, bool), "status": np.full(st.shape, -1, np.int8)}
+    data.update({q: np.full(st.shape, np.nan) for q in FLOAT_QUANTITIES if q in st.quantities})
+    todo = list(range(st.n_chunks))
+    with _client(workers, scheduler, client, timeout) as cl:
+        bar = _Progress(st, todo, 0, stream)
+        for c, res in _results(st, spec, todo, cl):
+            for k, a in data.items():
+                a[st.region(c)] = res[k]
+            bar.update(st.chunk_points(c))
+    va = variable_attrs(st)
+    dims = st.dims
+    if st.kind == "grid":
+        coords: dict[str, Any] = {a.name: xr.Variable((a.name,), a.values, {"units": _units(a.name),
+                                                                             "scale": a.scale}) for a in st.axes}
+    else:
+        coords = {"sample": np.arange(st.n_samples)}
+        coords.update({n: ("sample", v, {"units": _units(n)}) for n, v in st.samples().items()})
+    ds = xr.Dataset({k: (dims, v, {a: b for a, b in va[k].items() if a != "coordinates"})
+                     for k, v in data.items()}, coords=coords, attrs=study_attrs(st))
+    return ds
+
+
+def _units(name: str) -> str:
+    from ..results import _units as u
+
+    return u(name)
+
+
+def open_sweep(store: str | Path) -> Any:
+    """Open a study's Zarr store as a lazily loaded :class:`xarray.Dataset`.
+
+    Parameters
+    ----------
+    store : str or Path
+        The store directory written by :func:`sweep`.
+
+    Returns
+    -------
+    xarray.Dataset
+        Variables ``stable``, ``status`` and the computed quantities first.
+    """
+    import xarray as xr
+
+    p = Path(store)
+    if not (p / "zarr.json").is_file():
+        raise ParameterError(f"'{p}' is not a sweep store (no zarr.json)")
+    ds = xr.open_zarr(str(p), consolidated=False)
+    order = ["stable", "status", *[q for q in FLOAT_QUANTITIES if q in ds.data_vars]]
+    return ds[order + [v for v in ds.data_vars if v not in order]]
+
+
+# ---------------------------------------------------------------- status
+@dataclass
+class SweepStatus:
+    """Completed and missing chunks of a study's store.
+
+    Attributes
+    ----------
+    store : str
+        The store's path.
+    exists : bool
+        Whether the store has been created.
+    study_hash : str
+        SHA-256 of the study (see :meth:`Study.hash`).
+    dims : dict
+        Dimension sizes.
+    chunk_shape : list of int
+        Shape of one chunk.
+    n_chunks : int
+        Number of chunks.
+    completed, missing, corrupt : list of int
+        Verified chunks; chunks still to compute; chunks whose marker exists
+        but whose data do not match it (recomputed on resume; also in ``missing``).
+    version : str or None
+        The brakesqueal version that created the store.
+    """
+
+    store: str
+    exists: bool
+    study_hash: str
+    dims: dict[str, int]
+    chunk_shape: list[int]
+    n_chunks: int
+    completed: list[int] = field(default_factory=list)
+    missing: list[int] = field(default_factory=list)
+    corrupt: list[int] = field(default_factory=list)
+    version: str | None = None
+
+    @property
+    def complete(self) -> bool:
+        return not self.missing
+
+    def to_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["complete"] = self.complete
+        return d
+
+    def text(self) -> str:
+        pts = math.prod(self.dims.values())
+        lines = [f"store: {self.store}" + ("" if self.exists else " (not created yet)"),
+                 f"study: {self.study_hash[:16]}  dims: " + " x ".join(f"{k}={v}" for k, v in self.dims.items())
+                 + f" ({pts} points), chunks of {tuple(self.chunk_shape)}"]
+        if self.version:
+            lines.append(f"written by brakesqueal {self.version}")
+        lines.append(f"completed: {len(self.completed)}/{self.n_chunks} chunks "
+                     f"({100 * len(self.completed) / max(self.n_chunks, 1):.1f} %)")
+        lines.append(f"missing: {len(self.missing)}" + (f" [{_ranges(self.missing)}]" if self.missing else ""))
+        if self.corrupt:
+            lines.append(f"corrupt (will be recomputed): {len(self.corrupt)} [{_ranges(self.corrupt)}]")
+        return "\n".join(lines) + "\n"
+
+
+def _ranges(ids: list[int], limit: int = 20) -> str:
+    out: list[str] = []
+    i = 0
+    while i < len(ids):
+        j = i
+        while j + 1 < len(ids) and ids[j + 1] == ids[j] + 1:
+            j += 1
+        out.append(str(ids[i]) if i == j else f"{ids[i]}-{ids[j]}")
+        i = j + 1
+    return ", ".join(out[:limit]) + (", ..." if len(out) > limit else "")
+
+
+def sweep_status(study: Any, *, store: str | Path | None = None) -> SweepStatus:
+    """Completed (verified by checksum), corrupt and missing chunks of a study's store (read-only).
+
+    Parameters
+    ----------
+    study : str, Path, dict or Study
+        The study.
+    store : str or Path, optional
+        The store (default as for :func:`sweep`).
+
+    Returns
+    -------
+    SweepStatus
+        ``.text()`` / ``.to_dict()`` render it.
+    """
+    import zarr
+
+    from .store import _existing, check_study
+
+    st = load_study(study)
+    path = Path(store) if store is not None else default_store(st)
+    if path is None:
+        raise ParameterError("the study has no store: give store= or [output] store")
+    dims = dict(zip(st.dims, st.shape))
+    base = dict(store=str(path), study_hash=st.hash(), dims=dims, chunk_shape=list(st.chunks), n_chunks=st.n_chunks)
+    if not path.exists():
+        return SweepStatus(exists=False, missing=list(range(st.n_chunks)), **base)
+    check_study(_existing(path), path, st)
+    g = zarr.open_group(str(path), mode="r", zarr_format=3)
+    good, bad = verified_chunks(g, path, st, remove_bad=False)
+    return SweepStatus(exists=True, completed=sorted(good), corrupt=sorted(bad),
+                       missing=[c for c in range(st.n_chunks) if c not in good],
+                       version=g.attrs.get("brakesqueal_version"), **base)

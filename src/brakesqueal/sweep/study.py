@@ -1,0 +1,550 @@
+"""Study files: what a parameter study sweeps and computes, validated, hashed and chunked.
+
+A study file is a TOML superset of a parameter file (see ``docs/sweeps.md``)::
+
+    name = "fig2-omega"
+    preset = "paper-fig2"            # or: params = "my-parameters.toml"
+    [parameters]                     # fixed values of free/fixed names
+    h = 0.02
+    [tied]                           # extra (or replaced) tie expressions
+    N0 = "3600/mu"
+    [axes]                           # one dimension per entry, in this order
+    k_ip = "1e5:1e10:400:log"        # START:STOP:N[:log]
+    mu = { start = 0.05, stop = 1.0, num = 300 }
+    Omega = { values = [10, 50.26548, 100] }
+    [compute]
+    quantities = ["stable", "margin", "max_real", "frequency"]
+    [execution]
+    chunk_points = 1048576
+    [output]
+    store = "fig2-omega.zarr"
+
+Instead of ``[axes]``, ``[samples]`` draws ``n`` random or Latin-hypercube
+points (``method = "random" | "lhs"``, ``seed``) from ``[samples.ranges]``
+(the same range syntax without ``num``); the result then has one dimension
+``sample``.  Every problem raises a one-line
+:class:`~brakesqueal.errors.ParameterError` naming the file and the key.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..parameters import Value
+
+__all__ = ["Study", "GridAxis", "SampleRange", "load_study", "QUANTITIES", "DEFAULT_QUANTITIES"]
+
+#: Quantities a study may compute per point (``stable`` and ``status`` are always computed).
+QUANTITIES = ("stable", "margin", "max_real", "frequency", "critical_speed")
+DEFAULT_QUANTITIES = ("stable", "margin", "max_real", "frequency")
+#: Points per chunk by default: verdict-only studies / studies with eigenvalues.
+DEFAULT_CHUNK_POINTS = (1 << 22, 1 << 18)
+_TOP_KEYS = ("name", "description", "preset", "params", "parameters", "tied", "axes", "samples", "compute",
+             "execution", "output")
+_MAX_SAMPLES = 10**7
+
+
+def _is_num(v: object) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+@dataclass(frozen=True)
+class GridAxis:
+    """One grid dimension: a linear/log range or explicit values."""
+
+    name: str
+    values: np.ndarray = field(repr=False, compare=False)
+    scale: str  # "linear", "log" or "values"
+    spec: tuple[Any, ...]  # (start, stop, num) or the values, for the hash
+    ref: float  # magnitude used to scale polynomials in this axis (same for every chunk)
+
+    @property
+    def size(self) -> int:
+        return int(self.values.size)
+
+
+@dataclass(frozen=True)
+class SampleRange:
+    """The range of one sampled parameter."""
+
+    name: str
+    start: float
+    stop: float
+    log: bool
+
+
+@dataclass(frozen=True, eq=False)
+class Study:
+    """A validated parameter study (see the module docstring for the file format).
+
+    Attributes
+    ----------
+    source : str
+        Where it came from (file path or ``"<dict>"``), used in error messages.
+    text : str
+        The study file's text (stored with the results).
+    name : str
+        Label.
+    preset : str or None
+        Preset name; ``None`` for a complete parameter set.
+    values : dict
+        Overrides of the preset's settable names, or all 17 model parameters.
+    tied : dict
+        Tie expressions added or replaced by the study.
+    kind : str
+        ``"grid"`` or ``"samples"``.
+    axes : tuple of GridAxis
+        Grid dimensions (``kind == "grid"``).
+    ranges : tuple of SampleRange
+        Sampled parameters (``kind == "samples"``).
+    n_samples, seed, method : int, int, str
+        Sampling settings.
+    quantities : tuple of str
+        What to compute besides ``stable`` and ``status``.
+    critical_speed_range : tuple of float
+        Ω range [rad/s] searched for the critical speed.
+    chunks : tuple of int
+        Chunk shape (one entry per dimension).
+    store : str or None
+        Default result store (relative paths are relative to the study file).
+    """
+
+    source: str
+    text: str
+    name: str
+    preset: str | None
+    values: Mapping[str, Value]
+    tied: Mapping[str, str]
+    kind: str
+    axes: tuple[GridAxis, ...]
+    ranges: tuple[SampleRange, ...]
+    n_samples: int
+    seed: int
+    method: str
+    quantities: tuple[str, ...]
+    critical_speed_range: tuple[float, float]
+    chunks: tuple[int, ...]
+    store: str | None
+
+    # ------------------------------------------------------------ layout
+    @property
+    def dims(self) -> tuple[str, ...]:
+        """Dimension names of the result."""
+        return tuple(a.name for a in self.axes) if self.kind == "grid" else ("sample",)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(a.size for a in self.axes) if self.kind == "grid" else (self.n_samples,)
+
+    @property
+    def n_points(self) -> int:
+        return math.prod(self.shape)
+
+    @property
+    def chunk_grid(self) -> tuple[int, ...]:
+        """Number of chunks along each dimension."""
+        return tuple(-(-s // c) for s, c in zip(self.shape, self.chunks))
+
+    @property
+    def n_chunks(self) -> int:
+        return math.prod(self.chunk_grid)
+
+    def region(self, chunk: int) -> tuple[slice, ...]:
+        """Index region of chunk number ``chunk`` (C order over the chunk grid)."""
+        idx = np.unravel_index(chunk, self.chunk_grid)
+        return tuple(slice(int(i) * c, min(int(i) * c + c, s)) for i, c, s in zip(idx, self.chunks, self.shape))
+
+    def chunk_points(self, chunk: int) -> int:
+        return math.prod(s.stop - s.start for s in self.region(chunk))
+
+    @property
+    def sample_names(self) -> tuple[str, ...]:
+        return tuple(r.name for r in self.ranges)
+
+    def samples(self) -> dict[str, np.ndarray]:
+        """The sampled parameter values (deterministic in ``seed``; computed once)."""
+        if "_samples" in self.__dict__:
+            return self.__dict__["_samples"]
+        d, n = len(self.ranges), self.n_samples
+        if self.method == "lhs":
+            from scipy.stats import qmc
+
+            u = qmc.LatinHypercube(d=d, seed=np.random.default_rng(self.seed)).random(n)
+        else:
+            u = np.random.default_rng(self.seed).random((n, d))
+        out = {}
+        for k, r in enumerate(self.ranges):
+            if r.log:
+                lo, hi = math.log(r.start), math.log(r.stop)
+                out[r.name] = np.exp(lo + (hi - lo) * u[:, k])
+            else:
+                out[r.name] = r.start + (r.stop - r.start) * u[:, k]
+        self.__dict__["_samples"] = out
+        return out
+
+    # ------------------------------------------------------------ identity
+    def canonical(self) -> dict[str, Any]:
+        """Everything that determines the stored results (hashed by :meth:`hash`)."""
+        space = self.space()
+        d: dict[str, Any] = {
+            "space": {"label": space.label, "definitions": {k: str(v) for k, v in sorted(space.definitions().items())},
+                      "tied": dict(sorted(space.tied.items()))},
+            "kind": self.kind, "quantities": list(self.quantities), "chunks": list(self.chunks),
+        }
+        if "critical_speed" in self.quantities:
+            d["critical_speed_range"] = list(self.critical_speed_range)
+        if self.kind == "grid":
+            d["axes"] = [{"name": a.name, "scale": a.scale, "spec": [repr(x) for x in a.spec],
+                          "values_sha256": hashlib.sha256(np.ascontiguousarray(a.values).tobytes()).hexdigest()}
+                         for a in self.axes]
+        else:
+            d["samples"] = {"method": self.method, "n": self.n_samples, "seed": self.seed,
+                            "ranges": [[r.name, repr(r.start), repr(r.stop), r.log] for r in self.ranges]}
+        return d
+
+    def hash(self) -> str:
+        """SHA-256 of :meth:`canonical` (identifies the study in a store)."""
+        if "_hash" not in self.__dict__:
+            self.__dict__["_hash"] = hashlib.sha256(json.dumps(self.canonical(), sort_keys=True).encode()).hexdigest()
+        return self.__dict__["_hash"]
+
+    def space(self) -> Any:
+        """The :class:`~brakesqueal.analysis.space.ParameterSpace` of the study (cached per process)."""
+        from .compute import build_space
+
+        return build_space(self.preset, tuple(self.values.items()), tuple(self.tied.items()))
+
+
+# ---------------------------------------------------------------- parsing helpers
+class _Ctx:
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def err(self, key: str, msg: str) -> ParameterError:
+        return ParameterError(f"study file '{self.source}': key '{key}': {msg}")
+
+    def table(self, data: Any, key: str, allowed: tuple[str, ...] | None = None) -> dict[str, Any]:
+        if not isinstance(data, dict):
+            raise self.err(key, f"must be a table; got {data!r}")
+        if allowed is not None:
+            for k in data:
+                if k not in allowed:
+                    raise self.err(k if key == "<top>" else f"{key}.{k}",
+                                   "unknown key; allowed keys: " + ", ".join(allowed))
+        return data
+
+    def number(self, v: Any, key: str) -> float:
+        from ..expressions import evaluate
+
+        if isinstance(v, str):
+            try:
+                x = evaluate(v, {}, what=f"value of '{key}'")
+            except ParameterError as exc:
+                raise self.err(key, str(exc)) from None
+        elif _is_num(v):
+            x = float(v)
+        else:
+            raise self.err(key, f"must be a number or an expression string; got {v!r}")
+        if not math.isfinite(x):
+            raise self.err(key, f"must be finite; got {v!r}")
+        return x
+
+    def integer(self, v: Any, key: str, low: int) -> int:
+        if not isinstance(v, int) or isinstance(v, bool):
+            raise self.err(key, f"must be an integer; got {v!r}")
+        if v < low:
+            raise self.err(key, f"must be >= {low}; got {v}")
+        return v
+
+
+def _parse_range(ctx: _Ctx, key: str, v: Any, with_num: bool) -> tuple[float, float, int, bool]:
+    """A range entry: ``"START:STOP:N[:log]"`` or ``{start, stop, num, scale}``."""
+    if isinstance(v, str):
+        from ..analysis.maps import parse_axis
+
+        name = key.rsplit(".", 1)[-1]
+        parts = [p.strip() for p in v.split(":")]
+        log = parts[-1].lower() == "log"
+        core = parts[:-1] if parts[-1].lower() in ("log", "lin", "linear") else parts
+        if with_num and len(core) == 3 and core[2].lstrip("+-").isdigit() and int(core[2]) < 1:
+            raise ctx.err(key, f"empty axis (N = {core[2]}); give N >= 2 points")
+        try:
+            ax = parse_axis(f"{name}={v}", with_num=with_num)
+        except ParameterError as exc:
+            raise ctx.err(key, str(exc)) from None
+        return ax.start, ax.stop, ax.num, log
+    tab = ctx.table(v, key, ("start", "stop", "num", "scale") if with_num else ("start", "stop", "scale"))
+    for req in ("start", "stop", "num") if with_num else ("start", "stop"):
+        if req not in tab:
+            raise ctx.err(f"{key}.{req}", "missing")
+    start, stop = ctx.number(tab["start"], f"{key}.start"), ctx.number(tab["stop"], f"{key}.stop")
+    num = 2
+    if with_num:
+        num = tab["num"]
+        if not isinstance(num, int) or isinstance(num, bool):
+            raise ctx.err(f"{key}.num", f"must be an integer; got {num!r}")
+        if num < 1:
+            raise ctx.err(f"{key}.num", f"empty axis (num = {num}); give num >= 2 points")
+    scale = tab.get("scale", "linear")
+    if scale not in ("linear", "log"):
+        raise ctx.err(f"{key}.scale", f"must be 'linear' or 'log'; got {scale!r}")
+    return start, stop, num, scale == "log"
+
+
+def _grid_axis(ctx: _Ctx, name: str, v: Any) -> GridAxis:
+    from ..analysis.maps import Axis
+
+    key = f"axes.{name}"
+    values: list[Any] | None = None
+    if isinstance(v, list):
+        values = v
+    elif isinstance(v, dict) and "values" in v:
+        ctx.table(v, key, ("values",))
+        values = v["values"]
+        if not isinstance(values, list):
+            raise ctx.err(f"{key}.values", f"must be a list of numbers; got {values!r}")
+    if values is not None:
+        if not values:
+            raise ctx.err(key, "empty axis (no values)")
+        arr = np.array([ctx.number(x, f"{key}.values[{i}]") for i, x in enumerate(values)])
+        if np.unique(arr).size != arr.size:
+            raise ctx.err(key, "values must be distinct")
+        ref = float(np.max(np.abs(arr))) or 1.0
+        if np.all(arr > 0):
+            ref = float(math.sqrt(arr.min() * arr.max()))
+        return GridAxis(name, arr, "values", tuple(float(x) for x in arr), ref)
+    start, stop, num, log = _parse_range(ctx, key, v, True)
+    try:
+        ax = Axis(name, start, stop, num, log)
+    except ParameterError as exc:
+        raise ctx.err(key, str(exc)) from None
+    return GridAxis(name, ax.values(), "log" if log else "linear", (start, stop, num), ax.ref)
+
+
+def _default_chunks(shape: tuple[int, ...], points: int) -> tuple[int, ...]:
+    """Chunk shape of at most ``points`` points: whole trailing dimensions, a block of the next one."""
+    chunks = [1] * len(shape)
+    acc = 1
+    for k in reversed(range(len(shape))):
+        if acc * shape[k] <= points:
+            chunks[k] = shape[k]
+            acc *= shape[k]
+        else:
+            chunks[k] = max(1, points // acc)
+            break
+    return tuple(chunks)
+
+
+def _read(path: str) -> tuple[str, dict[str, Any]]:
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ParameterError(f"cannot read study file '{path}': {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise ParameterError(f"study file '{path}' is not valid UTF-8 text") from None
+    try:
+        return text, tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"study file '{path}' is not valid TOML: {exc}") from None
+
+
+def load_study(study: Any) -> Study:
+    """Read and validate a study.
+
+    Parameters
+    ----------
+    study : Study, str, Path or dict
+        A loaded study (returned as is), a TOML study file, or a dict of the
+        same content (relative paths are then relative to the working directory).
+
+    Returns
+    -------
+    Study
+        The validated study.
+
+    Raises
+    ------
+    ParameterError
+        One line naming the file and the key.
+    """
+    if isinstance(study, Study):
+        return study
+    if isinstance(study, (str, Path)):
+        text, data = _read(str(study))
+        return _from_data(data, str(study), text, Path(study).resolve().parent)
+    if isinstance(study, Mapping):
+        return _from_data(dict(study), "<dict>", json.dumps(study, sort_keys=True, default=str), Path.cwd())
+    raise ParameterError(f"a study is a TOML file path, a dict or a Study; got {type(study).__name__}")
+
+
+def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Study:
+    from ..parameters import PARAMETER_NAMES, get_preset, load_parameters
+
+    ctx = _Ctx(source)
+    ctx.table(data, "<top>", _TOP_KEYS)
+    name = data.get("name", Path(source).stem if source != "<dict>" else "study")
+    if not isinstance(name, str):
+        raise ctx.err("name", f"must be a string; got {name!r}")
+    preset_name = data.get("preset")
+    if preset_name is not None and not isinstance(preset_name, str):
+        raise ctx.err("preset", f"must be a string; got {preset_name!r}")
+    values: dict[str, Value] = {}
+    if "params" in data:
+        pfile = data["params"]
+        if not isinstance(pfile, str):
+            raise ctx.err("params", f"must be a file name; got {pfile!r}")
+        path = pfile if Path(pfile).is_absolute() else str(base / pfile)
+        try:
+            file_preset, entries = load_parameters(path)
+        except ParameterError as exc:
+            raise ctx.err("params", str(exc)) from None
+        if preset_name is not None and file_preset is not None and file_preset.name != preset_name:
+            raise ctx.err("preset", f"'{preset_name}' conflicts with preset '{file_preset.name}' of '{pfile}'")
+        preset_name = preset_name or (file_preset.name if file_preset else None)
+        values.update(entries)
+    elif preset_name is None and not data.get("parameters"):
+        raise ctx.err("preset", "missing: name a preset (e.g. preset = \"paper-fig2\"), a parameter file "
+                                "(params = \"file.toml\") or all 17 model parameters in [parameters]")
+    if preset_name is not None:
+        try:
+            get_preset(preset_name)
+        except ParameterError as exc:
+            raise ctx.err("preset", str(exc)) from None
+    params_tab = ctx.table(data.get("parameters", {}), "parameters")
+    for k, v in params_tab.items():
+        if not (_is_num(v) or isinstance(v, str)):
+            raise ctx.err(f"parameters.{k}", f"must be a number or an expression string; got {v!r}")
+        values[k] = v
+    if preset_name is None and set(values) != set(PARAMETER_NAMES):
+        missing = [n for n in PARAMETER_NAMES if n not in values]
+        unknown = [n for n in values if n not in PARAMETER_NAMES]
+        if unknown:
+            raise ctx.err(f"parameters.{unknown[0]}", "unknown parameter; valid names: " + ", ".join(PARAMETER_NAMES))
+        raise ctx.err("parameters", "missing " + ", ".join(missing) + " (no preset: give all 17 model parameters)")
+    tied_tab = ctx.table(data.get("tied", {}), "tied")
+    for k, v in tied_tab.items():
+        if not isinstance(v, str):
+            raise ctx.err(f"tied.{k}", f"must be an expression string; got {v!r}")
+        if k in values:
+            raise ctx.err(f"tied.{k}", f"'{k}' is also given in [parameters]; a name is either fixed or tied")
+    from .compute import build_space
+
+    try:
+        space = build_space(preset_name, tuple(values.items()), tuple(tied_tab.items()))
+    except ParameterError as exc:
+        bad = next((f"parameters.{k}" for k in values if f"'{k}'" in str(exc)), None)
+        bad = bad or next((f"tied.{k}" for k in tied_tab if f"'{k}'" in str(exc)), "parameters")
+        raise ctx.err(bad, str(exc)) from None
+
+    # ---- axes / samples
+    if ("axes" in data) == ("samples" in data):
+        raise ctx.err("axes", "give exactly one of [axes] (grid) or [samples] (random / Latin hypercube)")
+    axes: tuple[GridAxis, ...] = ()
+    ranges: tuple[SampleRange, ...] = ()
+    n_samples, seed, method = 0, 0, ""
+    if "axes" in data:
+        tab = ctx.table(data["axes"], "axes")
+        if not tab:
+            raise ctx.err("axes", "empty: give at least one axis")
+        axes = tuple(_grid_axis(ctx, k, v) for k, v in tab.items())
+        kind, names = "grid", [a.name for a in axes]
+    else:
+        tab = ctx.table(data["samples"], "samples", ("method", "n", "seed", "ranges"))
+        method = tab.get("method", "lhs")
+        if method not in ("lhs", "random"):
+            raise ctx.err("samples.method", f"must be 'lhs' or 'random'; got {method!r}")
+        if "n" not in tab:
+            raise ctx.err("samples.n", "missing (number of samples)")
+        n_samples = tab["n"]
+        if not isinstance(n_samples, int) or isinstance(n_samples, bool) or n_samples <= 0:
+            raise ctx.err("samples.n", f"the sample count must be a positive integer; got {n_samples!r}")
+        if n_samples > _MAX_SAMPLES:
+            raise ctx.err("samples.n", f"at most {_MAX_SAMPLES:.0e} samples; got {n_samples}")
+        seed = tab.get("seed", 0)
+        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+            raise ctx.err("samples.seed", f"must be a non-negative integer; got {seed!r}")
+        rtab = ctx.table(tab.get("ranges", {}), "samples.ranges")
+        if not rtab:
+            raise ctx.err("samples.ranges", "empty: give at least one parameter range")
+        rl = []
+        for k, v in rtab.items():
+            start, stop, _, log = _parse_range(ctx, f"samples.ranges.{k}", v, False)
+            if not stop > start:
+                raise ctx.err(f"samples.ranges.{k}", f"empty or reversed range {start!r}:{stop!r}")
+            if log and start <= 0:
+                raise ctx.err(f"samples.ranges.{k}", f"a log range needs positive bounds; got start = {start!r}")
+            rl.append(SampleRange(k, start, stop, log))
+        ranges = tuple(rl)
+        kind, names = "samples", [r.name for r in ranges]
+    prefix = "axes" if kind == "grid" else "samples.ranges"
+    for n in names:
+        if n == "sample":
+            raise ctx.err(f"{prefix}.{n}", "'sample' is reserved for the sample dimension")
+        try:
+            space.check_axis(n)
+        except ParameterError as exc:
+            raise ctx.err(f"{prefix}.{n}", str(exc)) from None
+
+    # ---- compute
+    ctab = ctx.table(data.get("compute", {}), "compute", ("quantities", "critical_speed_range"))
+    quantities = ctab.get("quantities", list(DEFAULT_QUANTITIES))
+    if not isinstance(quantities, list) or not all(isinstance(q, str) for q in quantities):
+        raise ctx.err("compute.quantities", f"must be a list of names; got {quantities!r}")
+    for q in quantities:
+        if q not in QUANTITIES:
+            raise ctx.err("compute.quantities", f"unknown quantity {q!r}; allowed: " + ", ".join(QUANTITIES))
+    quant = tuple(q for q in QUANTITIES if q in quantities or q == "stable")
+    crit = (1.0, 1e5)
+    if "critical_speed_range" in ctab:
+        cr = ctab["critical_speed_range"]
+        if not (isinstance(cr, list) and len(cr) == 2):
+            raise ctx.err("compute.critical_speed_range", f"must be [LO, HI] in rad/s; got {cr!r}")
+        crit = (ctx.number(cr[0], "compute.critical_speed_range[0]"),
+                ctx.number(cr[1], "compute.critical_speed_range[1]"))
+        if not 0 < crit[0] < crit[1]:
+            raise ctx.err("compute.critical_speed_range", f"needs 0 < LO < HI; got {cr!r}")
+    if "critical_speed" in quant:
+        from ..expressions import names_in
+
+        if "Omega" in names:
+            raise ctx.err("compute.quantities", "'critical_speed' searches along Omega; Omega cannot also be swept")
+        if "Omega" not in space.settable() or any("Omega" in names_in(e) for e in space.tied.values()):
+            raise ctx.err("compute.quantities", "'critical_speed' needs Omega to be a settable parameter that no "
+                                                "tie expression uses")
+
+    # ---- execution / output
+    shape = tuple(a.size for a in axes) if kind == "grid" else (n_samples,)
+    etab = ctx.table(data.get("execution", {}), "execution", ("chunk_points", "chunks"))
+    eigen = any(q in quant for q in ("margin", "max_real", "frequency", "critical_speed"))
+    points = DEFAULT_CHUNK_POINTS[1 if eigen else 0]
+    if "chunk_points" in etab:
+        points = ctx.integer(etab["chunk_points"], "execution.chunk_points", 1)
+    chunks = _default_chunks(shape, points)
+    if "chunks" in etab:
+        dims = names if kind == "grid" else ["sample"]
+        ch = ctx.table(etab["chunks"], "execution.chunks", tuple(dims))
+        chunks = tuple(min(ctx.integer(ch[d], f"execution.chunks.{d}", 1), s) if d in ch else c
+                       for d, c, s in zip(dims, chunks, shape))
+    otab = ctx.table(data.get("output", {}), "output", ("store",))
+    store = otab.get("store")
+    if store is not None:
+        if not isinstance(store, str) or not store:
+            raise ctx.err("output.store", f"must be a path; got {store!r}")
+        if not Path(store).is_absolute():
+            store = str(base / store)
+    desc = data.get("description", "")
+    if not isinstance(desc, str):
+        raise ctx.err("description", f"must be a string; got {desc!r}")
+    return Study(source=source, text=text, name=name, preset=preset_name, values=values, tied=dict(tied_tab),
+                 kind=kind, axes=axes, ranges=ranges, n_samples=n_samples, seed=seed, method=method,
+                 quantities=quant, critical_speed_range=crit, chunks=chunks, store=store)
