@@ -66,7 +66,6 @@ __all__ = [
     "CrossingResult",
     "CriticalSpeedResult",
     "open_map",
-    "run_sweep",
     "sweep_status",
     "open_sweep",
     "load_study",
@@ -114,7 +113,6 @@ _LAZY = {
     "CrossingResult": "results",
     "CriticalSpeedResult": "results",
     "open_map": "results",
-    "run_sweep": "sweep",
     "sweep_status": "sweep",
     "open_sweep": "sweep",
     "load_study": "sweep",
@@ -128,7 +126,7 @@ def __getattr__(name: str) -> Any:
         import importlib
 
         mod = importlib.import_module(f".{_LAZY[name]}", __name__)
-        return getattr(mod, "sweep" if name == "run_sweep" else name)
+        return getattr(mod, name)
     raise AttributeError(f"module 'brakesqueal' has no attribute {name!r}")
 
 

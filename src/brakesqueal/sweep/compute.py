@@ -37,7 +37,7 @@ from ..analysis.maps import _numeric_point, _roots_summary, _trivial
 from ..analysis.space import VECTOR_NAMES, ParameterSpace
 from ..parameters import _BOUNDS, PARAMETER_NAMES, Value
 
-__all__ = ["ChunkSpec", "build_space", "compute_chunk", "grid_kernel", "FLOAT_QUANTITIES"]
+__all__ = ["ChunkSpec", "build_space", "model_space", "compute_chunk", "grid_kernel", "FLOAT_QUANTITIES"]
 
 #: Float quantities and their attributes.
 FLOAT_QUANTITIES = {
@@ -71,6 +71,7 @@ class ChunkSpec:
     signs: tuple[int, ...]
     quantities: tuple[str, ...]
     critical_speed_range: tuple[float, float]
+    model: str | None = None
 
     @classmethod
     def from_study(cls, study: Any) -> ChunkSpec:
@@ -81,7 +82,7 @@ class ChunkSpec:
             refs, signs = (), ()
         names = study.dims if study.kind == "grid" else study.sample_names
         return cls(study.hash(), study.preset, tuple(study.values.items()), tuple(study.tied.items()), study.kind,
-                   names, refs, signs, study.quantities, study.critical_speed_range)
+                   names, refs, signs, study.quantities, study.critical_speed_range, study.model)
 
 
 # ---------------------------------------------------------------- parameter space
@@ -113,6 +114,43 @@ def build_space(preset: str | None, values: tuple[tuple[str, Value], ...],
     space = ParameterSpace(p.name, p, {})
     space.resolve({})
     return space
+
+
+@lru_cache(maxsize=16)
+def model_space(model_json: str, values: tuple[tuple[str, Value], ...]) -> Any:
+    """The :class:`~brakesqueal.builder.analysis.ModelSpace` of a built-model study (cached per process)."""
+    import json
+
+    from ..builder import spec_from_dict
+    from ..builder.analysis import ModelSpace
+
+    return ModelSpace(spec_from_dict(json.loads(model_json), source="study model"), dict(values))
+
+
+def _model_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """One chunk of a built-model study: batched eigenvalues (``builder.analysis``)."""
+    from ..builder.analysis import NONTRIVIAL, _batch
+
+    space = model_space(spec.model, spec.values)  # type: ignore[arg-type]
+    if spec.kind == "grid":
+        shape = tuple(int(np.size(coords[n])) for n in spec.names)
+        nd = len(shape)
+        grid = {n: np.asarray(coords[n], dtype=float).reshape([-1 if i == k else 1 for i in range(nd)])
+                for k, n in enumerate(spec.names)}  # fmt: skip
+    else:
+        shape = (int(np.size(coords[spec.names[0]])),)
+        grid = {n: np.asarray(coords[n], dtype=float) for n in spec.names}
+    r = _batch(space, grid, shape)
+    mr, fr = r["max_real"], r["frequency"]
+    out: dict[str, np.ndarray] = {"stable": (mr < 0) & (r["status"] <= NONTRIVIAL), "status": r["status"]}
+    with np.errstate(all="ignore"):
+        s = {"max_real": mr, "frequency": fr, "margin": -mr / np.hypot(mr, 2 * np.pi * fr)}
+    for q in FLOAT_QUANTITIES:
+        if q in spec.quantities:
+            a = np.array(s[q], dtype=float)
+            a[np.isnan(a)] = np.nan
+            out[q] = a
+    return out
 
 
 # ---------------------------------------------------------------- N-D grid kernel
@@ -263,6 +301,8 @@ def compute_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, n
         ``stable`` (bool), ``status`` (int8) and the requested float
         quantities, shaped like the chunk (dimensions in study order).
     """
+    if spec.model is not None:
+        return _model_chunk(spec, coords)
     space = build_space(spec.preset, spec.values, spec.tied)
     if spec.kind == "grid":
         shape = tuple(int(np.size(coords[n])) for n in spec.names)

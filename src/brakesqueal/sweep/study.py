@@ -49,7 +49,7 @@ QUANTITIES = ("stable", "margin", "max_real", "frequency", "critical_speed")
 DEFAULT_QUANTITIES = ("stable", "margin", "max_real", "frequency")
 #: Points per chunk by default: verdict-only studies / studies with eigenvalues.
 DEFAULT_CHUNK_POINTS = (1 << 22, 1 << 18)
-_TOP_KEYS = ("name", "description", "preset", "params", "parameters", "tied", "axes", "samples", "compute",
+_TOP_KEYS = ("name", "description", "preset", "params", "model", "parameters", "tied", "axes", "samples", "compute",
              "execution", "output")
 _MAX_SAMPLES = 10**7
 
@@ -117,6 +117,9 @@ class Study:
         Chunk shape (one entry per dimension).
     store : str or None
         Default result store (relative paths are relative to the study file).
+    model : str or None
+        A built model (canonical JSON of its description) instead of a preset;
+        ``values`` then override the model's parameters.
     """
 
     source: str
@@ -135,6 +138,7 @@ class Study:
     critical_speed_range: tuple[float, float]
     chunks: tuple[int, ...]
     store: str | None
+    model: str | None = None
 
     # ------------------------------------------------------------ layout
     @property
@@ -201,6 +205,8 @@ class Study:
                       "tied": dict(sorted(space.tied.items()))},
             "kind": self.kind, "quantities": list(self.quantities), "chunks": list(self.chunks),
         }
+        if self.model is not None:
+            d["model"] = json.loads(self.model)
         if "critical_speed" in self.quantities:
             d["critical_speed_range"] = list(self.critical_speed_range)
         if self.kind == "grid":
@@ -220,8 +226,10 @@ class Study:
 
     def space(self) -> Any:
         """The :class:`~brakesqueal.analysis.space.ParameterSpace` of the study (cached per process)."""
-        from .compute import build_space
+        from .compute import build_space, model_space
 
+        if self.model is not None:
+            return model_space(self.model, tuple(self.values.items()))
         return build_space(self.preset, tuple(self.values.items()), tuple(self.tied.items()))
 
 
@@ -387,14 +395,11 @@ def load_study(study: Any) -> Study:
     raise ParameterError(f"a study is a TOML file path, a dict or a Study; got {type(study).__name__}")
 
 
-def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Study:
+def _preset_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str | None, dict[str, Value],
+                                                                        dict[str, Any], Any]:
+    """The preset / parameter-file / [parameters] / [tied] part of a study: (preset, values, tied, space)."""
     from ..parameters import PARAMETER_NAMES, get_preset, load_parameters
 
-    ctx = _Ctx(source)
-    ctx.table(data, "<top>", _TOP_KEYS)
-    name = data.get("name", Path(source).stem if source != "<dict>" else "study")
-    if not isinstance(name, str):
-        raise ctx.err("name", f"must be a string; got {name!r}")
     preset_name = data.get("preset")
     if preset_name is not None and not isinstance(preset_name, str):
         raise ctx.err("preset", f"must be a string; got {preset_name!r}")
@@ -445,6 +450,53 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
         bad = next((f"parameters.{k}" for k in values if f"'{k}'" in str(exc)), None)
         bad = bad or next((f"tied.{k}" for k in tied_tab if f"'{k}'" in str(exc)), "parameters")
         raise ctx.err(bad, str(exc)) from None
+
+    return preset_name, values, tied_tab, space
+
+
+def _model_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str, dict[str, Value], Any]:
+    """The ``model = ...`` part of a study: (canonical model JSON, parameter overrides, space)."""
+    from ..builder import resolve_model, spec_to_dict
+
+    for key in ("preset", "params", "tied"):
+        if key in data:
+            raise ctx.err(key, "cannot be combined with 'model' (give the model's parameters in [parameters])")
+    m = data["model"]
+    if not isinstance(m, str) or not m:
+        raise ctx.err("model", f"must be a model file or a built-in model name; got {m!r}")
+    path = Path(m) if Path(m).is_absolute() else base / m
+    try:
+        spec = resolve_model(str(path) if path.exists() else m)
+    except ParameterError as exc:
+        raise ctx.err("model", str(exc)) from None
+    values: dict[str, Value] = {}
+    for k, v in ctx.table(data.get("parameters", {}), "parameters").items():
+        if not (_is_num(v) or isinstance(v, str)):
+            raise ctx.err(f"parameters.{k}", f"must be a number or an expression string; got {v!r}")
+        values[k] = v
+    model_json = json.dumps(spec_to_dict(spec), sort_keys=True)
+    from .compute import model_space
+
+    try:
+        space = model_space(model_json, tuple(values.items()))
+    except ParameterError as exc:
+        bad = next((f"parameters.{k}" for k in values if f"'{k}'" in str(exc)), "parameters")
+        raise ctx.err(bad, str(exc)) from None
+    return model_json, values, space
+
+
+def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Study:
+    ctx = _Ctx(source)
+    ctx.table(data, "<top>", _TOP_KEYS)
+    name = data.get("name", Path(source).stem if source != "<dict>" else "study")
+    if not isinstance(name, str):
+        raise ctx.err("name", f"must be a string; got {name!r}")
+    model_json = None
+    if "model" in data:
+        model_json, values, space = _model_space(ctx, data, base)
+        preset_name, tied_tab = None, {}
+    else:
+        preset_name, values, tied_tab, space = _preset_space(ctx, data, base)
 
     # ---- axes / samples
     if ("axes" in data) == ("samples" in data):
@@ -513,6 +565,9 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
                 ctx.number(cr[1], "compute.critical_speed_range[1]"))
         if not 0 < crit[0] < crit[1]:
             raise ctx.err("compute.critical_speed_range", f"needs 0 < LO < HI; got {cr!r}")
+    if "critical_speed" in quant and model_json is not None:
+        raise ctx.err("compute.quantities", "'critical_speed' is not available for built models in sweeps; "
+                                            "use brakesqueal critical-speed --model")
     if "critical_speed" in quant:
         from ..expressions import names_in
 
@@ -547,4 +602,4 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
         raise ctx.err("description", f"must be a string; got {desc!r}")
     return Study(source=source, text=text, name=name, preset=preset_name, values=values, tied=dict(tied_tab),
                  kind=kind, axes=axes, ranges=ranges, n_samples=n_samples, seed=seed, method=method,
-                 quantities=quant, critical_speed_range=crit, chunks=chunks, store=store)
+                 quantities=quant, critical_speed_range=crit, chunks=chunks, store=store, model=model_json)
