@@ -30,7 +30,7 @@ from ..bench import BenchResult
 __all__ = ["bench_sweep", "grid_study"]
 
 
-def grid_study(points: int, *, chunk_points: int = 1 << 20, quantities: tuple[str, ...] = ("stable",)
+def grid_study(points: int, *, chunk_points: int = 1 << 22, quantities: tuple[str, ...] = ("stable",)
                ) -> dict[str, Any]:
     """A 3-D paper-fig2 study (Omega x mu x k_ip) of about ``points`` points."""
     n = max(2, round((points / 100) ** 0.5))
