@@ -40,7 +40,7 @@ def _ref_params(p: Parameters) -> dict[str, float]:
     return dict(zip(PARAMETER_SYMBOLS, parameter_vector(p)))
 
 
-def _close(a, b, rtol=1e-9, label=""):
+def assert_close(a, b, rtol=1e-9, label=""):
     a, b = np.asarray(a, float), np.asarray(b, float)
     scale = np.maximum(np.abs(b), 1e-12 * np.max(np.abs(b)))
     err = np.max(np.abs(a - b) / scale)
@@ -58,8 +58,8 @@ def test_nonlinear_residuals_agree_at_random_states(seed):
     }  # fmt: skip
     psi_ref, g_ref = ref.residuals(x, _ref_params(p))
     out = compiled_model().residuals([x[n] for n in STATE_SYMBOLS], parameter_vector(p))
-    _close(out[:2], psi_ref, label="psi")
-    _close(out[2:], g_ref, label="g")
+    assert_close(out[:2], psi_ref, label="psi")
+    assert_close(out[2:], g_ref, label="g")
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -78,9 +78,9 @@ def test_linear_matrices_agree_at_random_general_parameters(seed):
         for got, want in ((lm.q_m0, [state0["q1"], state0["q2"]]), (lm.silent.l0, [state0["l1"], state0["l2"]])):
             assert np.linalg.norm(got - np.array(want)) <= 1e-9 * np.linalg.norm(want)
     M, D, K = ref.linearize(state0, pr)
-    _close(lm.M, M, label="M")
-    _close(lm.D, D, label="D")
-    _close(lm.K, K, label="K")
+    assert_close(lm.M, M, label="M")
+    assert_close(lm.D, D, label="D")
+    assert_close(lm.K, K, label="K")
 
 
 def test_silent_motion_satisfies_the_reference_equations():

@@ -176,6 +176,44 @@ class MapKernel:
     source: str
 
 
+def normalise_rows(C: np.ndarray, degrees: tuple[int, ...], inner_ref: float) -> tuple[np.ndarray, np.ndarray]:
+    """Scale per-row quartic coefficient tables for the compiled Hurwitz classifier.
+
+    ``C`` holds, per row, the inner-axis polynomial coefficients of ``a0..a4``
+    (``degrees[i] + 1`` columns each).  The inner variable is divided by
+    ``inner_ref``, time is rescaled per row by ``sigma = (|a0| / |a4|)^(1/4)``
+    (``λ → σ λ``, which keeps the roots' magnitudes near one and does not change
+    the Hurwitz signs), and each row is divided by its largest entry.
+
+    Parameters
+    ----------
+    C : ndarray, shape (rows, sum(degrees) + 5)
+        Coefficient table (modified copy returned).
+    degrees : tuple of int
+        Inner-axis degree of each of ``a0..a4``.
+    inner_ref : float
+        Scale of the inner axis.
+
+    Returns
+    -------
+    C : ndarray
+        The normalised, C-contiguous table.
+    sigma : ndarray, shape (rows,)
+        The per-row time scales.
+    """
+    C = C * np.concatenate([inner_ref ** np.arange(d + 1) for d in degrees])
+    offs = np.concatenate([[0], np.cumsum([d + 1 for d in degrees])])
+    mag = [np.max(np.abs(C[:, offs[i]:offs[i + 1]]), axis=1) for i in range(5)]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sigma = np.where((mag[0] > 0) & (mag[4] > 0), (mag[0] / mag[4]) ** 0.25, 1.0)
+    for i in range(5):
+        C[:, offs[i]:offs[i + 1]] *= (sigma ** i)[:, None]
+    scale = np.max(np.abs(C), axis=1)
+    scale[~(scale > 0)] = 1.0
+    C /= scale[:, None]
+    return np.ascontiguousarray(C), sigma
+
+
 def _kernel_source(degrees: tuple[int, ...]) -> str:
     offs = np.concatenate([[0], np.cumsum([d + 1 for d in degrees])]).tolist()
     load = "; ".join(f"c{i}_{k} = C[i, {offs[i] + k}]" for i in range(5) for k in range(degrees[i] + 1))
@@ -276,18 +314,7 @@ def _map_kernel_cached(space: ParameterSpace, x: str, y: str, sx: int, sy: int) 
         ov = np.asarray(outer_values, dtype=float)
         cols = [np.broadcast_to(np.asarray(c, dtype=float), ov.shape) for c in fn(ov)]
         C = np.stack(cols, axis=1) if cols else np.zeros((ov.size, 0))
-        powers = np.concatenate([inner_ref ** np.arange(d + 1) for d in degs])
-        C = C * powers
-        offs = np.concatenate([[0], np.cumsum([d + 1 for d in degs])])
-        mag = [np.max(np.abs(C[:, offs[i]:offs[i + 1]]), axis=1) for i in range(5)]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            sigma = np.where((mag[0] > 0) & (mag[4] > 0), (mag[0] / mag[4]) ** 0.25, 1.0)
-        for i in range(5):
-            C[:, offs[i]:offs[i + 1]] *= (sigma ** i)[:, None]
-        scale = np.max(np.abs(C), axis=1)
-        scale[~(scale > 0)] = 1.0
-        C /= scale[:, None]
-        return np.ascontiguousarray(C), sigma
+        return normalise_rows(C, degs, inner_ref)
 
     source = _kernel_source(degrees)
     mod = _load_generated(source, "map")

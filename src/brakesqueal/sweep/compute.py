@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.kernels import critical_speeds_batch, hurwitz_stable, quartic_coefficients
+from ..analysis.kernels import critical_speeds_batch, hurwitz_stable, normalise_rows, quartic_coefficients
 from ..analysis.maps import _numeric_point, _roots_summary, _trivial
 from ..analysis.space import VECTOR_NAMES, ParameterSpace
 from ..parameters import _BOUNDS, PARAMETER_NAMES, Value
@@ -165,20 +165,8 @@ class GridKernel:
 
     def row_coefficients(self, outer: list[np.ndarray], n_rows: int, inner_ref: float) -> np.ndarray:
         """Per-row coefficient table, scaled and normalised as ``MapKernel.row_coefficients``."""
-        degs = self.degrees
         cols = [np.broadcast_to(np.asarray(c, dtype=float), (n_rows,)) for c in self.rows(*outer)]
-        C = np.stack(cols, axis=1)
-        C = C * np.concatenate([inner_ref ** np.arange(d + 1) for d in degs])
-        offs = np.concatenate([[0], np.cumsum([d + 1 for d in degs])])
-        mag = [np.max(np.abs(C[:, offs[i]:offs[i + 1]]), axis=1) for i in range(5)]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            sigma = np.where((mag[0] > 0) & (mag[4] > 0), (mag[0] / mag[4]) ** 0.25, 1.0)
-        for i in range(5):
-            C[:, offs[i]:offs[i + 1]] *= (sigma ** i)[:, None]
-        scale = np.max(np.abs(C), axis=1)
-        scale[~(scale > 0)] = 1.0
-        C /= scale[:, None]
-        return np.ascontiguousarray(C)
+        return normalise_rows(np.stack(cols, axis=1), self.degrees, inner_ref)[0]
 
 
 @lru_cache(maxsize=8)
