@@ -33,8 +33,9 @@ def main() -> int:
         data = json.loads(proc.stdout)
         results[target] = data
         for rec in [data, *data.get("more", [])]:
-            print(f"  {rec['metric']}: {rec['value']:.4g} {rec['unit']} (baseline {rec['baseline']:.4g}) "
-                  f"ratio {rec['ratio']:.1f}x")
+            base = "none" if rec["baseline"] is None else f"{rec['baseline']:.4g}"
+            ratio = "" if rec["ratio"] is None else f" ratio {rec['ratio']:.1f}x"
+            print(f"  {rec['metric']}: {rec['value']:.4g} {rec['unit']} (baseline {base}){ratio}")
     for script in sorted(here.glob("bench_*.py")):
         print(f"== {script.name}", flush=True)
         proc = subprocess.run([sys.executable, str(script)], text=True)
