@@ -100,7 +100,7 @@ def linearize(
     """Find the silent motion, linearize (eqs. 46-48) and print M, D, K and the eigenvalues."""
     from .analysis.linear import linearize as _linearize
     from .numeric.compiled import compiled_model
-    from .parameters import parse_assignment, resolve_parameters
+    from .parameters import parse_sets, resolve_parameters
     from .render import render_linear_model
 
     if model is not None:
@@ -110,7 +110,7 @@ def linearize(
 
         if preset or params:
             raise ParameterError("--model cannot be combined with --preset or --params (use --set for its parameters)")
-        overrides = dict(parse_assignment(a) for a in (set_ or []))
+        overrides = parse_sets(set_ or [])
         lm_b = linearize_model(resolve_model(model), overrides, use_cache=not no_cache)
         sys.stdout.write(render_built_linear(lm_b, fmt.value))
         return

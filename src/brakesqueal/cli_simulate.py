@@ -109,12 +109,12 @@ def _simulate_built(model: str, preset: Any, params: Any, set_: Any, t_end: floa
     """``simulate --model``: the generic built-model integrator (``builder.simulate``)."""
     from .builder import resolve_model
     from .builder.simulate import simulate_model
-    from .parameters import parse_assignment
+    from .parameters import parse_sets
 
     if preset or params or x0 is not None or wav:
         raise ParameterError("--model cannot be combined with --preset, --params, --x0 or --wav")
     sim_method = "DOP853" if method == "DOP853-jit" else method
-    tr = simulate_model(resolve_model(model), dict(parse_assignment(a) for a in (set_ or [])), t_end,
+    tr = simulate_model(resolve_model(model), parse_sets(set_ or []), t_end,
                         _floats(q0, "--q0"), method=sim_method, rtol=rtol)  # fmt: skip
     if out:
         tr.to_netcdf(out)

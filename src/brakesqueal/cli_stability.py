@@ -40,11 +40,11 @@ def _model_space(model: str, preset: Optional[str], params: Optional[str], sets:
     """A built model with ``--set`` overrides (``--preset``/``--params`` do not apply to built models)."""
     from .builder import resolve_model
     from .builder.analysis import ModelSpace
-    from .parameters import parse_assignment
+    from .parameters import parse_sets
 
     if preset or params:
         raise ParameterError("--model cannot be combined with --preset or --params (use --set for its parameters)")
-    return ModelSpace(resolve_model(model), dict(parse_assignment(a) for a in (sets or [])))
+    return ModelSpace(resolve_model(model), parse_sets(sets or []))
 
 
 def _space(preset: Optional[str], params: Optional[str], sets: Optional[list[str]]):  # type: ignore[no-untyped-def]

@@ -603,6 +603,33 @@ def parse_assignment(text: str) -> tuple[str, Value]:
         return name, value
 
 
+def parse_sets(sets: Sequence[str]) -> dict[str, Value]:
+    """Parse repeated ``--set NAME=VALUE`` options into overrides.
+
+    Parameters
+    ----------
+    sets : sequence of str
+        The ``NAME=VALUE`` texts.
+
+    Returns
+    -------
+    dict
+        ``{name: value}``; values are floats where they are plain numbers, else strings.
+
+    Raises
+    ------
+    ParameterError
+        A malformed assignment, or a name given more than once.
+    """
+    overrides: dict[str, Value] = {}
+    for text in sets:
+        name, value = parse_assignment(text)
+        if name in overrides:
+            raise ParameterError(f"--set '{name}' is given more than once")
+        overrides[name] = value
+    return overrides
+
+
 def resolve_parameters(preset: str | None, params_file: str | None, sets: list[str]
                        ) -> Parameters:
     """Combine ``--preset``, ``--params FILE`` and ``--set NAME=VALUE`` options.
@@ -632,12 +659,7 @@ def resolve_parameters(preset: str | None, params_file: str | None, sets: list[s
         If the file names a preset other than ``preset``, a ``--set`` name
         is given twice, or any value, name or file is invalid.
     """
-    overrides: dict[str, Value] = {}
-    for text in sets:
-        name, value = parse_assignment(text)
-        if name in overrides:
-            raise ParameterError(f"--set '{name}' is given more than once")
-        overrides[name] = value
+    overrides = parse_sets(sets)
     if params_file is None:
         return get_preset(preset or "paper-fig2").resolve(overrides)
     return _from_file(params_file, preset, overrides)

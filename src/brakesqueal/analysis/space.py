@@ -22,7 +22,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..expressions import dependency_order
 from ..parameters import (
-    PARAMETER_NAMES, Parameters, Preset, Value, get_preset, load_parameters, parse_assignment,
+    PARAMETER_NAMES, Parameters, Preset, Value, get_preset, load_parameters, parse_sets,
 )
 
 __all__ = ["ParameterSpace", "COMPLIANCE_NAMES", "VECTOR_NAMES"]
@@ -82,12 +82,7 @@ class ParameterSpace:
     def from_options(cls, preset: str | None, params_file: str | None, sets: Sequence[str]
                      ) -> ParameterSpace:
         """Combine ``--preset``, ``--params FILE`` and ``--set NAME=VALUE`` like the other commands."""
-        overrides: dict[str, Value] = {}
-        for text in sets:
-            name, value = parse_assignment(text)
-            if name in overrides:
-                raise ParameterError(f"--set '{name}' is given more than once")
-            overrides[name] = value
+        overrides = parse_sets(sets)
         if params_file is None:
             return cls.from_preset(preset or "paper-fig2", overrides)
         file_preset, entries = load_parameters(params_file)
