@@ -1,100 +1,289 @@
-r"""The silent motion ``q_m(t) = q_m0 = const`` (paper eq. 46).
+r"""The silent motion ``Q(t) = Q0 = const`` of any model (paper eq. 46).
 
-With ``q_mdot = q_mddot = 0`` and ``ldot = 0`` the residuals ``psi`` (eq. 44)
-and ``g`` (eqs. 33-34) are four equations in ``(q1, q2, l1, l2)``.  When
-``mu1*h10 = mu2*h20`` (eq. 49) the solution is the trivial one, zero; otherwise
-it is found by Newton's method with the exact compiled Jacobian, started at
-zero (the silent motion is the branch connected to the trivial one).
+With ``Qdot = Qddot = 0`` and ``Ldot = 0`` the residuals ``R`` (eq. 44,
+generalized) and ``G`` (eqs. 33-34) are ``n + m`` equations
+``F(Q, L) = 0``.
+
+* **Trivial silent motion.** When ``F(0) = 0`` — for the paper's model when
+  ``mu1 h10 = mu2 h20`` (eq. 49) — the silent motion is ``Q0 = 0`` exactly.
+  "Zero" is decided to rounding: ``|F_i(0)| <= 64 eps S_i`` with ``S_i`` the
+  magnitude of the terms that cancel, ``sum_k |p_k dF_i/dp_k|`` (generated
+  with the model, :attr:`CompiledModel.zero_residual_scale
+  <brakesqueal.codegen.compiled.CompiledModel.zero_residual_scale>`), so ties
+  such as Fig. 3's ``h10 = h mu2/(mu1 + mu2)`` give the exact zero.
+* **Otherwise** the silent motion is the solution connected to the trivial
+  one: the Newton homotopy ``H(z, s) = F(z) - (1 - s) F(0)`` is followed from
+  ``(z, s) = (0, 0)`` to ``s = 1`` by pseudo-arclength continuation with a
+  Newton corrector (equilibrated scaling), then polished by Newton's method on
+  ``F``.  If the path turns back before ``s = 1`` (a fold) or leaves the
+  range where the kinematics is valid, it is *established* that no silent
+  motion exists on that branch (:class:`~brakesqueal.errors.NoSilentMotionError`);
+  if the continuation cannot proceed (a singular point, step-size
+  underflow) the solver reports that it failed
+  (:class:`~brakesqueal.errors.SolverFailedError`) — a different status.
+* **Validity.** Every pad must touch (``F_n > 0``) and slide (``|v_r| > 0``)
+  at the silent motion (:class:`~brakesqueal.errors.ContactLossError`,
+  :class:`~brakesqueal.errors.NoSlidingError`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
-from ..errors import SilentMotionError
-from ..numeric.compiled import CompiledModel, compiled_model
-from ..numeric.newton import damped_newton
-from ..parameters import Parameters
+from ..errors import ContactLossError, NoSilentMotionError, NoSlidingError, SolverFailedError
 
-__all__ = ["SilentMotion", "silent_motion", "parameter_vector"]
+__all__ = ["SilentMotion", "silent_motion", "parameter_vector", "as_parameters", "is_trivial"]
 
-_EQ_IDX = (0, 1, 6, 7)  # q1, q2, l1, l2 in the state vector
+_EPS = np.finfo(float).eps
+#: Largest tilt angle [rad] for which the kinematics (eq. 42: 1/(cos q1 cos q2)) is used.
+MAX_TILT = 1.2
 
 
-def parameter_vector(params: Parameters) -> list[float]:
-    """Parameters in the order of the compiled functions (compliances for ``k_ip``)."""
-    d = params.as_dict()
-    c1, c2 = params.compliances()
-    return [
-        d["Theta"], d["Phi"], d["k_t"], d["d_t"], d["k1"], d["k2"], d["d1"], d["d2"], c1, c2,
-        d["mu1"], d["mu2"], d["h10"], d["h20"], d["r"], d["N0"], d["Omega"],
-    ]  # fmt: skip
+def as_parameters(params: Any) -> Any:
+    """A :class:`~brakesqueal.model.parameters.Parameters` (paper-model dataclasses of earlier versions converted)."""
+    from ..model.parameters import Parameters
+
+    if isinstance(params, Parameters):
+        return params
+    if hasattr(params, "as_dict"):  # the 17-field paper parameter set of earlier versions
+        from ..model.library import get_model
+
+        return Parameters(get_model("paper"), params.as_dict())
+    raise TypeError(f"expected a Parameters object; got {type(params).__name__}")
+
+
+def parameter_vector(params: Any) -> list[float]:
+    """Parameters in packing order (compliances for ``k_ip``): the ``p`` of every generated function."""
+    return [float(v) for v in as_parameters(params).vector()]
 
 
 @dataclass(frozen=True)
 class SilentMotion:
-    """A silent motion of the 2-DOF model.
+    """A silent motion (eq. 46) of a model.
 
     Attributes
     ----------
-    q_m0 : ndarray, shape (2,)
-        Tilt angles ``(q1, q2)`` [rad] (eq. 46).
-    l0 : ndarray, shape (2,)
-        Tangential pad deformations [m].
-    normal_forces : ndarray, shape (2,)
-        ``F_n1, F_n2`` [N] (eqs. 29-30); positive while the pads touch.
-    sliding_speeds : ndarray, shape (2,)
-        ``|v_r1|, |v_r2|`` [m/s].
+    coords : tuple of str
+        Names of the coordinates ``Q``.
+    q0 : ndarray, shape (n,)
+        Coordinates at the silent motion (tilts [rad], displacements [m]).
+    l0 : ndarray, shape (m,)
+        Tangential deformations of the massless pads [m].
+    normal_forces : ndarray, shape (n_pads,)
+        Normal contact forces [N] (eqs. 29-30); positive.
+    sliding_speeds : ndarray, shape (n_pads,)
+        ``|v_r|`` of every pad [m/s]; positive.
     trivial : bool
-        True when eq. (49) holds and ``q_m0 = 0`` exactly.
+        ``True`` when ``F(0) = 0`` to rounding and ``q0 = 0`` exactly.
     iterations : int
-        Newton iterations used (0 for the trivial solution).
+        Corrector iterations used (0 for the trivial silent motion).
+    method : str
+        How it was found.
     """
 
-    q_m0: np.ndarray
+    coords: tuple[str, ...]
+    q0: np.ndarray
     l0: np.ndarray
     normal_forces: np.ndarray
     sliding_speeds: np.ndarray
     trivial: bool
     iterations: int
+    method: str = "trivial"
+    _n: int = field(default=0, repr=False)
+
+    @property
+    def q_m0(self) -> np.ndarray:
+        """Deprecated alias of :attr:`q0` (the disk tilt of the paper's model); kept for one release."""
+        return self.q0
 
     def state(self) -> list[float]:
-        """Full state vector ``x`` of the silent motion (rates zero)."""
-        return [self.q_m0[0], self.q_m0[1], 0.0, 0.0, 0.0, 0.0, self.l0[0], self.l0[1], 0.0, 0.0]
+        """The full state ``x = (Q0, 0, 0, L0, 0)`` of the generated functions."""
+        n, m = self.q0.size, self.l0.size
+        return [*map(float, self.q0), *([0.0] * (2 * n)), *map(float, self.l0), *([0.0] * m)]
 
 
-def _state(z: np.ndarray) -> list[float]:
-    return [z[0], z[1], 0.0, 0.0, 0.0, 0.0, z[2], z[3], 0.0, 0.0]
+def is_trivial(residuals: np.ndarray, scale: np.ndarray) -> Any:
+    """Whether residuals at ``x = 0`` vanish to rounding (``|F_i| <= 64 eps S_i`` for all rows; vectorized)."""
+    r = np.abs(np.asarray(residuals, dtype=float))
+    s = np.abs(np.asarray(scale, dtype=float))
+    return np.all(r <= 64.0 * _EPS * s, axis=0)
 
 
-def _newton(model: CompiledModel, p: list[float]) -> tuple[np.ndarray, int]:
-    """Damped Newton on the scaled residuals, from ``z = 0``; returns ``(z, iterations)``."""
-    moment_scale = max(p[2], p[15] * (abs(p[12]) + abs(p[13])))  # N m / rad
-    scale = np.array([moment_scale, moment_scale, 1.0, 1.0])  # psi in N m, g in m
-
-    def f(z: np.ndarray) -> np.ndarray:
-        return np.asarray(model.residuals(_state(z), p)) / scale
-
-    def jac(z: np.ndarray) -> np.ndarray:
-        return np.asarray(model.jacobians(_state(z), p)).reshape(4, 10)[:, _EQ_IDX] / scale[:, None]
-
-    return damped_newton(
-        f, jac, np.zeros(4), atol=np.array([1e-18, 1e-18, 1e-21, 1e-21]), max_iter=60,
-        admissible=lambda z: abs(z[0]) < 1.2 and abs(z[1]) < 1.2,
-    )  # fmt: skip
+def _state(z: np.ndarray, n: int, m: int) -> list[float]:
+    return [*map(float, z[:n]), *([0.0] * (2 * n)), *map(float, z[n:]), *([0.0] * m)]
 
 
-def silent_motion(params: Parameters, *, model: CompiledModel | None = None) -> SilentMotion:
-    """Find the silent motion of eq. (46) and check that both pads touch.
+class _System:
+    """``F(z)`` and its Jacobian for ``z = (Q, L)``, scaled (rows and unknowns equilibrated at z = 0)."""
+
+    def __init__(self, cm: Any, p: list[float]) -> None:
+        self.cm, self.p = cm, p
+        n, m = cm.n, cm.m
+        self.n, self.m = n, m
+        self.cols = list(range(n)) + list(range(3 * n, 3 * n + m))
+        J0 = self.jac_raw(np.zeros(n + m))
+        row = np.abs(J0).max(axis=1)
+        row[~(row > 0)] = 1.0
+        Jr = J0 / row[:, None]
+        col = np.abs(Jr).max(axis=0)
+        col[~(col > 0)] = 1.0
+        self.row, self.col = row, col  # z = y / col
+
+    def f_raw(self, z: np.ndarray) -> np.ndarray:
+        return np.asarray(self.cm.residuals(_state(z, self.n, self.m), self.p), dtype=float)
+
+    def jac_raw(self, z: np.ndarray) -> np.ndarray:
+        return self.cm.jacobian_matrix(_state(z, self.n, self.m), self.p)[:, self.cols]
+
+    def z(self, y: np.ndarray) -> np.ndarray:
+        return y / self.col
+
+    def f(self, y: np.ndarray) -> np.ndarray:
+        return self.f_raw(self.z(y)) / self.row
+
+    def jac(self, y: np.ndarray) -> np.ndarray:
+        return self.jac_raw(self.z(y)) / self.row[:, None] / self.col[None, :]
+
+    def admissible(self, y: np.ndarray) -> bool:
+        z = self.z(y)
+        if not np.all(np.isfinite(z)):
+            return False
+        if self.cm.spec.disk.tilting and (abs(z[0]) >= MAX_TILT or abs(z[1]) >= MAX_TILT):
+            return False
+        return True
+
+
+def _newton(sysm: _System, y: np.ndarray, g: np.ndarray, max_iter: int = 30,
+            monotone: bool = False) -> tuple[np.ndarray, int, bool]:
+    """Newton on ``f(y) - g = 0`` (scaled unknowns and rows).
+
+    Converged when every component's step is at rounding level relative to
+    that component (so a tilt of 1e-12 rad next to a deformation of 1e-5 m is
+    still resolved to full relative precision), or when the steps stop
+    shrinking at rounding level.  With ``monotone`` the iteration is abandoned
+    as soon as a step is not at most half the previous one (a converged result
+    is then the root Newton's contraction region around the start leads to).
+    """
+    last = math.inf
+    for it in range(1, max_iter + 1):
+        r = sysm.f(y) - g
+        if not np.all(np.isfinite(r)):
+            return y, it, False
+        try:
+            step = np.linalg.solve(sysm.jac(y), -r)
+        except np.linalg.LinAlgError:
+            return y, it, False
+        if not np.all(np.isfinite(step)):
+            return y, it, False
+        y = y + step
+        size = float(np.max(np.abs(step)))
+        if np.all(np.abs(step) <= 8 * _EPS * np.abs(y)) or size == 0.0:
+            return y, it, True
+        if size > 0.9 * last and size <= 1e-9 * float(np.max(np.abs(y))):
+            return y, it, True  # no longer contracting: at the noise floor of the residual
+        if monotone and it > 1 and size > 0.5 * last:
+            return y, it, False
+        last = size
+    return y, max_iter, bool(last <= 1e-9 * float(np.max(np.abs(y))))
+
+
+def _continuation(sysm: _System, F0s: np.ndarray) -> tuple[np.ndarray, int, str]:
+    """Follow ``f(y) - (1 - s) F0s = 0`` from ``(0, 0)`` to ``s = 1`` by pseudo-arclength continuation.
+
+    Returns ``(y at s = 1, corrector iterations, "")``; raises on a fold or a failure.
+    """
+    N = F0s.size
+    y, s = np.zeros(N), 0.0
+    h, h_min, h_max = 0.25, 1e-9, 1.0
+    total = 0
+
+    def tangent(yv: np.ndarray, prev: np.ndarray | None) -> np.ndarray:
+        A = np.hstack([sysm.jac(yv), F0s[:, None]])  # d/d(y, s) of f(y) - (1 - s) F0s
+        # null vector of the N x (N+1) matrix
+        _, _, vh = np.linalg.svd(A)
+        t = vh[-1]
+        if prev is not None:
+            if t @ prev < 0:
+                t = -t
+        elif t[-1] < 0:
+            t = -t
+        return t
+
+    t = tangent(y, None)
+    steps = 0
+    while True:
+        steps += 1
+        if steps > 2000:
+            raise SolverFailedError("the continuation of the silent motion did not reach the parameters "
+                                    "within 2000 steps")
+        yp, sp = y + h * t[:-1], s + h * t[-1]
+        yc, sc, ok = yp.copy(), sp, False
+        for _ in range(12):
+            total += 1
+            r = np.append(sysm.f(yc) - (1 - sc) * F0s, (yc - y) @ t[:-1] + (sc - s) * t[-1] - h)
+            if not np.all(np.isfinite(r)):
+                break
+            A = np.vstack([np.hstack([sysm.jac(yc), F0s[:, None]]), t])
+            try:
+                d = np.linalg.solve(A, -r)
+            except np.linalg.LinAlgError:
+                break
+            if not np.all(np.isfinite(d)):
+                break
+            yc, sc = yc + d[:-1], sc + d[-1]
+            if np.max(np.abs(d)) <= 1e-10 * max(1.0, float(np.max(np.abs(yc)))):
+                ok = True
+                break
+        if ok and not sysm.admissible(yc):
+            if h <= 2 * h_min or s > 0.0:
+                raise NoSilentMotionError(
+                    f"the silent motion connected to the trivial one leaves the range of the kinematics "
+                    f"(|q1|, |q2| < {MAX_TILT} rad) at {100 * max(s, 0.0):.3g} % of the asymmetry: "
+                    "no silent motion with these parameters")
+            ok = False
+        if not ok:
+            h /= 2
+            if h < h_min:
+                raise SolverFailedError(f"the continuation of the silent motion stalled at {100 * s:.4g} % of "
+                                        "the asymmetry (step size underflow)")
+            continue
+        t_new = tangent(yc, t)
+        if t_new[-1] < 0 and sc < 1.0:
+            raise NoSilentMotionError(
+                f"the silent motion connected to the trivial one turns back at {100 * sc:.4g} % of the "
+                "asymmetry (a fold): no silent motion exists with these parameters")
+        if sc >= 1.0:
+            # land exactly on s = 1 from the bracketing points; if Newton fails there, approach in smaller steps
+            frac = (1.0 - s) / (sc - s) if sc > s else 1.0
+            yg = y + frac * (yc - y)
+            yf, it, conv = _newton(sysm, yg, np.zeros(N))
+            total += it
+            if conv and sysm.admissible(yf):
+                return yf, total, ""
+            h /= 2
+            if h < h_min:
+                raise SolverFailedError("Newton's method failed at the end of the silent-motion continuation")
+            continue
+        y, s, t = yc, sc, t_new
+        h = min(h_max, h * 1.6)
+
+
+def silent_motion(params: Any, *, model: Any = None, use_cache: bool = True) -> SilentMotion:
+    """Find the silent motion of eq. (46) and check that every pad touches and slides.
 
     Parameters
     ----------
     params : Parameters
-        Model parameters.
+        The model and its parameter values.
     model : CompiledModel, optional
-        Compiled model (default: :func:`~brakesqueal.numeric.compiled_model`).
+        The compiled model (default: :func:`~brakesqueal.codegen.compile_model`
+        of ``params.model``).
+    use_cache : bool, optional
+        Use the on-disk code cache when compiling (default ``True``).
 
     Returns
     -------
@@ -102,43 +291,52 @@ def silent_motion(params: Parameters, *, model: CompiledModel | None = None) -> 
 
     Raises
     ------
-    SilentMotionError
-        If no silent motion is found, or a pad's normal force is not positive
-        there (contact loss), with a message naming the parameters involved.
+    NoSilentMotionError
+        No silent motion exists on the branch connected to the trivial one
+        (the continuation folds back or leaves the valid range).
+    SolverFailedError
+        The solver failed; nothing is established.
+    ContactLossError, NoSlidingError
+        A pad does not touch, or does not slide, at the silent motion.
 
     Notes
     -----
-    Assumes, as the paper does, that both pads slide (``|v_r| > 0``) and stay
-    in contact (``F_n > 0``); both are checked.
+    Assumes, as the paper does, that every pad slides in the direction of the
+    disk's spin (``Omega > 0``) and stays in contact; both are checked.
     """
-    model = model or compiled_model()
-    p = parameter_vector(params)
-    trivial = params.trivial_silent_motion()
-    d = params.as_dict()
-    moment = d["N0"] * (d["mu1"] * d["h10"] - d["mu2"] * d["h20"])
-    if trivial:
-        z, its = np.zeros(4), 0
+    from ..codegen import CompiledModel, compile_model
+
+    params = as_parameters(params)
+    cm = model if isinstance(model, CompiledModel) else compile_model(params.model, use_cache=use_cache)
+    p = list(map(float, params.vector()))
+    n, m = cm.n, cm.m
+    F0 = np.array([float(v) for v in np.broadcast_to(np.asarray(cm.zero_residuals(p), dtype=float), (n + m,))])
+    S0 = np.array([float(v) for v in np.broadcast_to(np.asarray(cm.zero_residual_scale(p), dtype=float), (n + m,))])
+    if bool(is_trivial(F0, S0)):
+        z, its, method, trivial = np.zeros(n + m), 0, "trivial (F(0) = 0 to rounding)", True
     else:
-        try:
-            z, its = _newton(model, p)
-        except SilentMotionError as exc:
-            raise SilentMotionError(
-                f"no silent motion found ({exc}) for mu1={d['mu1']:g}, mu2={d['mu2']:g}, h10={d['h10']:g}, "
-                f"h20={d['h20']:g}, N0={d['N0']:g}, k_t={d['k_t']:g}: the friction moment "
-                f"N0*(mu1*h10 - mu2*h20) = {moment:.6g} N m (eq. 49) is too large for the supports"
-            ) from None
-    c = model.contact(_state(z), p)
-    fn = np.array([c[0], c[3]])
-    speeds = np.array([c[1], c[4]])
-    if not np.all(np.isfinite(fn)) or np.any(fn <= 0.0):
-        bad = 1 if not (fn[0] > 0) else 2
-        raise SilentMotionError(
-            f"pad {bad} loses contact at the silent motion (normal force F_n{bad} = {fn[bad - 1]:.6g} N <= 0) "
-            f"for N0={d['N0']:g}, k{bad}={d[f'k{bad}']:g}, mu1={d['mu1']:g}, mu2={d['mu2']:g}, "
-            f"h10={d['h10']:g}, h20={d['h20']:g}"
-        )
-    if np.any(speeds <= 0.0):
-        raise SilentMotionError(f"a pad does not slide at the silent motion (|v_r| = {speeds.min():g} m/s)")
-    return SilentMotion(
-        q_m0=z[:2].copy(), l0=z[2:].copy(), normal_forces=fn, sliding_speeds=speeds, trivial=trivial, iterations=its
-    )
+        sysm = _System(cm, p)
+        y, its, ok = _newton(sysm, np.zeros(n + m), np.zeros(n + m), max_iter=12, monotone=True)
+        if ok and sysm.admissible(y):
+            method = "Newton's method from the trivial state"
+        else:
+            y, its2, _ = _continuation(sysm, F0 / sysm.row)
+            its += its2
+            method = "pseudo-arclength continuation of the Newton homotopy from the trivial state"
+        z, trivial = sysm.z(y), False
+    x = _state(z, n, m)
+    c = cm.contact_table(x, p)
+    fn, speed = c[:, 0], np.sqrt(c[:, 1] ** 2 + c[:, 2] ** 2 + c[:, 3] ** 2)
+    for pad, f, v in zip(cm.spec.pads, fn, speed):
+        if not (math.isfinite(f) and f > 0.0):
+            raise ContactLossError(f"{pad.label} loses contact at the silent motion (normal force {f:.6g} N <= 0)"
+                                   + _where(params))
+        if not v > 0.0:
+            raise NoSlidingError(f"{pad.label} does not slide at the silent motion (|v_r| = {v:g} m/s)")
+    return SilentMotion(coords=cm.coords, q0=z[:n].copy(), l0=z[n:].copy(), normal_forces=fn.copy(),
+                        sliding_speeds=speed, trivial=trivial, iterations=its, method=method)
+
+
+def _where(params: Any) -> str:
+    names = [k for k in ("mu1", "mu2", "h10", "h20", "N0", "k1", "k2") if k in params]
+    return (" for " + ", ".join(f"{k}={params[k]:g}" for k in names)) if names else ""

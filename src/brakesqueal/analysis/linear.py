@@ -1,10 +1,25 @@
-r"""Linearization about the silent motion (paper eqs. 47-48) and the linear model.
+r"""Linearization about the silent motion (paper eqs. 47-48) for any model.
 
-``Mbar dq_mddot + Dbar dq_mdot + Kbar dq_m = 0`` with the exact Jacobians of
-the compiled residuals evaluated at the (numeric) silent motion and the pads'
-tangential deformations eliminated quasi-statically (see
-:mod:`brakesqueal.symbolic.linearize`).  :func:`pad_rate_eigenvalues` keeps
-``ldot`` instead, as a descriptor system, to quantify that choice.
+The residuals are linearized with their exact compiled Jacobians at the
+silent motion ``x0 = (Q0, 0, 0, L0, 0)``:
+
+.. math::
+    M\,\delta\ddot Q + D\,\delta\dot Q + K\,\delta Q + R_L\,\delta L + R_{\dot L}\,\delta\dot L = 0,\qquad
+    G_Q\,\delta Q + G_{\dot Q}\,\delta\dot Q + G_L\,\delta L + G_{\dot L}\,\delta\dot L = 0 .
+
+**How the pads' tangential rates enter.**  A massless pad with a finite
+tangential stiffness has the deformation ``l`` as an unknown whose rate
+``ldot`` changes the sliding velocity.  Where its rate columns ``R_Ldot``
+and ``G_Ldot`` vanish — constant friction at the *trivial* silent motion,
+proved symbolically (``docs/theory.md``) — ``l`` follows quasi-statically
+and is eliminated exactly: ``delta L = -G_L^{-1}(G_Q delta Q + G_Qdot delta Qdot)``,
+giving the second-order ``M, D, K`` of eq. (47).  Otherwise the pad keeps
+its first-order dynamics and the linear model is the descriptor system
+``E xi' = A xi`` in ``xi = (delta Q, delta Qdot, delta L)`` (e.g. a falling
+friction law gives the pad mode ``lambda = -k_ip/(N0 mu')``; at a tilted
+silent motion the pads' normal dampers couple into the tangential balance).
+``pad_rates="quasi-static"`` sets ``ldot := 0`` everywhere instead (the
+approximation of earlier versions; exact only in the first case).
 """
 
 from __future__ import annotations
@@ -14,13 +29,13 @@ from typing import Any
 
 import numpy as np
 
-from ..numeric.compiled import CompiledModel, compiled_model
-from ..parameters import Parameters
-from .equilibrium import SilentMotion, parameter_vector, silent_motion
+from .equilibrium import SilentMotion, as_parameters, parameter_vector, silent_motion
 
-__all__ = ["ModalMixin", "LinearModel", "linearize", "jacobian_blocks_at", "pad_rate_eigenvalues", "state_matrix"]
+__all__ = ["ModalMixin", "LinearModel", "linearize", "state_matrix", "jacobian_blocks_at", "pad_rate_eigenvalues",
+           "PAD_RATES"]
 
-_COLS = {"q": slice(0, 2), "dq": slice(2, 4), "ddq": slice(4, 6), "l": slice(6, 8), "dl": slice(8, 10)}
+#: Treatments of the pads' tangential rates (see the module docstring).
+PAD_RATES = ("kept", "quasi-static")
 
 
 def state_matrix(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
@@ -33,17 +48,15 @@ def state_matrix(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
     return np.concatenate([top, bottom], axis=0)
 
 
-def jacobian_blocks_at(model: CompiledModel, x: list[float], p: list[float]) -> dict[str, np.ndarray]:
-    """Exact Jacobian blocks ``psi_q, ..., g_dl`` (each 2 × 2) at state ``x``."""
-    jac = np.asarray(model.jacobians(x, p), dtype=float).reshape(2, 2, 10)
-    return {f"{res}_{grp}": jac[i][:, sl] for i, res in enumerate(("psi", "g")) for grp, sl in _COLS.items()}
+def _sort(lam: np.ndarray) -> np.ndarray:
+    return lam[np.lexsort((-lam.imag, -lam.real))]
 
 
 class ModalMixin:
-    """State matrix, sorted eigenvalues and stability margin of ``M qddot + D qdot + K q = 0``.
+    """State matrix, sorted eigenvalues and stability margin of a linear model.
 
-    Mixed into the linear-model dataclasses, which provide ``M``, ``D``, ``K``
-    (``n × n`` arrays) and a private list ``_eig`` used as a cache.
+    Mixed into :class:`LinearModel`, which provides ``M``, ``D``, ``K`` and
+    the optional first-order pad blocks, and a private list ``_eig`` (cache).
     """
 
     M: np.ndarray
@@ -53,15 +66,14 @@ class ModalMixin:
 
     @property
     def A(self) -> np.ndarray:
-        """First-order state matrix (``2n × 2n``) for the state ``(dq, dqdot)``."""
+        """First-order state matrix for the state ``(delta Q, delta Qdot[, delta L])``."""
         return state_matrix(self.M, self.D, self.K)
 
     @property
     def eigenvalues(self) -> np.ndarray:
-        """Eigenvalues of :attr:`A` [1/s], sorted by decreasing real part, then imaginary part."""
+        """Eigenvalues [1/s], sorted by decreasing real part, then imaginary part."""
         if not self._eig:
-            lam = np.linalg.eigvals(self.A)
-            self._eig.append(lam[np.lexsort((-lam.imag, -lam.real))])
+            self._eig.append(_sort(np.linalg.eigvals(self.A)))
         return self._eig[0]
 
     @property
@@ -72,52 +84,178 @@ class ModalMixin:
 
 @dataclass(frozen=True)
 class LinearModel(ModalMixin):
-    """Linear model about a silent motion (eq. 47).
+    """Linear model of a model about its silent motion (eq. 47, generalized).
 
     Attributes
     ----------
     params : Parameters
-        The parameters it was built for.
+        The model and parameter values it was built for.
     silent : SilentMotion
         The operating point.
-    M, D, K : ndarray, shape (2, 2)
-        ``Mbar``, ``Dbar``, ``Kbar`` of eq. (48).
+    M, D, K : ndarray, shape (n, n)
+        Mass, damping and stiffness matrices (eq. 48) with the quasi-static
+        pads eliminated.
+    pad_states : tuple of str
+        Pad deformations kept as first-order states (empty when every pad is
+        quasi-static; see the module docstring).
+    R_L, R_dL : ndarray, shape (n, k)
+        Coupling of the kept pad states into the equations of motion.
+    G_Q, G_dQ, G_ddQ, G_L, G_dL : ndarray, shape (k, n) / (k, k)
+        Linearized tangential balance of the kept pads.
+    pad_rates : str
+        ``"kept"`` or ``"quasi-static"``.
     """
 
-    params: Parameters
+    params: Any
     silent: SilentMotion
     M: np.ndarray
     D: np.ndarray
     K: np.ndarray
+    pad_states: tuple[str, ...] = ()
+    R_L: np.ndarray | None = None
+    R_dL: np.ndarray | None = None
+    G_Q: np.ndarray | None = None
+    G_dQ: np.ndarray | None = None
+    G_ddQ: np.ndarray | None = None
+    G_L: np.ndarray | None = None
+    G_dL: np.ndarray | None = None
+    pad_rates: str = "kept"
     _eig: list[Any] = field(default_factory=list, repr=False, compare=False)
+
+    # ---------------------------------------------------------------- structure
+    @property
+    def model(self) -> Any:
+        """The :class:`~brakesqueal.model.components.ModelSpec`."""
+        return self.params.model
+
+    @property
+    def coords(self) -> tuple[str, ...]:
+        """Names of the coordinates."""
+        return self.silent.coords
+
+    @property
+    def n(self) -> int:
+        """Number of coordinates."""
+        return int(self.M.shape[0])
+
+    @property
+    def q0(self) -> np.ndarray:
+        """Coordinates at the silent motion (tilts [rad], displacements [m])."""
+        return self.silent.q0
 
     @property
     def q_m0(self) -> np.ndarray:
-        """Silent-motion tilt angles [rad]."""
-        return self.silent.q_m0
+        """Deprecated alias of :attr:`q0`, kept for one release."""
+        return self.silent.q0
 
+    @property
+    def descriptor(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(E, A)`` of ``E xi' = A xi`` in ``xi = (delta Q, delta Qdot, delta L_kept)``."""
+        n, k = self.n, len(self.pad_states)
+        I, Z = np.eye(n), np.zeros((n, n))
+        if k == 0:
+            return np.block([[I, Z], [Z, self.M]]), np.block([[Z, I], [-self.K, -self.D]])
+        Znk, Zkn = np.zeros((n, k)), np.zeros((k, n))
+        E = np.block([[I, Z, Znk], [Z, self.M, self.R_dL], [Zkn, self.G_ddQ, self.G_dL]])
+        A = np.block([[Z, I, Znk], [-self.K, -self.D, -self.R_L], [-self.G_Q, -self.G_dQ, -self.G_L]])
+        return E, A
+
+    @property
+    def A(self) -> np.ndarray:
+        """First-order state matrix ``E^-1 A`` (``2n + k`` square)."""
+        if not self.pad_states:
+            return state_matrix(self.M, self.D, self.K)
+        E, A = self.descriptor
+        return np.linalg.solve(E, A)
+
+    @property
+    def eigenvalues(self) -> np.ndarray:
+        """Finite eigenvalues [1/s] of the linear model, sorted by decreasing real part, then imaginary part."""
+        if not self._eig:
+            if not self.pad_states:
+                lam = np.linalg.eigvals(self.A)
+            else:
+                import scipy.linalg
+
+                E, A = self.descriptor
+                lam = scipy.linalg.eigvals(A, E)
+                lam = lam[np.isfinite(lam)]
+            self._eig.append(_sort(lam))
+        return self._eig[0]
+
+    def characteristic_polynomial(self) -> np.ndarray:
+        """Coefficients (highest power first) of ``det(lambda E - A)`` divided by ``det(E)``, from the eigenvalues."""
+        return np.real_if_close(np.poly(self.eigenvalues))
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dictionary (the ``brakesqueal linearize --format json`` schema)."""
+        """JSON-ready dictionary (the ``brakesqueal linearize --format json`` schema).
+
+        Keys: ``model``, ``parameters``, ``coords``, ``q0`` (and its deprecated
+        alias ``q_m0``), ``l0``, ``M``, ``D``, ``K``, ``pad_states``,
+        ``pad_rates``, ``eigenvalues`` (``[re, im]`` pairs).
+        """
+        q0 = [float(v) for v in self.q0]
         return {
+            "model": self.model.name,
             "parameters": self.params.to_json_dict(),
-            "q_m0": [float(v) for v in self.q_m0],
+            "coords": list(self.coords),
+            "q0": q0,
+            "q_m0": q0,
+            "l0": [float(v) for v in self.silent.l0],
             "M": self.M.tolist(),
             "D": self.D.tolist(),
             "K": self.K.tolist(),
+            "pad_states": list(self.pad_states),
+            "pad_rates": self.pad_rates,
             "eigenvalues": [[float(z.real), float(z.imag)] for z in self.eigenvalues],
         }
 
 
-def linearize(params: Parameters, *, model: CompiledModel | None = None) -> LinearModel:
-    """Find the silent motion and linearize about it (eqs. 46-48).
+def _blocks(cm: Any, x: list[float] | None, p: list[float]) -> dict[str, np.ndarray]:
+    """Jacobian blocks at ``x`` (``None``: the zero state, with its structural zeros exact)."""
+    n, m = cm.n, cm.m
+    J = cm.zero_jacobian_matrix(p) if x is None else cm.jacobian_matrix(x, p)
+    cols = {"Q": slice(0, n), "dQ": slice(n, 2 * n), "ddQ": slice(2 * n, 3 * n), "L": slice(3 * n, 3 * n + m),
+            "dL": slice(3 * n + m, 3 * n + 2 * m)}
+    out = {}
+    for res, rows in (("R", slice(0, n)), ("G", slice(n, n + m))):
+        for k, c in cols.items():
+            out[f"{res}_{k}"] = J[rows, c]
+    return out
+
+
+def jacobian_blocks_at(model: Any, x: list[float], p: list[float]) -> dict[str, np.ndarray]:
+    """Exact Jacobian blocks at state ``x``: keys ``R_Q, R_dQ, R_ddQ, R_L, R_dL, G_Q, ..., G_dL``.
+
+    For the paper's model the old keys ``psi_q, psi_dq, psi_ddq, psi_l, psi_dl, g_q, ...`` are
+    also present (``psi`` = ``R``, ``g`` = ``G``).
+    """
+    from ..codegen import CompiledModel, compile_model
+
+    cm = model if isinstance(model, CompiledModel) else compile_model("paper")
+    b = _blocks(cm, x, p)
+    for res, old in (("R", "psi"), ("G", "g")):
+        for k, o in (("Q", "q"), ("dQ", "dq"), ("ddQ", "ddq"), ("L", "l"), ("dL", "dl")):
+            b[f"{old}_{o}"] = b[f"{res}_{k}"]
+    return b
+
+
+def linearize(params: Any, *, model: Any = None, pad_rates: str = "kept", use_cache: bool = True) -> LinearModel:
+    """Find the silent motion and linearize about it (eqs. 46-48), for any model.
 
     Parameters
     ----------
     params : Parameters
-        Model parameters.
+        The model and its parameter values.
     model : CompiledModel, optional
-        Compiled model (default: the cached one).
+        Compiled model (default: :func:`~brakesqueal.codegen.compile_model`).
+    pad_rates : {"kept", "quasi-static"}
+        How the massless pads' tangential rates enter (module docstring).
+        ``"kept"`` (default) is exact for the model; ``"quasi-static"`` sets
+        ``ldot := 0`` (exact only for rate-independent friction at the trivial
+        silent motion).
+    use_cache : bool, optional
+        Use the on-disk code cache (default ``True``).
 
     Returns
     -------
@@ -125,62 +263,63 @@ def linearize(params: Parameters, *, model: CompiledModel | None = None) -> Line
 
     Raises
     ------
+    ParameterError
+        For an unknown ``pad_rates``.
     SilentMotionError
-        If the silent motion does not exist or a pad loses contact.
+        A subclass saying why there is no usable silent motion
+        (:func:`~brakesqueal.analysis.equilibrium.silent_motion`).
 
     Notes
     -----
-    Pads are quasi-static (``ldot = 0``); at the trivial silent motion this is
-    exact to first order.  Assumes sliding contact at both pads.
+    Assumes sliding contact at every pad at the silent motion (checked).
     """
-    model = model or compiled_model()
-    sm = silent_motion(params, model=model)
+    from ..codegen import CompiledModel, compile_model
+    from ..errors import ParameterError
+
+    if pad_rates not in PAD_RATES:
+        raise ParameterError(f"pad_rates must be one of {', '.join(PAD_RATES)}; got {pad_rates!r}")
+    params = as_parameters(params)
+    cm = model if isinstance(model, CompiledModel) else compile_model(params.model, use_cache=use_cache)
+    sm = silent_motion(params, model=cm)
     p = parameter_vector(params)
-    b = jacobian_blocks_at(model, sm.state(), p)
-    P = b["psi_l"] @ np.linalg.inv(b["g_l"])
-    M = b["psi_ddq"].copy()
-    D = b["psi_dq"] - P @ b["g_dq"]
-    K = b["psi_q"] - P @ b["g_q"]
-    return LinearModel(params=params, silent=sm, M=M, D=D, K=K)
+    b = _blocks(cm, None if sm.trivial else sm.state(), p)
+    n, m = cm.n, cm.m
+    M, D, K = b["R_ddQ"].copy(), b["R_dQ"].copy(), b["R_Q"].copy()
+    if m == 0:
+        return LinearModel(params=params, silent=sm, M=M, D=D, K=K, pad_rates=pad_rates)
+    if pad_rates == "quasi-static":
+        dyn = np.zeros(m, dtype=bool)
+    else:
+        dyn = np.any(b["R_dL"] != 0.0, axis=0) | np.any(b["G_dL"] != 0.0, axis=0) | np.any(b["G_dL"] != 0.0, axis=1)
+    qs = ~dyn
+    # eliminate the quasi-static pads: their rows of G and columns of L (their Ldot columns are zero or ignored)
+    G_Q, G_dQ, G_ddQ, G_L, G_dL = (b[k] for k in ("G_Q", "G_dQ", "G_ddQ", "G_L", "G_dL"))
+    R_L, R_dL = b["R_L"], b["R_dL"]
+    if qs.any():
+        P = np.linalg.solve(G_L[np.ix_(qs, qs)].T, R_L[:, qs].T).T  # R_L,s G_L,ss^-1
+        M = M - P @ G_ddQ[qs]
+        D = D - P @ G_dQ[qs]
+        K = K - P @ G_Q[qs]
+        if dyn.any():
+            # the kept pads' balances also see the eliminated ones through G_L[dyn, qs]
+            Pd = np.linalg.solve(G_L[np.ix_(qs, qs)].T, G_L[np.ix_(dyn, qs)].T).T
+            R_L = R_L[:, dyn] - P @ G_L[np.ix_(qs, dyn)]
+            G_Qd = G_Q[dyn] - Pd @ G_Q[qs]
+            G_dQd = G_dQ[dyn] - Pd @ G_dQ[qs]
+            G_ddQd = G_ddQ[dyn] - Pd @ G_ddQ[qs]
+            G_Ld = G_L[np.ix_(dyn, dyn)] - Pd @ G_L[np.ix_(qs, dyn)]
+            return LinearModel(params=params, silent=sm, M=M, D=D, K=K,
+                               pad_states=tuple(np.array(cm.algebraic)[dyn]), R_L=R_L, R_dL=R_dL[:, dyn],
+                               G_Q=G_Qd, G_dQ=G_dQd, G_ddQ=G_ddQd, G_L=G_Ld, G_dL=G_dL[np.ix_(dyn, dyn)],
+                               pad_rates=pad_rates)
+        return LinearModel(params=params, silent=sm, M=M, D=D, K=K, pad_rates=pad_rates)
+    return LinearModel(params=params, silent=sm, M=M, D=D, K=K, pad_states=tuple(cm.algebraic), R_L=R_L,
+                       R_dL=R_dL, G_Q=G_Q, G_dQ=G_dQ, G_ddQ=G_ddQ, G_L=G_L, G_dL=G_dL, pad_rates=pad_rates)
 
 
-def pad_rate_eigenvalues(params: Parameters, *, model: CompiledModel | None = None) -> np.ndarray:
-    """Finite eigenvalues when the pads' tangential rates ``ldot`` are kept.
+def pad_rate_eigenvalues(params: Any, *, model: Any = None) -> np.ndarray:
+    """Finite eigenvalues with the pads' tangential rates kept (the default :func:`linearize`).
 
-    The linearized ``psi`` (eq. 44) and ``g`` (eqs. 33-34) form the descriptor
-    system ``E xdot = A x`` in ``x = (dq_m, dq_mdot, dl)``; ``g_dl`` (zero at the
-    trivial silent motion) turns each pad's ``l`` into a first-order state, the
-    "spurious pad mode".  Comparing with :func:`linearize`, which sets
-    ``ldot = 0`` (quasi-static pads), quantifies that modelling choice.
-
-    Parameters
-    ----------
-    params : Parameters
-        Model parameters.
-    model : CompiledModel, optional
-        Compiled model (default: the cached one of
-        :func:`~brakesqueal.numeric.compiled.compiled_model`).
-
-    Returns
-    -------
-    ndarray of complex, shape (m,)
-        The finite generalized eigenvalues [1/s] of ``(A, E)`` (``m <= 6``;
-        infinite ones, from a singular ``E``, are dropped), sorted by
-        decreasing real part, then decreasing imaginary part.
-
-    Raises
-    ------
-    SilentMotionError
-        If the silent motion does not exist or a pad loses contact.
+    Kept for compatibility: equals ``linearize(params).eigenvalues``.
     """
-    import scipy.linalg
-
-    model = model or compiled_model()
-    sm = silent_motion(params, model=model)
-    b = jacobian_blocks_at(model, sm.state(), parameter_vector(params))
-    Z, I2 = np.zeros((2, 2)), np.eye(2)
-    E = np.block([[I2, Z, Z], [Z, b["psi_ddq"], b["psi_dl"]], [Z, Z, b["g_dl"]]])
-    A = np.block([[Z, I2, Z], [-b["psi_q"], -b["psi_dq"], -b["psi_l"]], [-b["g_q"], -b["g_dq"], -b["g_l"]]])
-    lam = scipy.linalg.eigvals(A, E)
-    lam = lam[np.isfinite(lam)]
-    return lam[np.lexsort((-lam.imag, -lam.real))]
+    return linearize(params, model=model, pad_rates="kept").eigenvalues

@@ -1,64 +1,44 @@
-r"""Frictional point contacts of massless pads with the disk (paper eqs. 12-34).
+r"""Frictional point contact of one pad with the disk (paper eqs. 12-34, generalized).
 
-A :class:`PadSymbols` bundles the symbols of one pad; :func:`pad_contact`
-builds every contact quantity of that pad from the disk kinematics.  The
-paper's two pads are ``side=+1`` (upper face, at ``z = -h10``) and ``side=-1``
-(lower face, at ``z = +h20``); both lie on the line ``y0 = -r``.
+This is the one implementation of pad contact used for every model.  A pad
+sits at angle ``a`` on the line ``Rz(a) (0, -r, 0) + l Rz(a) x0`` (the paper's
+pads have ``a = 0``, eqs. 14-15) and touches the face ``z0 = -s h0`` of the
+disk (``s = +1`` upper face, ``s = -1`` lower face, eqs. 17-18).
 
-Notes
------
-* The contact point height ``h_i`` is the third row of eq. (16) solved by
-  Cramer's rule: the pad line ``p_li + h z0`` meets the disk face plane
-  ``z3 · p = z_K`` (``z_K = -h10`` or ``+h20``, the body-frame offset of the
-  face, eqs. 17-18), hence ``h = (z_K - z3·p_l) / (z3·z0)``.
-* The relative velocity ``v_r = A d/dt(A^T p) = pdot - omega × p`` (eqs. 21-24)
-  is the velocity of the pad's contact point relative to the disk material
-  point under it.  ``pdot`` contains the pad's tangential rate ``ldot``.
-* The tangential equilibrium of the massless pad (eqs. 33-34) is stored as the
-  residual ``g = l + c_ip (x0 · f_p + mu N0)`` with the compliance
-  ``c_ip = 1/k_ip``: ``c_ip = 0`` is a rigid tangential support (``l = 0``).
+* Contact point height: the third row of eq. (16), solved by Cramer's rule:
+  the pad line ``p_l + h z0`` meets the disk face ``z3 . p = -s h0``, hence
+  ``h = (-s h0 - z3 . p_l) / (z3 . z0)``; the contact point is ``p = p_l + h z0``
+  (eqs. 12-13).
+* Relative sliding velocity ``v_r = pdot - omega x p`` (eqs. 21-24): the
+  velocity of the pad's contact point relative to the disk material point
+  under it.  ``pdot`` contains the pad's tangential rate ``ldot`` (no
+  quasi-static assumption here; see :mod:`brakesqueal.analysis.linear` for
+  how the rates enter the linearization).
+* Friction direction ``t_p = v_r / |v_r|`` (eqs. 25-26) and coefficient
+  ``mu(|v_r|)`` of the pad's friction law.
+* Normal force: a massless normal direction gives eqs. (29)-(30),
+  ``F_n = F_s / (s z3_z + mu t_pz)`` with the support force
+  ``F_s = s N0 - k (h - w_m) - d (hdot - w_mdot)``; a pad with a normal DOF
+  ``w`` has the contact law ``F_n = N0 + k_c delta + d_c deltadot``,
+  ``delta = s (w - h)``.
+* Contact force on the disk ``f_p = s F_n z3 + mu F_n t_p`` (eqs. 27-28, 31-32).
+* Tangential balance of a massless pad (eqs. 33-34) as the residual
+  ``g = (l - u_m) + c_ip (e_t . f_p + mu* N0)`` with the compliance
+  ``c_ip = 1/k_ip`` (0 = rigid) and the preload friction ``mu* = mu(Omega r)``
+  at the nominal sliding speed, so that ``l`` is measured from the silent motion.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from fractions import Fraction
 from types import ModuleType
-from typing import Any, Sequence
+from typing import Any, Callable
 
 from .kinematics import tilde
 
-__all__ = ["PadSymbols", "PadContact", "pad_contact"]
-
-
-@dataclass(frozen=True)
-class PadSymbols:
-    """Symbols of one massless pad.
-
-    Attributes
-    ----------
-    side : int
-        ``+1`` for the upper pad (face at ``z0 = -h0``), ``-1`` for the lower
-        pad (face at ``z0 = +h0``).
-    k, d : expression
-        Normal support stiffness and damping (``k1``/``d1`` or ``k2``/``d2``).
-    c_ip : expression
-        Tangential compliance ``1/k_ip``.
-    mu : expression
-        Coefficient of kinetic friction.
-    h0 : expression
-        Distance from O to the pad's disk face (``h10`` or ``h20``).
-    l, dl : expression
-        Tangential spring deformation and its rate.
-    """
-
-    side: int
-    k: Any
-    d: Any
-    c_ip: Any
-    mu: Any
-    h0: Any
-    l: Any
-    dl: Any
+__all__ = ["PadContact", "pad_contact", "friction_coefficient", "angle_cos_sin"]
 
 
 @dataclass(frozen=True)
@@ -67,48 +47,91 @@ class PadContact:
 
     Attributes
     ----------
-    h : expression
-        Normal displacement of the pad (eqs. 12-16).
-    hdot : expression
-        Its time derivative.
     p : Matrix
-        Contact point position (eqs. 12-13).
+        Contact point (eqs. 12-13).
+    h, hdot : expression
+        Height of the contact point along ``z0`` (eq. 16) and its rate.
     v_r : Matrix
-        Relative sliding velocity (eqs. 23-24).
+        Relative sliding velocity (eqs. 21-24).
+    speed : expression
+        ``|v_r|``.
     t_p : Matrix
         Friction direction on the disk (eqs. 25-26).
-    F_n, F_t : expression
-        Normal and friction force magnitudes (eqs. 29-32).
+    mu : expression
+        Friction coefficient at the actual sliding speed.
+    F_n : expression
+        Normal force (eqs. 29-30, or the contact law of a pad with a normal DOF).
     f_p : Matrix
         Contact force on the disk (eqs. 27-28).
     moment : Matrix
         Its moment about O, ``tilde(p) f_p`` (a term of eq. 38).
-    g : expression
-        Residual of the pad's tangential equilibrium (eqs. 33-34).
+    f_t : expression
+        Component of ``f_p`` along the pad's tangential direction ``e_t``.
+    support_normal : expression
+        Force of the pad's normal support on the pad (``F_s``; equals the
+        contact force's ``z0`` component for a massless normal direction).
+    g : expression or None
+        Residual of the quasi-static tangential balance (eqs. 33-34), for a
+        massless pad with a finite tangential stiffness.
+    mu_star : expression
+        Friction coefficient at the nominal sliding speed ``Omega r`` (preload).
     """
 
+    p: Any
     h: Any
     hdot: Any
-    p: Any
     v_r: Any
+    speed: Any
     t_p: Any
+    mu: Any
     F_n: Any
-    F_t: Any
     f_p: Any
     moment: Any
+    f_t: Any
+    support_normal: Any
     g: Any
+    mu_star: Any
+
+
+def angle_cos_sin(sm: ModuleType, deg: float) -> tuple[Any, Any]:
+    """Exact ``cos``/``sin`` of an angle in degrees (a rational multiple of pi)."""
+    fr = Fraction(deg).limit_denominator(10**6)
+    a = sm.pi * sm.Integer(fr.numerator) / sm.Integer(fr.denominator * 180)
+    return sm.cos(a), sm.sin(a)
+
+
+def friction_coefficient(sm: ModuleType, law: Any, v: Any, val: Callable[[Any], Any]) -> Any:
+    """``mu(v)`` of a :class:`~brakesqueal.model.components.FrictionLaw` (``val`` maps fields to symbols)."""
+    mu = val(law.mu)
+    if law.law == "coulomb":
+        return mu
+    if law.law == "linear":
+        return mu - val(law.slope) * v
+    return mu + (val(law.mu_s) - mu) * sm.exp(-v / val(law.v_s))
 
 
 def pad_contact(
     sm: ModuleType,
-    pad: PadSymbols,
     *,
-    r: Any,
-    N0: Any,
+    side: int,
+    h0: Any,
+    base: Any,
+    e_t: Any,
+    l: Any,
     z3: Any,
     omega0: Any,
-    q: Sequence[Any],
-    dq: Sequence[Any],
+    rate: Callable[[Any], Any],
+    friction: Callable[[Any], Any],
+    N0: Any,
+    nominal_speed: Any,
+    k: Any,
+    d: Any,
+    w_m: Any,
+    normal_dof: Any = None,
+    k_c: Any = None,
+    d_c: Any = None,
+    u_m: Any = None,
+    compliance: Any = None,
 ) -> PadContact:
     """Build the contact quantities of one pad.
 
@@ -116,39 +139,72 @@ def pad_contact(
     ----------
     sm : module
         Symbolic backend.
-    pad : PadSymbols
-        The pad.
-    r, N0 : expression
-        Effective braking radius and normal preload.
+    side : {+1, -1}
+        Upper (``+1``, face ``z0 = -h0``) or lower (``-1``, face ``z0 = +h0``) face.
+    h0 : expression
+        Distance from O to the pad's face.
+    base, e_t : Matrix
+        Point of the pad line at ``l = 0`` and its tangential direction.
+    l : expression
+        Tangential position of the pad on its line.
     z3 : Matrix
-        Disk axis in the fixed frame (third column of ``A``).
+        Disk axis in the fixed frame.
     omega0 : Matrix
-        Disk angular velocity in the fixed frame, ``J_R0 qdot`` (eq. 6).
-    q, dq : sequence
-        Generalized coordinates the geometry depends on and their rates.
+        Disk angular velocity in the fixed frame (constraint substituted).
+    rate : callable
+        Time derivative along the motion of an expression of the coordinates.
+    friction : callable
+        ``mu(v)`` of the pad's friction law.
+    N0 : expression
+        Normal preload.
+    nominal_speed : expression
+        ``Omega r``: the sliding speed of the silent motion (preload friction).
+    k, d : expression
+        Normal support stiffness and damping.
+    w_m : expression
+        Normal displacement of the support's mount (a caliper; 0 for ground).
+    normal_dof, k_c, d_c : expression, optional
+        The pad's normal coordinate ``w`` (a pad with mass moving normally)
+        and its contact stiffness and damping.
+    u_m : expression, optional
+        Tangential displacement of the mount along ``e_t`` (for ``g``).
+    compliance : expression, optional
+        ``1/k_ip`` of a massless pad with a finite tangential stiffness (``g`` is built).
 
     Returns
     -------
     PadContact
     """
-    s = pad.side
+    s = side
     z0 = sm.Matrix([0, 0, 1])
-    p_l = sm.Matrix([pad.l, -r, -s * pad.h0])  # eqs. (14)-(15)
-    z_K = -s * pad.h0  # face offset in the body frame, eqs. (17)-(18)
-    z3_dot_pl = z3[0] * p_l[0] + z3[1] * p_l[1] + z3[2] * p_l[2]
-    h = (z_K - z3_dot_pl) / z3[2]  # eq. (16), third row (Cramer)
+    p_l = base + e_t * l + z0 * (-s * h0)  # eqs. (14)-(15), generalized
+    z3_pl = z3[0] * p_l[0] + z3[1] * p_l[1] + z3[2] * p_l[2]
+    h = (-s * h0 - z3_pl) / z3[2]  # eq. (16), third row (Cramer)
     p = p_l + z0 * h  # eqs. (12)-(13)
-    coords = list(q) + [pad.l]
-    rates = list(dq) + [pad.dl]
-    hdot = sum((h.diff(c) * v for c, v in zip(coords, rates)), sm.Integer(0))
-    pdot = sm.Matrix([pad.dl, 0, hdot])
+    pdot = sm.Matrix([rate(p[i]) for i in range(3)])
     v_r = pdot - tilde(sm, omega0) * p  # eqs. (21)-(24)
     speed = sm.sqrt(v_r[0] ** 2 + v_r[1] ** 2 + v_r[2] ** 2)
     t_p = v_r / speed  # eqs. (25)-(26)
-    # eqs. (29)-(30): z0-equilibrium of the massless pad
-    F_n = (s * N0 - pad.k * h - pad.d * hdot) / (s * z3[2] + pad.mu * t_p[2])
-    F_t = pad.mu * F_n  # eqs. (31)-(32)
-    f_p = z3 * (s * F_n) + t_p * F_t  # eqs. (27)-(28)
-    moment = tilde(sm, p) * f_p
-    g = pad.l + pad.c_ip * (f_p[0] + pad.mu * N0)  # eqs. (33)-(34)
-    return PadContact(h=h, hdot=hdot, p=p, v_r=v_r, t_p=t_p, F_n=F_n, F_t=F_t, f_p=f_p, moment=moment, g=g)
+    mu = friction(speed)
+    mu_star = friction(nominal_speed)
+    hdot, wdot_m = rate(h), rate(w_m)
+    if normal_dof is not None:
+        delta = s * (normal_dof - h)
+        F_n = N0 + k_c * delta + d_c * rate(delta)
+        F_s = s * N0 - k * (normal_dof - w_m) - d * (rate(normal_dof) - wdot_m)
+    else:
+        F_s = s * N0 - k * (h - w_m) - d * (hdot - wdot_m)
+        F_n = F_s / (s * z3[2] + mu * t_p[2])  # eqs. (29)-(30)
+    f_p = z3 * (s * F_n) + t_p * (mu * F_n)  # eqs. (27)-(28), (31)-(32)
+    f_t = e_t[0] * f_p[0] + e_t[1] * f_p[1] + e_t[2] * f_p[2]
+    if normal_dof is None:
+        F_s = f_p[2]  # massless: the support carries the contact force
+    g = None
+    if compliance is not None:
+        g = (l - (u_m if u_m is not None else 0)) + compliance * (f_t + mu_star * N0)  # eqs. (33)-(34)
+    return PadContact(p=p, h=h, hdot=hdot, v_r=v_r, speed=speed, t_p=t_p, mu=mu, F_n=F_n, f_p=f_p,
+                      moment=tilde(sm, p) * f_p, f_t=f_t, support_normal=F_s, g=g, mu_star=mu_star)
+
+
+def _isinf(v: Any) -> bool:
+    return not isinstance(v, str) and v is not None and math.isinf(float(v))

@@ -25,7 +25,7 @@ from typing import Any
 
 from .backend import Backend, get_backend
 from .constraint import ReducedEquations, reduce_equations, spin_constraint
-from .contact import PadContact, PadSymbols, pad_contact
+from .contact_legacy import PadContact, PadSymbols, pad_contact
 from .euler import angular_momentum_rate, euler_matrices, support_moment
 from .kinematics import CardanKinematics, cardan_kinematics
 

@@ -1,0 +1,272 @@
+r"""Numeric callables of any model, generated once from its symbolic equations and cached.
+
+:func:`compile_model` assembles the equations of a
+:class:`~brakesqueal.model.components.ModelSpec`
+(:func:`~brakesqueal.symbolic.assemble.build_equations`), differentiates them
+and generates Python source with common subexpressions eliminated
+(:mod:`.printer`).  The source is cached on disk keyed on the model's
+equations (not its default values) and the generator's own source, so a warm
+start imports neither SymPy nor symengine.  The same source is bound to
+``math`` (fast scalar calls) and to ``numpy`` (broadcast over parameter
+arrays, for maps and sweeps).
+
+Argument conventions (every function documents them in its docstring):
+
+* ``x = (Q, Qdot, Qddot, L, Ldot)`` — coordinates, rates, accelerations,
+  pad deformations and their rates (SI units);
+* ``p`` — parameters in the model's canonical order with tangential
+  stiffnesses replaced by compliances (:meth:`Parameters.vector
+  <brakesqueal.model.parameters.Parameters.vector>`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import types
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+__all__ = ["CompiledModel", "compile_model", "model_key", "CONTACT_FIELDS"]
+
+#: Per-pad outputs of ``contact(x, p)``, in this order.
+CONTACT_FIELDS = ("F_n", "v_rx", "v_ry", "v_rz", "h", "hdot", "l")
+
+
+def model_key(spec: Any) -> str:
+    """Cache key of a model's equations: a hash of its components (not defaults, presets or texts)."""
+    from ..model.io import spec_to_dict
+
+    d = spec_to_dict(spec, presets=False)
+    d = {k: v for k, v in d.items() if k in ("disk", "pads", "calipers")}
+    d["parameters"] = list(spec.parameters)  # the packing order, not the values
+    text = json.dumps(d, sort_keys=True)
+    return "model-" + hashlib.sha256(text.encode()).hexdigest()[:20]
+
+
+@dataclass(frozen=True, eq=False)
+class CompiledModel:
+    """Compiled callables of one model.
+
+    Attributes
+    ----------
+    spec : ModelSpec
+        The model.
+    coords : tuple of str
+        Coordinates ``Q``.
+    algebraic : tuple of str
+        Pad deformations ``L``.
+    param_names : tuple of str
+        Names of the entries of ``p`` (compliance names for tangential stiffnesses).
+    residuals : callable
+        ``residuals(x, p) -> (n + m,)``: ``R`` then ``G``.
+    jacobians : callable
+        ``jacobians(x, p) -> ((n + m) * (3n + 2m),)``: ``d(R, G)/dx``, row-major.
+    contact : callable
+        ``contact(x, p)``: per pad the :data:`CONTACT_FIELDS`.
+    zero_residuals, zero_jacobians : callable
+        The same at ``x = 0`` as functions of ``p`` only (NumPy-bound: ``p``
+        may hold broadcastable arrays).
+    zero_residual_scale : callable
+        ``f(p)``: per row of ``(R, G)`` at ``x = 0``, the sum over parameters
+        of ``|p_k dF/dp_k|`` — the magnitude of the terms whose cancellation
+        gives the residual, used to recognise a trivial silent motion to
+        rounding (:func:`brakesqueal.analysis.equilibrium.silent_motion`).
+    vectorized : module
+        Every function bound to NumPy.
+    source : str
+        The generated source.
+    """
+
+    spec: Any
+    coords: tuple[str, ...]
+    algebraic: tuple[str, ...]
+    param_names: tuple[str, ...]
+    residuals: Callable[..., tuple[float, ...]]
+    jacobians: Callable[..., tuple[float, ...]]
+    contact: Callable[..., tuple[float, ...]]
+    vectorized: types.ModuleType
+    source: str = field(repr=False)
+
+    @property
+    def n(self) -> int:
+        """Number of coordinates."""
+        return len(self.coords)
+
+    @property
+    def m(self) -> int:
+        """Number of pad deformations ``L``."""
+        return len(self.algebraic)
+
+    @property
+    def nx(self) -> int:
+        """Length of the state ``x``."""
+        return 3 * self.n + 2 * self.m
+
+    @property
+    def zero_residuals(self) -> Callable[..., tuple[Any, ...]]:
+        """``f(p)``: residuals at ``x = 0`` (NumPy-bound)."""
+        return self.vectorized.zero_residuals
+
+    @property
+    def zero_jacobians(self) -> Callable[..., tuple[Any, ...]]:
+        """``f(p)``: Jacobians at ``x = 0`` (NumPy-bound), row-major like :attr:`jacobians`."""
+        return self.vectorized.zero_jacobians
+
+    @property
+    def zero_residual_scale(self) -> Callable[..., tuple[Any, ...]]:
+        """``f(p)``: term magnitude of every residual row at ``x = 0`` (NumPy-bound)."""
+        return self.vectorized.zero_residual_scale
+
+    def jacobian_matrix(self, x: Any, p: Any) -> np.ndarray:
+        """``d(R, G)/dx`` as an ``(n + m, 3n + 2m)`` array."""
+        return np.asarray(self.jacobians(x, p), dtype=float).reshape(self.n + self.m, self.nx)
+
+    def zero_jacobian_matrix(self, p: Any) -> np.ndarray:
+        """``d(R, G)/dx`` at ``x = 0`` with structural zeros exact, as an ``(n + m, 3n + 2m)`` array."""
+        vals = self.zero_jacobians(list(map(float, p)))
+        return np.array([float(v) for v in vals], dtype=float).reshape(self.n + self.m, self.nx)
+
+    def contact_table(self, x: Any, p: Any) -> np.ndarray:
+        """``contact(x, p)`` as an array ``(n_pads, len(CONTACT_FIELDS))``."""
+        return np.asarray(self.contact(x, p), dtype=float).reshape(len(self.spec.pads), len(CONTACT_FIELDS))
+
+
+def _generate(spec: Any) -> str:
+    import symengine as se
+
+    from ..symbolic.assemble import build_equations
+    from .printer import FunctionSpec, generate_module
+
+    eq = build_equations(spec)
+    res = list(eq.R) + (list(eq.G) if eq.G is not None else [])
+    X = se.Matrix(eq.x)
+    jac: list[Any] = []
+    for e in res:
+        jac.extend(se.Matrix([e]).jacobian(X))
+    zero = {s: 0 for s in eq.x}
+    res0 = [se.sympify(e).subs(zero) for e in res]
+    jac0 = _structural_zeros([se.sympify(e).subs(zero) for e in jac], eq.params)
+    scale0 = []
+    for e in res0:
+        terms = [se.Abs(pk * e.diff(pk)) for pk in eq.params]
+        scale0.append(sum(terms, se.Integer(0)))
+    contact: list[Any] = []
+    for c, l in zip(eq.pads, eq.tangential):
+        contact += [c.F_n, c.v_r[0], c.v_r[1], c.v_r[2], c.h, c.hdot, l]
+    meta = {"coords": list(eq.coords), "algebraic": list(eq.algebraic), "params": list(eq.param_names),
+            "x": [str(s) for s in eq.x]}
+    header = (f"Generated by brakesqueal for the equations of model {spec.name!r}. Do not edit.\n\n"
+              f"x = ({', '.join(meta['x'])})\np = ({', '.join(meta['params'])})")
+    xa, pa = ("x", eq.x), ("p", eq.params)
+    specs = [
+        FunctionSpec("residuals", (xa, pa), res, "(R, G) at the state x: eqs. (44), (33)-(34) generalized."),
+        FunctionSpec("jacobians", (xa, pa), jac, "d(R, G)/dx, row-major (n + m) x (3n + 2m)."),
+        FunctionSpec("contact", (xa, pa), contact,
+                     "Per pad: F_n [N], v_r (3) [m/s], h [m], hdot [m/s], l [m] (eqs. 12-34)."),
+        FunctionSpec("zero_residuals", (pa,), res0, "(R, G) at x = 0."),
+        FunctionSpec("zero_jacobians", (pa,), jac0, "d(R, G)/dx at x = 0, row-major."),
+        FunctionSpec("zero_residual_scale", (pa,), scale0, "Sum_k |p_k d(R, G)/dp_k| at x = 0, per row."),
+    ]
+    return generate_module(specs, header) + f"META = {json.dumps(meta)}\n"
+
+
+def _structural_zeros(exprs: list[Any], params: list[Any], points: int = 3) -> list[Any]:
+    """Replace expressions that vanish identically by the exact 0.
+
+    At ``x = 0`` several Jacobian entries are identically zero but are
+    generated as cancelling terms (e.g. ``N0 mu/|Omega r| - N0 mu r^2 Omega^2/|Omega r|^3``),
+    which floating point turns into rounding noise.  Each entry is evaluated
+    with 60-digit arithmetic (mpmath) at ``points`` random positive parameter
+    points (every parameter's range contains positive values); an entry whose
+    values are zero to 1e-40 relative to its terms at every point is an
+    identity 0 on the domain (a polynomial-identity test).
+    """
+    import mpmath
+    import symengine as se
+    import sympy as sp
+
+    rng = np.random.default_rng(20261123)
+    cand = [i for i, e in enumerate(exprs) if not (e.is_Number and float(e) == 0.0)]
+    if not cand:
+        return exprs
+    syms = [sp.Symbol(str(p)) for p in params]
+    sexprs = [sp.sympify(str(exprs[i])) for i in cand]
+    fns = sp.lambdify(syms, sexprs, modules="mpmath")
+    zero = np.ones(len(cand), dtype=bool)
+    with mpmath.workdps(60):
+        for _ in range(points):
+            vals = [mpmath.mpf(float(v)) for v in rng.uniform(0.5, 2.0, size=len(syms))]
+            try:
+                out = fns(*vals)
+            except (ZeroDivisionError, ValueError, TypeError):
+                return exprs
+            for j, v in enumerate(out):
+                if zero[j] and not (abs(v) <= mpmath.mpf("1e-40")):
+                    zero[j] = False
+    result = list(exprs)
+    for j, i in enumerate(cand):
+        if zero[j]:
+            result[i] = se.Integer(0)
+    return result
+
+
+def _bind(source: str, lib: str) -> types.ModuleType:
+    mod = types.ModuleType(f"brakesqueal_model_{lib}")
+    ns: Any = math if lib == "math" else np
+    mod.__dict__.update(sin=ns.sin, cos=ns.cos, tan=ns.tan, sqrt=ns.sqrt, exp=ns.exp, log=ns.log,
+                        abs=abs if lib == "math" else np.abs, pi=math.pi)
+    exec(compile(source, f"<brakesqueal generated model {lib}>", "exec"), mod.__dict__)
+    return mod
+
+
+_COMPILED: dict[tuple[str, bool], CompiledModel] = {}
+
+
+def _compiled(key: str, spec: Any, use_cache: bool) -> CompiledModel:
+    from . import cache
+
+    if (key, use_cache) in _COMPILED:
+        return _COMPILED[(key, use_cache)]
+    source = cache.read_text(key, "model.py") if use_cache else None
+    if source is None:
+        source = _generate(spec)
+        if use_cache:
+            cache.write_text(key, "model.py", source)
+    scalar, vec = _bind(source, "math"), _bind(source, "numpy")
+    meta = scalar.META
+    cm = CompiledModel(spec=spec, coords=tuple(meta["coords"]), algebraic=tuple(meta["algebraic"]),
+                       param_names=tuple(meta["params"]), residuals=scalar.residuals,
+                       jacobians=scalar.jacobians, contact=scalar.contact, vectorized=vec, source=source)
+    _COMPILED[(key, use_cache)] = cm
+    return cm
+
+
+def compile_model(spec: Any, *, use_cache: bool = True) -> CompiledModel:
+    """Generate (or load from the cache) the numeric code of a model.
+
+    Parameters
+    ----------
+    spec : ModelSpec or str
+        The model, or a built-in model name / model file.
+    use_cache : bool, optional
+        Read and write the on-disk cache (default ``True``); ``False``
+        generates in-process and leaves the cache untouched.
+
+    Returns
+    -------
+    CompiledModel
+        Memoized per process by the model's equations.
+    """
+    from ..model.parameters import _model
+
+    spec = _model(spec)
+    cm = _compiled(model_key(spec), spec, use_cache)
+    if cm.spec is not spec:
+        cm = CompiledModel(spec=spec, coords=cm.coords, algebraic=cm.algebraic, param_names=cm.param_names,
+                           residuals=cm.residuals, jacobians=cm.jacobians, contact=cm.contact,
+                           vectorized=cm.vectorized, source=cm.source)
+    return cm

@@ -1,0 +1,386 @@
+"""Model files and parameter files in TOML (and plain dictionaries).
+
+Model file::
+
+    name = "my-model"
+    description = "..."
+    [parameters]            # default values of every named parameter (canonical order)
+    Theta = 0.16
+    k_ip1 = "inf"           # strings: "inf" or constant expressions like "16*pi"
+    [disk]                  # fields of Disk; numbers or parameter names
+    Theta = "Theta"
+    [[pads]]                # one table per pad (fields of Pad)
+    name = "upper"
+    face = "upper"
+    k_ip = "k_ip1"
+    friction = { law = "coulomb", mu = "mu1" }
+    [[calipers]]            # optional (fields of Caliper)
+    name = "caliper"
+    [presets.symmetric]     # optional presets: free, fixed and tied names
+    description = "..."
+    free = { mu = 0.5 }
+    tied = { mu1 = "mu", mu2 = "mu" }
+
+In component fields a string is a parameter name, except ``"inf"``.
+
+Parameter file::
+
+    model = "paper"          # optional: a built-in model name or a model file
+    preset = "paper-fig3"    # optional: a preset of that model
+    [parameters]             # values overriding the preset (or all parameters)
+    mu1 = 0.7
+
+Files larger than :data:`MAX_FILE_BYTES` are refused before they are read
+whole; every problem is one :class:`~brakesqueal.errors.ParameterError` line
+naming the file and the key.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from typing import Any, Mapping
+
+from ..errors import ParameterError
+from .components import Caliper, Disk, FrictionLaw, ModelSpec, Pad
+from .expressions import evaluate
+from .parameters import Preset, Value
+
+__all__ = ["spec_from_dict", "spec_to_dict", "load_model", "model_to_toml", "read_toml", "load_parameter_file",
+           "parameters_to_toml", "MAX_FILE_BYTES"]
+
+#: Largest model, parameter or study file read.
+MAX_FILE_BYTES = 1 << 20
+
+_TOP = ("name", "description", "reference", "parameters", "disk", "pads", "calipers", "presets")
+_PRESET_KEYS = ("description", "reference", "free", "fixed", "tied", "auxiliary")
+
+
+def read_toml(path: str, what: str) -> dict[str, Any]:
+    """Read a TOML file (at most :data:`MAX_FILE_BYTES`), turning every failure into one ParameterError line.
+
+    Parameters
+    ----------
+    path : str
+        The file.
+    what : str
+        What the file is, for messages (``"model file"``, ``"parameter file"``).
+
+    Returns
+    -------
+    dict
+        The parsed TOML document.
+    """
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise ParameterError(f"cannot read {what} '{path}': {exc.strerror or exc}") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ParameterError(f"{what} '{path}' is larger than {MAX_FILE_BYTES // 1024} KiB; refusing to read it")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"{what} '{path}' is not UTF-8 text (byte {exc.start})") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"{what} '{path}' is not valid TOML: {exc}") from None
+
+
+def _fields(cls: type, data: Mapping[str, Any], where: str) -> dict[str, Any]:
+    from ..suggest import did_you_mean
+
+    names = [f.name for f in dataclasses.fields(cls)]
+    unknown = sorted(set(data) - set(names))
+    if unknown:
+        raise ParameterError(f"{where}: unknown key '{unknown[0]}'{did_you_mean(unknown[0], names)}; valid keys: "
+                             f"{', '.join(names)}")
+    out = {}
+    for k, v in data.items():
+        if v == "inf":
+            v = math.inf
+        if k == "dofs":
+            if not isinstance(v, (list, tuple)):
+                raise ParameterError(f"{where}: 'dofs' must be a list such as [\"normal\", \"tangential\"]; "
+                                     f"got {v!r}")
+            v = tuple(v)
+        out[k] = v
+    return out
+
+
+def _table(data: Mapping[str, Any], key: str, where: str, *, kind: type = dict, what: str = "a table") -> Any:
+    v = data.get(key, kind())
+    if not isinstance(v, kind):
+        raise ParameterError(f"{where}: key '{key}' must be {what}; got {v!r} ({type(v).__name__})")
+    return v
+
+
+def _presets(data: Mapping[str, Any], source: str) -> tuple[Preset, ...]:
+    out = []
+    for name, raw in _table(data, "presets", source).items():
+        where = f"{source}: presets.{name}"
+        if not isinstance(raw, dict):
+            raise ParameterError(f"{where}: must be a table with free/fixed/tied")
+        unknown = sorted(set(raw) - set(_PRESET_KEYS))
+        if unknown:
+            raise ParameterError(f"{where}: unknown key '{unknown[0]}'; valid keys: {', '.join(_PRESET_KEYS)}")
+        kw = {k: _table(raw, k, where) for k in ("free", "fixed", "tied", "auxiliary")}
+        for k in ("description", "reference"):
+            kw[k] = str(raw.get(k, ""))
+        out.append(Preset(name=name, **kw))
+    return tuple(out)
+
+
+def spec_from_dict(data: Mapping[str, Any], *, source: str = "model") -> ModelSpec:
+    """Build a :class:`ModelSpec` from a dictionary (the TOML layout of the module docstring).
+
+    Parameters
+    ----------
+    data : Mapping[str, Any]
+        Keys ``name``, ``description``, ``reference`` (strings),
+        ``parameters`` (name → number or constant expression string such as
+        ``"16*pi"`` or ``"inf"``, SI units), ``disk`` (fields of
+        :class:`Disk`), ``pads`` (required: a list of tables of :class:`Pad`
+        fields, each with ``name``, ``face`` and an optional ``friction``
+        table of :class:`FrictionLaw` fields), ``calipers`` (optional list of
+        tables of :class:`Caliper` fields) and ``presets`` (optional tables).
+    source : str, optional
+        How to name the data in error messages (default ``"model"``).
+
+    Returns
+    -------
+    ModelSpec
+        The validated model.
+
+    Raises
+    ------
+    ParameterError
+        Unknown or missing keys, a value of the wrong type, an expression
+        that cannot be evaluated, or a model that fails validation; the
+        message names ``source`` and the key.
+    """
+    from ..suggest import did_you_mean
+
+    if not isinstance(data, Mapping):
+        raise ParameterError(f"{source}: must be a table")
+    unknown = sorted(set(data) - set(_TOP))
+    if unknown:
+        raise ParameterError(f"{source}: unknown key '{unknown[0]}'{did_you_mean(unknown[0], _TOP)}; valid keys: "
+                             f"{', '.join(_TOP)}")
+    for key in ("name", "description", "reference"):
+        if key in data and not isinstance(data[key], str):
+            raise ParameterError(f"{source}: key '{key}' must be a string; got {data[key]!r}")
+    pads_raw = data.get("pads")
+    if not isinstance(pads_raw, list) or not pads_raw:
+        raise ParameterError(f"{source}: needs a non-empty list of [[pads]] tables")
+    params: dict[str, float] = {}
+    for k, v in _table(data, "parameters", source).items():
+        if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+            raise ParameterError(f"{source}: parameters.{k} must be a number or an expression string; got {v!r}")
+        params[k] = float(v) if not isinstance(v, str) else evaluate(v, {}, what=f"{source}: parameter '{k}'")
+    pads = []
+    try:
+        for i, raw in enumerate(pads_raw):
+            where = f"{source}: pads[{i}]" + (f" ('{raw.get('name')}')" if isinstance(raw, dict) else "")
+            if not isinstance(raw, dict):
+                raise ParameterError(f"{where}: must be a table")
+            raw = dict(raw)
+            fr = raw.pop("friction", {})
+            if not isinstance(fr, dict):
+                raise ParameterError(f"{where}: friction must be a table like {{ law = 'coulomb', mu = 'mu1' }}")
+            if "name" not in raw or "face" not in raw:
+                raise ParameterError(f"{where}: a pad needs 'name' and 'face'")
+            pads.append(Pad(**_fields(Pad, raw, where),
+                            friction=FrictionLaw(**_fields(FrictionLaw, fr, f"{where} friction"))))
+        calipers = []
+        for i, raw in enumerate(_table(data, "calipers", source, kind=list, what="a list of [[calipers]] tables")):
+            where = f"{source}: calipers[{i}]"
+            if not isinstance(raw, dict) or "name" not in raw:
+                raise ParameterError(f"{where}: a caliper needs a 'name'")
+            calipers.append(Caliper(**_fields(Caliper, raw, where)))
+        disk = Disk(**_fields(Disk, _table(data, "disk", source), f"{source}: disk"))
+        return ModelSpec(
+            name=str(data.get("name", "model")), disk=disk, pads=tuple(pads), calipers=tuple(calipers),
+            parameters=params, description=str(data.get("description", "")),
+            reference=str(data.get("reference", "")), presets=_presets(data, source),
+        )  # fmt: skip
+    except ParameterError as exc:
+        msg = str(exc)
+        raise ParameterError(msg if msg.startswith(source) else f"{source}: {msg}") from None
+    except (TypeError, ValueError) as exc:
+        raise ParameterError(f"{source}: {exc}") from None
+
+
+def _plain(v: Any) -> Any:
+    if isinstance(v, float) and math.isinf(v):
+        return "inf"
+    if isinstance(v, tuple):
+        return list(v)
+    return v
+
+
+def spec_to_dict(spec: ModelSpec, *, presets: bool = True) -> dict[str, Any]:
+    """The dictionary (TOML layout) of a spec; :func:`spec_from_dict` reads it back.
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+    presets : bool, optional
+        Include the ``presets`` table (default ``True``).
+
+    Returns
+    -------
+    dict
+        Keys ``name``, ``description``, ``reference``, ``parameters``,
+        ``disk``, ``pads``, ``calipers`` (and ``presets``); every component
+        field that is not ``None`` is present, infinite numbers are written
+        ``"inf"`` and tuples as lists (plain JSON/TOML types).
+    """
+
+    def comp(obj: Any) -> dict[str, Any]:
+        out = {}
+        for f in dataclasses.fields(obj):
+            v = getattr(obj, f.name)
+            if f.name == "friction":
+                out["friction"] = {k: _plain(x) for k, x in comp(v).items()}
+            elif v is not None:
+                out[f.name] = _plain(v)
+        return out
+
+    d: dict[str, Any] = {
+        "name": spec.name, "description": spec.description, "reference": spec.reference,
+        "parameters": {k: _plain(v) for k, v in spec.parameters.items()}, "disk": comp(spec.disk),
+        "pads": [comp(p) for p in spec.pads], "calipers": [comp(c) for c in spec.calipers],
+    }  # fmt: skip
+    if presets and spec.presets:
+        d["presets"] = {p.name: {"description": p.description, "reference": p.reference,
+                                 "free": {k: _plain(v) for k, v in p.free.items()},
+                                 "fixed": {k: _plain(v) for k, v in p.fixed.items()},
+                                 "tied": dict(p.tied), "auxiliary": dict(p.auxiliary)} for p in spec.presets}
+    return d
+
+
+def load_model(path: str) -> ModelSpec:
+    """Read a model TOML file; errors name the file and the key.
+
+    Parameters
+    ----------
+    path : str
+        Path of the TOML file (layout in the module docstring).
+
+    Returns
+    -------
+    ModelSpec
+        The validated model.
+
+    Raises
+    ------
+    ParameterError
+        If the file cannot be read, is too large, not UTF-8, not valid TOML,
+        or describes an invalid model.
+    """
+    return spec_from_dict(read_toml(path, "model file"), source=f"model file '{path}'")
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
+    return repr(float(v)) if isinstance(v, float) else str(v)
+
+
+def model_to_toml(spec: ModelSpec) -> str:
+    """A TOML model file for ``spec`` (round-trips through :func:`load_model`).
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+
+    Returns
+    -------
+    str
+        The TOML text: top-level ``name``, ``description``, ``reference``,
+        then ``[parameters]``, ``[disk]``, one ``[[pads]]`` table per pad
+        (friction as an inline table), one ``[[calipers]]`` table per caliper
+        and one ``[presets.NAME]`` table per preset.  Floats are written with
+        ``repr`` (exact round trip), infinity as ``"inf"``.
+    """
+    d = spec_to_dict(spec)
+    lines = [f"name = {_toml_value(d['name'])}", f"description = {_toml_value(d['description'])}",
+             f"reference = {_toml_value(d['reference'])}", "", "[parameters]"]  # fmt: skip
+    lines += [f"{k} = {_toml_value(v)}" for k, v in d["parameters"].items()]
+    lines += ["", "[disk]"] + [f"{k} = {_toml_value(v)}" for k, v in d["disk"].items()]
+    for p in d["pads"]:
+        lines += ["", "[[pads]]"] + [f"{k} = {_toml_value(v)}" for k, v in p.items()]
+    for c in d["calipers"]:
+        lines += ["", "[[calipers]]"] + [f"{k} = {_toml_value(v)}" for k, v in c.items()]
+    for name, p in d.get("presets", {}).items():
+        lines += ["", f"[presets.{name}]"] + [f"{k} = {_toml_value(v)}" for k, v in p.items()]
+    return "\n".join(lines) + "\n"
+
+
+def load_parameter_file(path: str) -> tuple[str | None, str | None, dict[str, Value]]:
+    """Read a parameter file: optional ``model`` and ``preset`` keys and a ``[parameters]`` table.
+
+    Returns
+    -------
+    model : str or None
+        The ``model`` key (built-in name or model file path, relative paths
+        resolved against the parameter file's directory).
+    preset : str or None
+        The ``preset`` key.
+    entries : dict
+        The ``[parameters]`` table: numbers or expression strings.
+
+    Raises
+    ------
+    ParameterError
+        One line naming the file and the key for an unreadable file, invalid
+        TOML, unknown top-level keys or wrong types.
+    """
+    import os
+
+    from ..suggest import did_you_mean
+
+    data = read_toml(path, "parameter file")
+    where = f"parameter file '{path}'"
+    allowed = ("model", "preset", "parameters")
+    for key in data:
+        if key not in allowed:
+            raise ParameterError(f"{where}: unknown top-level key '{key}'{did_you_mean(key, allowed)}; "
+                                 f"allowed keys: {', '.join(allowed)}")
+    model, preset = data.get("model"), data.get("preset")
+    for key, v in (("model", model), ("preset", preset)):
+        if v is not None and not isinstance(v, str):
+            raise ParameterError(f"{where}: key '{key}' must be a string; got {v!r}")
+    if isinstance(model, str) and (model.endswith(".toml") and not os.path.isabs(model)):
+        model = os.path.join(os.path.dirname(os.path.abspath(path)), model)
+    table = _table(data, "parameters", where, what="a table ([parameters])")
+    for key, value in table.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+            raise ParameterError(f"{where}: key 'parameters.{key}' must be a number or an expression string; "
+                                 f"got {value!r} ({type(value).__name__})")
+    return model, preset, dict(table)
+
+
+def parameters_to_toml(params: Any) -> str:
+    """A complete parameter file for ``params`` (a :class:`~.parameters.Parameters`) that reads back exactly.
+
+    Floats are written with ``repr`` (exact round trip); ``inf`` as ``"inf"``.
+    """
+    spec = params.model
+    lines = ["# brakesqueal parameter set (SI units)", f"model = {_toml_value(spec.name)}", "[parameters]"]
+    for name, value in params.to_json_dict().items():
+        text = '"inf"' if isinstance(value, str) else repr(float(value))
+        unit = spec.unit(name)
+        lines.append(f"{name} = {text}  # {('[' + unit + '] ') if unit else ''}{spec.describe_parameter(name)}")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,99 @@
+"""One resolution of ``--model``, ``--preset``, ``--params`` and ``--set`` for every command and the API."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from ..errors import ParameterError
+from .parameters import ParameterSpace, Parameters, parse_sets
+
+__all__ = ["resolve_space", "resolve_parameters", "DEFAULT_PRESET"]
+
+#: The preset used when neither a model, a preset nor a parameter file is given.
+DEFAULT_PRESET = "paper-fig2"
+
+
+def resolve_space(model: Any = None, preset: str | None = None, params: str | None = None,
+                  sets: Sequence[str] | dict[str, Any] = ()) -> ParameterSpace:
+    """Combine the model, preset, parameter-file and ``--set`` options into one parameter space.
+
+    Parameters
+    ----------
+    model : ModelSpec or str, optional
+        A model, a built-in model name or a model file path (``--model``).
+    preset : str, optional
+        A preset name (``--preset``): a preset of the model, or, without a
+        model, any built-in preset (which names its model).
+    params : str, optional
+        A parameter file (``--params``): optional ``model`` and ``preset``
+        keys and a ``[parameters]`` table of overrides.
+    sets : sequence of str or dict, optional
+        ``NAME=VALUE`` assignments (``--set``) or a ready ``{name: value}``
+        dict; they override the file.  Setting a tied name replaces its tie
+        (see :attr:`ParameterSpace.untied`).
+
+    Returns
+    -------
+    ParameterSpace
+        Validated (its current point resolves).
+
+    Notes
+    -----
+    Without a preset the model's default preset is used (every parameter
+    free at the model's default value); with nothing at all, the preset
+    :data:`DEFAULT_PRESET`.  A parameter file without ``model`` and
+    ``preset`` keys must give every parameter of the paper's model (as in
+    earlier versions).
+
+    Raises
+    ------
+    ParameterError
+        Conflicting model or preset names between the options and the file,
+        unknown names (with a suggestion), invalid values.
+    """
+    from .components import ModelSpec
+    from .library import get_model, get_preset, resolve_model
+
+    overrides = dict(sets) if isinstance(sets, dict) else parse_sets(list(sets))
+    entries: dict[str, Any] = {}
+    f_model = f_preset = None
+    source = None
+    if params is not None:
+        from .io import load_parameter_file
+
+        f_model, f_preset, entries = load_parameter_file(params)
+        source = f"parameter file '{params}'"
+    spec = model if isinstance(model, ModelSpec) else (resolve_model(model) if model is not None else None)
+    if f_model is not None:
+        f_spec = resolve_model(f_model)
+        if spec is not None and spec.name != f_spec.name:
+            raise ParameterError(f"{source}: key 'model' = '{f_spec.name}' conflicts with --model '{spec.name}'")
+        spec = spec or f_spec
+    if preset is not None and f_preset is not None and preset != f_preset:
+        raise ParameterError(f"{source}: key 'preset' = '{f_preset}' conflicts with --preset '{preset}'")
+    name = preset or f_preset
+    try:
+        if name is not None:
+            pr = spec.get_preset(name) if spec is not None else get_preset(name)
+        elif spec is not None:
+            pr = spec.get_preset(None)
+        elif params is not None:
+            # a complete parameter set of the paper's model
+            p = Parameters(get_model("paper"), {**entries, **overrides}, source=source)
+            return ParameterSpace.from_parameters(p)
+        else:
+            pr = get_preset(DEFAULT_PRESET)
+        space = ParameterSpace(pr, {**entries, **overrides})
+        space.resolve({})
+    except ParameterError as exc:
+        if source is None or str(exc).startswith(source):
+            raise
+        raise ParameterError(f"{source}: {exc}") from None
+    return space
+
+
+def resolve_parameters(model: Any = None, preset: str | None = None, params: str | None = None,
+                       sets: Sequence[str] | dict[str, Any] = ()) -> Parameters:
+    """The validated parameter set of :func:`resolve_space` at its current point."""
+    return resolve_space(model, preset, params, sets).resolve({})

@@ -1,0 +1,352 @@
+"""Roles of model parameters: allowed ranges, units and descriptions, for scalars and arrays.
+
+A parameter of a model is a *name* used by one or more component fields
+(:mod:`.components`); the field is its *role*: ``pad.k`` (a normal support
+stiffness), ``disk.Omega`` (the spin rate of eq. 40), ``friction.mu`` ...
+This module holds the one table of roles.  Every input channel (presets,
+parameter files, ``--set``, model files, map and sweep axes, the explorer)
+validates through :func:`problems` (scalars) or :func:`valid_mask` (arrays),
+so a value is accepted or refused the same way everywhere.
+
+Besides each role's interval, two rules hold for every parameter:
+
+* finite values must have a magnitude of at most :data:`MAX_MAGNITUDE`
+  (larger ones overflow in products; write ``inf`` for a rigid support where
+  the role allows it);
+* joint constraints: the disk thickness ``h_upper + h_lower`` is positive
+  (eq. 58), a pad sits on the disk (``radius <= disk radius``), a caliper DOF
+  has a stiffness.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+__all__ = ["Role", "ROLES", "MAX_MAGNITUDE", "ParameterRoles", "parameter_roles", "problems", "valid_mask",
+           "format_interval"]
+
+#: Largest magnitude of a finite parameter value.
+MAX_MAGNITUDE = 1e100
+
+_INF = math.inf
+
+
+@dataclass(frozen=True)
+class Role:
+    """What a component field means and which values it allows.
+
+    Attributes
+    ----------
+    key : str
+        ``"<component>.<field>"``, e.g. ``"pad.k_ip"``.
+    unit : str
+        SI unit (``""``: dimensionless).
+    description : str
+        Template with ``{owner}`` (e.g. ``"pad '1' (upper face)"``).
+    low, high : float
+        Interval bounds.
+    low_open, high_open : bool
+        Whether the bounds are excluded; ``high = inf`` with ``high_open =
+        False`` allows ``+inf`` (rigid tangential supports, unbounded disks).
+    """
+
+    key: str
+    unit: str
+    description: str
+    low: float
+    high: float
+    low_open: bool
+    high_open: bool
+
+    @property
+    def allows_inf(self) -> bool:
+        """Whether ``+inf`` is an allowed value."""
+        return math.isinf(self.high) and not self.high_open
+
+    def interval(self) -> str:
+        """The allowed interval, e.g. ``[0, inf)``."""
+        return format_interval(self.low, self.high, self.low_open, self.high_open)
+
+    def contains(self, v: Any) -> Any:
+        """Element-wise membership (NaN is never a member; magnitude limit applied)."""
+        above = (v > self.low) if self.low_open else (v >= self.low)
+        below = (v < self.high) if self.high_open else (v <= self.high)
+        big = np.abs(v) > MAX_MAGNITUDE
+        if self.allows_inf:
+            big = big & ~(v == _INF)
+        return above & below & ~big
+
+
+def _fmt(value: float) -> str:
+    if math.isfinite(value) and float(value).is_integer() and abs(value) < 1e16:
+        return str(int(value))
+    return repr(float(value))
+
+
+def format_interval(low: float, high: float, low_open: bool, high_open: bool) -> str:
+    """Interval notation such as ``(0, inf]``."""
+    return f"{'(' if low_open else '['}{_fmt(low)}, {_fmt(high)}{')' if high_open else ']'}"
+
+
+def _role(key: str, unit: str, desc: str, low: float, high: float, low_open: bool, high_open: bool) -> Role:
+    return Role(key, unit, desc, low, high, low_open, high_open)
+
+
+_POS = (0.0, _INF, True, True)      # (0, inf)
+_NONNEG = (0.0, _INF, False, True)  # [0, inf)
+_REAL = (-_INF, _INF, True, True)   # (-inf, inf)
+_POS_INF = (0.0, _INF, True, False)  # (0, inf]
+
+#: Every role, keyed ``"<component>.<field>"``.
+ROLES: Mapping[str, Role] = {r.key: r for r in (
+    _role("disk.Theta", "kg m^2", "moment of inertia of the disk about a diameter (eqs. 36-38)", *_POS),
+    _role("disk.Phi", "kg m^2", "moment of inertia of the disk about its axis (eqs. 36-38)", *_POS),
+    _role("disk.k_t", "N m/rad", "stiffness of the disk's rotational supports (eq. 45)", *_NONNEG),
+    _role("disk.d_t", "N m s/rad", "damping of the disk's rotational supports (eq. 45)", *_NONNEG),
+    _role("disk.h_upper", "m", "distance from O to the upper disk surface (eq. 14)", *_REAL),
+    _role("disk.h_lower", "m", "distance from O to the lower disk surface (eq. 15)", *_REAL),
+    _role("disk.Omega", "rad/s", "spin rate of the disk (eq. 40; reverse rotation is not modelled, mirror the "
+          "model instead)", *_POS),
+    _role("disk.radius", "m", "outer radius of the disk (inf: not checked)", *_POS_INF),
+    _role("pad.radius", "m", "effective braking radius of {owner}", *_POS),
+    _role("pad.k", "N/m", "normal support stiffness of {owner}", *_NONNEG),
+    _role("pad.d", "N s/m", "normal support damping of {owner}", *_NONNEG),
+    _role("pad.preload", "N", "normal preload of {owner}", *_POS),
+    _role("pad.k_ip", "N/m", "tangential support stiffness of {owner} (inf = rigid)", *_POS_INF),
+    _role("pad.d_ip", "N s/m", "tangential support damping of {owner}", *_NONNEG),
+    _role("pad.mass", "kg", "mass of {owner}", *_POS),
+    _role("pad.k_c", "N/m", "contact stiffness of {owner}", *_POS),
+    _role("pad.d_c", "N s/m", "contact damping of {owner}", *_NONNEG),
+    _role("friction.mu", "", "kinetic friction coefficient at {owner}", *_NONNEG),
+    _role("friction.slope", "s/m", "friction slope -dmu/dv at {owner}", *_REAL),
+    _role("friction.mu_s", "", "static friction coefficient (Stribeck) at {owner}", *_NONNEG),
+    _role("friction.v_s", "m/s", "Stribeck speed at {owner}", *_POS),
+    _role("caliper.mass", "kg", "mass of {owner}", *_POS),
+    _role("caliper.k_n", "N/m", "normal stiffness of {owner} to ground", *_NONNEG),
+    _role("caliper.d_n", "N s/m", "normal damping of {owner} to ground", *_NONNEG),
+    _role("caliper.k_t", "N/m", "tangential stiffness of {owner} to ground", *_NONNEG),
+    _role("caliper.d_t", "N s/m", "tangential damping of {owner} to ground", *_NONNEG),
+)}
+
+_DISK_FIELDS = ("Theta", "Phi", "k_t", "d_t", "h_upper", "h_lower", "Omega", "radius")
+_PAD_FIELDS = ("radius", "k", "d", "preload", "k_ip", "d_ip", "mass", "k_c", "d_c")
+_FRICTION_FIELDS = ("mu", "slope", "mu_s", "v_s")
+_CALIPER_FIELDS = ("mass", "k_n", "d_n", "k_t", "d_t")
+
+
+@dataclass(frozen=True)
+class ParameterRoles:
+    """The roles of every named parameter of a model and its joint constraints.
+
+    Attributes
+    ----------
+    uses : Mapping[str, tuple of (Role, str)]
+        Parameter name → the roles it plays, each with its owner label.
+    fixed : tuple of (Role, str, float)
+        Numeric (literal) component fields with their role, owner and value.
+    thickness : tuple of (object, object)
+        ``(h_upper, h_lower)`` of the disk: names or numbers.
+    pad_radii : tuple of (str, object)
+        ``(owner, radius)`` of every pad (name or number), checked against the disk radius.
+    disk_radius : object
+        The disk radius: a name or a number.
+    caliper_dofs : tuple of (str, str, object)
+        ``(owner, field, stiffness)`` for every caliper DOF (its stiffness must be positive).
+    """
+
+    uses: Mapping[str, tuple[tuple[Role, str], ...]]
+    fixed: tuple[tuple[Role, str, float], ...]
+    thickness: tuple[Any, Any]
+    pad_radii: tuple[tuple[str, Any], ...]
+    disk_radius: Any
+    caliper_dofs: tuple[tuple[str, str, Any], ...]
+
+    def unit(self, name: str) -> str:
+        """SI unit of a parameter (``""`` if dimensionless or unknown)."""
+        roles = self.uses.get(name, ())
+        return roles[0][0].unit if roles else ""
+
+    def description(self, name: str) -> str:
+        """One-line description built from the parameter's roles."""
+        roles = self.uses.get(name, ())
+        if not roles:
+            return ""
+        texts: list[str] = []
+        for role, owner in roles:
+            t = role.description.format(owner=owner)
+            if t not in texts:
+                texts.append(t)
+        if len(texts) > 3:
+            return f"{texts[0]} (and {len(texts) - 1} more uses)"
+        return "; ".join(texts)
+
+    def interval(self, name: str) -> str:
+        """Allowed interval of a parameter (the intersection over its roles)."""
+        low, high, lo_open, hi_open = self._bounds(name)
+        return format_interval(low, high, lo_open, hi_open)
+
+    def _bounds(self, name: str) -> tuple[float, float, bool, bool]:
+        low, high, lo_open, hi_open = -_INF, _INF, True, False
+        for role, _ in self.uses.get(name, ()):
+            if role.low > low or (role.low == low and role.low_open):
+                low, lo_open = role.low, role.low_open
+            if role.high < high or (role.high == high and role.high_open):
+                high, hi_open = role.high, role.high_open
+        return low, high, lo_open, hi_open
+
+    def allows_inf(self, name: str) -> bool:
+        """Whether ``+inf`` is allowed (every role of the name allows it)."""
+        roles = self.uses.get(name, ())
+        return bool(roles) and all(r.allows_inf for r, _ in roles)
+
+
+def _owner_pad(pad: Any) -> str:
+    return f"pad '{pad.name}' ({pad.face} face)"
+
+
+def parameter_roles(spec: Any) -> ParameterRoles:
+    """Collect the roles of the named parameters of ``spec`` (a :class:`~.components.ModelSpec`)."""
+    uses: dict[str, list[tuple[Role, str]]] = {}
+    fixed: list[tuple[Role, str, float]] = []
+
+    def add(kind: str, field: str, value: Any, owner: str) -> None:
+        if value is None:
+            return
+        role = ROLES[f"{kind}.{field}"]
+        if isinstance(value, str):
+            lst = uses.setdefault(value, [])
+            if (role, owner) not in lst:
+                lst.append((role, owner))
+        elif not isinstance(value, bool):
+            fixed.append((role, owner, float(value)))
+
+    d = spec.disk
+    for f in _DISK_FIELDS:
+        if not d.tilting and f in ("Theta", "Phi", "k_t", "d_t"):
+            continue
+        add("disk", f, getattr(d, f), "the disk")
+    for p in spec.pads:
+        owner = _owner_pad(p)
+        for f in _PAD_FIELDS:
+            add("pad", f, getattr(p, f), owner)
+        for f in _FRICTION_FIELDS:
+            add("friction", f, getattr(p.friction, f), owner)
+    cal_dofs = []
+    for c in spec.calipers:
+        owner = f"caliper '{c.name}'"
+        for f in _CALIPER_FIELDS:
+            add("caliper", f, getattr(c, f), owner)
+        for dof, f in (("normal", "k_n"), ("tangential", "k_t")):
+            if dof in c.dofs:
+                cal_dofs.append((owner, f, getattr(c, f)))
+    # non-tilting disks still name Theta etc.: give them their roles (values are unused but must be valid)
+    if not d.tilting:
+        for f in ("Theta", "Phi", "k_t", "d_t"):
+            add("disk", f, getattr(d, f), "the disk")
+    return ParameterRoles(
+        uses={k: tuple(v) for k, v in uses.items()}, fixed=tuple(fixed), thickness=(d.h_upper, d.h_lower),
+        pad_radii=tuple((_owner_pad(p), p.radius) for p in spec.pads), disk_radius=d.radius,
+        caliper_dofs=tuple(cal_dofs),
+    )
+
+
+def _value_message(name: str, value: Any, roles: ParameterRoles) -> str | None:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        return f"The parameter '{name}' must be a real number; got {value!r} ({type(value).__name__})"
+    v = float(value)
+    if math.isnan(v):
+        return f"The parameter '{name}' must be a number; got nan"
+    for role, owner in roles.uses.get(name, ()):
+        if not bool(role.contains(v)):
+            unit = f" {role.unit}" if role.unit else ""
+            what = role.description.format(owner=owner)
+            if math.isfinite(v) and abs(v) > MAX_MAGNITUDE:
+                return (f"The parameter '{name}' ({what}) must have a magnitude of at most "
+                        f"{MAX_MAGNITUDE:.0e}{' or be inf' if role.allows_inf else ''}; got {v!r}")
+            return f"The parameter '{name}' ({what}) must be in {role.interval()}{unit}; got {v!r}"
+    return None
+
+
+def _lookup(v: Any, values: Mapping[str, Any]) -> Any:
+    return values[v] if isinstance(v, str) else v
+
+
+def problems(roles: ParameterRoles, values: Mapping[str, Any]) -> list[tuple[str, str]]:
+    """Every violated bound or joint constraint, as ``(parameter name, one-line message)``.
+
+    Parameters
+    ----------
+    roles : ParameterRoles
+        From :func:`parameter_roles`.
+    values : Mapping[str, float]
+        A value for every named parameter of the model.
+
+    Returns
+    -------
+    list of (str, str)
+        Empty when the values are valid.
+    """
+    out = [(n, m) for n in roles.uses if (m := _value_message(n, values[n], roles)) is not None]
+    bad = {n for n, _ in out}
+    hu, hl = roles.thickness
+    if not ({hu, hl} & bad):
+        a, b = float(_lookup(hu, values)), float(_lookup(hl, values))
+        if not a + b > 0.0:
+            names = [x for x in (hu, hl) if isinstance(x, str)]
+            out.append((names[0] if names else "h_upper",
+                        f"The parameters '{hu}' and '{hl}' must satisfy {hu} + {hl} > 0 (disk thickness, "
+                        f"eq. 58); got {hu} = {a!r}, {hl} = {b!r}"))
+    R = roles.disk_radius
+    if not (isinstance(R, str) and R in bad):
+        Rv = float(_lookup(R, values))
+        for owner, r in roles.pad_radii:
+            if isinstance(r, str) and r in bad:
+                continue
+            rv = float(_lookup(r, values))
+            if rv > Rv:
+                out.append((r if isinstance(r, str) else str(R),
+                            f"{owner} lies off the disk: radius {rv!r} m > disk radius {Rv!r} m"))
+    for owner, field, k in roles.caliper_dofs:
+        if isinstance(k, str) and k in bad:
+            continue
+        if not float(_lookup(k, values)) > 0:
+            out.append((k if isinstance(k, str) else field,
+                        f"{owner}: a DOF needs a positive stiffness; got {field} = {_lookup(k, values)!r}"))
+    return out
+
+
+def valid_mask(roles: ParameterRoles, arrays: Mapping[str, Any]) -> Any:
+    """Element-wise validity of broadcastable parameter arrays (the array form of :func:`problems`).
+
+    Parameters
+    ----------
+    roles : ParameterRoles
+        From :func:`parameter_roles`.
+    arrays : Mapping[str, array_like]
+        Every named parameter of the model (floats or broadcastable arrays).
+
+    Returns
+    -------
+    ndarray of bool
+        Broadcast shape of the inputs; ``True`` where every bound and joint
+        constraint holds.
+    """
+    with np.errstate(invalid="ignore"):
+        ok: Any = np.True_
+        for name, uses in roles.uses.items():
+            v = np.asarray(arrays[name], dtype=float)
+            for role, _ in uses:
+                ok = ok & role.contains(v)
+        hu, hl = roles.thickness
+        ok = ok & (np.asarray(_lookup(hu, arrays), float) + np.asarray(_lookup(hl, arrays), float) > 0)
+        Rv = np.asarray(_lookup(roles.disk_radius, arrays), float)
+        for _, r in roles.pad_radii:
+            ok = ok & (np.asarray(_lookup(r, arrays), float) <= Rv)
+        for _, _, k in roles.caliper_dofs:
+            ok = ok & (np.asarray(_lookup(k, arrays), float) > 0)
+    return np.asarray(ok)

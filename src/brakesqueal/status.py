@@ -1,0 +1,70 @@
+"""Point and run statuses shared by maps, sweeps, crossings and the simulation.
+
+Codes are small integers stored in files (``int8``); their meanings are the
+``flag_meanings`` attribute of stored arrays.  Decisions are taken on these
+codes, never on message text.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+__all__ = ["PointStatus", "STATUS_MEANINGS", "status_of_error"]
+
+
+class PointStatus(IntEnum):
+    """Status of one parameter point of a map or a sweep.
+
+    ``OK`` and ``OK_NONTRIVIAL`` carry a decided verdict (``stable`` and
+    ``max_real`` agree); every other status is never marked stable.
+    """
+
+    OK = 0                   #: trivial silent motion, verdict decided
+    OK_NONTRIVIAL = 1        #: non-trivial silent motion, verdict decided
+    NO_SILENT_MOTION = 2     #: established: no silent motion on the branch from the trivial one
+    CONTACT_LOSS = 3         #: a pad's normal force is not positive at the silent motion
+    INVALID = 4              #: parameters outside their allowed ranges
+    UNDECIDED = 5            #: |max Re λ| within the error bound of the computation
+    SOLVER_FAILED = 6        #: the silent-motion solver failed (nothing established)
+    NO_SLIDING = 7           #: a pad does not slide at the silent motion
+    NOT_COMPUTED = 8         #: not computed (e.g. a sweep chunk still missing)
+
+    @property
+    def meaning(self) -> str:
+        """Snake-case meaning (``"no_silent_motion"``)."""
+        return _MEANINGS[self]
+
+
+_MEANINGS = {
+    PointStatus.OK: "ok",
+    PointStatus.OK_NONTRIVIAL: "ok_nontrivial_silent_motion",
+    PointStatus.NO_SILENT_MOTION: "no_silent_motion",
+    PointStatus.CONTACT_LOSS: "pad_loses_contact",
+    PointStatus.INVALID: "invalid_parameters",
+    PointStatus.UNDECIDED: "undecided",
+    PointStatus.SOLVER_FAILED: "solver_failed",
+    PointStatus.NO_SLIDING: "pad_does_not_slide",
+    PointStatus.NOT_COMPUTED: "not_computed",
+}
+
+#: ``flag_meanings`` of stored status arrays (space-separated, in code order).
+STATUS_MEANINGS = " ".join(_MEANINGS[s] for s in PointStatus)
+
+
+def status_of_error(exc: BaseException) -> PointStatus:
+    """The status of a point whose silent motion raised ``exc`` (by type, never by message)."""
+    from .errors import (
+        ContactLossError, NoSilentMotionError, NoSlidingError, ParameterError, SolverFailedError,
+    )
+
+    if isinstance(exc, ContactLossError):
+        return PointStatus.CONTACT_LOSS
+    if isinstance(exc, NoSlidingError):
+        return PointStatus.NO_SLIDING
+    if isinstance(exc, NoSilentMotionError):
+        return PointStatus.NO_SILENT_MOTION
+    if isinstance(exc, SolverFailedError):
+        return PointStatus.SOLVER_FAILED
+    if isinstance(exc, ParameterError):
+        return PointStatus.INVALID
+    raise TypeError(f"not a point failure: {exc!r}")
