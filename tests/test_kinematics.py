@@ -117,14 +117,15 @@ def test_contact_height_is_eq16_third_row(rng):
     """h from Cramer's rule equals the third unknown of the full 3x3 system of eq. (16)."""
     import symengine as se
 
-    from brakesqueal.symbolic.contact import PadSymbols, pad_contact
+    from brakesqueal.symbolic.contact import pad_contact
 
     qs = se.symbols("q1 q2 q3")
     kin = cardan_kinematics(se, qs)
     h10, l1, r = se.symbols("h10 l1 r")
-    pad = PadSymbols(side=1, k=1, d=0, c_ip=0, mu=0, h0=h10, l=l1, dl=0)
-    omega0 = se.zeros(3, 1)
-    c = pad_contact(se, pad, r=r, N0=1, z3=kin.A[:, 2], omega0=omega0, q=qs[:2], dq=(0, 0))
+    c = pad_contact(se, side=1, h0=h10, base=se.Matrix([0, -r, 0]), e_t=se.Matrix([1, 0, 0]), l=l1,
+                    z3=kin.A[:, 2], omega0=se.zeros(3, 1), rate=lambda e: se.Integer(0),
+                    friction=lambda v: se.Integer(0), N0=se.Integer(1), nominal_speed=r, k=se.Integer(1),
+                    d=se.Integer(0), w_m=se.Integer(0))
     for _ in range(3):
         qv = rng.uniform(-0.3, 0.3, 2)
         vals = {qs[0]: qv[0], qs[1]: qv[1], qs[2]: 0.4, h10: 0.011, l1: rng.normal(0, 1e-3), r: 0.13}

@@ -49,10 +49,11 @@ class Equations:
         The model.
     coords : tuple of str
         Generalized coordinates ``Q``: ``q1, q2`` (disk tilt), ``w_<pad>``,
-        ``u_<pad>`` (pad DOFs), ``wc_<caliper>``, ``uc_<caliper>``.
+        ``u_<pad>`` (pad DOFs), ``wc_<caliper>``, ``uc_<caliper>`` (without
+        the underscore for components named by digits: ``w1``).
     algebraic : tuple of str
         Tangential deformations ``L`` of the massless pads with a finite
-        tangential stiffness: ``l_<pad>``.
+        tangential stiffness: ``l_<pad>`` (``l1``, ``l2`` for the paper's pads).
     R, G : Matrix
         Residuals (``G`` is ``None`` when ``L`` is empty).
     Q, dQ, ddQ, L, dL : list
@@ -120,6 +121,11 @@ class Equations:
         raise KeyError(name)
 
 
+def _name(prefix: str, component: str) -> str:
+    """State name of a component: ``l1`` for pad ``"1"`` (the paper's names), ``l_upper`` otherwise."""
+    return f"{prefix}{component}" if component.isdigit() else f"{prefix}_{component}"
+
+
 def _rigid(pad: Any) -> bool:
     return not isinstance(pad.k_ip, str) and math.isinf(pad.k_ip)
 
@@ -177,10 +183,10 @@ def build_equations(spec: Any, backend: Backend = "symengine", *, kronecker: boo
     Omega = val(disk.Omega)
     coords: list[str] = ["q1", "q2"] if disk.tilting else []
     for p in spec.pads:
-        coords += [f"{'w' if d == 'normal' else 'u'}_{p.name}" for d in ("normal", "tangential") if d in p.dofs]
+        coords += [_name("w" if d == "normal" else "u", p.name) for d in ("normal", "tangential") if d in p.dofs]
     for c in spec.calipers:
-        coords += [f"{'wc' if d == 'normal' else 'uc'}_{c.name}" for d in ("normal", "tangential") if d in c.dofs]
-    algebraic = [f"l_{p.name}" for p in spec.pads if "tangential" not in p.dofs and not _rigid(p)]
+        coords += [_name("wc" if d == "normal" else "uc", c.name) for d in ("normal", "tangential") if d in c.dofs]
+    algebraic = [_name("l", p.name) for p in spec.pads if "tangential" not in p.dofs and not _rigid(p)]
     Q = {n: sm.Symbol(n) for n in coords}
     dQ = {n: sm.Symbol(f"d{n}") for n in coords}
     ddQ = {n: sm.Symbol(f"dd{n}") for n in coords}
@@ -228,28 +234,28 @@ def build_equations(spec: Any, backend: Backend = "symengine", *, kronecker: boo
         e_t = sm.Matrix([ca, sa, 0])
         base = sm.Matrix([r * sa, -r * ca, 0])
         mount = cal.get(pad.mount) if pad.mount else None
-        w_m = Q[f"wc_{mount.name}"] if mount and "normal" in mount.dofs else sm.Integer(0)
-        u_m = Q[f"uc_{mount.name}"] * ca if mount and "tangential" in mount.dofs else sm.Integer(0)
+        w_m = Q[_name("wc", mount.name)] if mount and "normal" in mount.dofs else sm.Integer(0)
+        u_m = Q[_name("uc", mount.name)] * ca if mount and "tangential" in mount.dofs else sm.Integer(0)
         if "tangential" in pad.dofs:
-            l = Q[f"u_{pad.name}"]
+            l = Q[_name("u", pad.name)]
         elif _rigid(pad):
             l = u_m
         else:
-            l = L[f"l_{pad.name}"]
+            l = L[_name("l", pad.name)]
         normal = "normal" in pad.dofs
         quasi = "tangential" not in pad.dofs and not _rigid(pad)
         c = pad_contact(
             sm, side=s, h0=val(disk.h_upper if s == 1 else disk.h_lower), base=base, e_t=e_t, l=l, z3=z3,
             omega0=omega0, rate=rate, friction=lambda v, law=pad.friction: friction_coefficient(sm, law, v, val),
             N0=N0, nominal_speed=Omega * r, k=val(pad.k), d=val(pad.d), w_m=w_m,
-            normal_dof=Q[f"w_{pad.name}"] if normal else None, k_c=val(pad.k_c) if normal else None,
+            normal_dof=Q[_name("w", pad.name)] if normal else None, k_c=val(pad.k_c) if normal else None,
             d_c=val(pad.d_c) if normal else None, u_m=u_m, compliance=val.compliance(pad.k_ip) if quasi else None,
         )  # fmt: skip
         if normal:
-            n = f"w_{pad.name}"
+            n = _name("w", pad.name)
             rows[n] = val(pad.mass) * ddQ[n] - c.support_normal + c.f_p[2]
         if "tangential" in pad.dofs:
-            n = f"u_{pad.name}"
+            n = _name("u", pad.name)
             F_t = -(val(pad.k_ip) * (l - u_m) + val(pad.d_ip) * (dQ[n] - rate(u_m)) + c.mu_star * N0)
             rows[n] = val(pad.mass) * ddQ[n] - F_t + c.f_t
         else:
@@ -264,10 +270,10 @@ def build_equations(spec: Any, backend: Backend = "symengine", *, kronecker: boo
         tangential.append(l)
     for cp in spec.calipers:
         if "normal" in cp.dofs:
-            n = f"wc_{cp.name}"
+            n = _name("wc", cp.name)
             rows[n] = val(cp.mass) * ddQ[n] + val(cp.k_n) * Q[n] + val(cp.d_n) * dQ[n] + cal_normal[cp.name]
         if "tangential" in cp.dofs:
-            n = f"uc_{cp.name}"
+            n = _name("uc", cp.name)
             rows[n] = val(cp.mass) * ddQ[n] + val(cp.k_t) * Q[n] + val(cp.d_t) * dQ[n] + cal_tang[cp.name]
     red = None
     if disk.tilting:

@@ -1,29 +1,28 @@
-r"""Symbolic linearization about the silent motion (paper eqs. 46-48).
+r"""Symbolic linearization about the trivial silent motion (paper eqs. 46-48), for any model.
 
-The residuals ``psi`` (eq. 44) and ``g`` (eqs. 33-34) depend on
-``x = (q_m, q_mdot, q_mddot, l, ldot)``.  Treatment of the pads' tangential
-rates (documented in ``docs/theory.md``): the massless pads are *quasi-static*,
-``ldot := 0`` in the relative sliding velocities and normal-force rates, and
-``l`` follows ``(q_m, q_mdot)`` through ``g = 0`` (implicit function theorem).
-Linearizing about the silent motion ``(q_m0, l0)`` gives eq. (47) with
+The residuals ``R`` (eq. 44) and ``G`` (eqs. 33-34) depend on
+``x = (Q, Qdot, Qddot, L, Ldot)``.  At the zero state (the trivial silent
+motion, e.g. ``mu1*h10 = mu2*h20`` for the paper's model, eq. 49) the pads'
+rate blocks ``R_Ldot`` and ``G_Ldot`` vanish identically for rate-independent
+friction (verified symbolically here and in the tests), so ``L`` follows
+``(Q, Qdot)`` through ``G = 0`` exactly to first order and eq. (47) holds with
 
-* ``Mbar = psi_ddq``,
-* ``Dbar = psi_dq - psi_l g_l^{-1} g_dq``,
-* ``Kbar = psi_q  - psi_l g_l^{-1} g_q``
+* ``Mbar = R_Qddot``,
+* ``Dbar = R_Qdot - R_L G_L^{-1} G_Qdot``,
+* ``Kbar = R_Q  - R_L G_L^{-1} G_Q``
 
-(eq. 48 with ``l`` eliminated).  At the trivial silent motion
-``psi_dl = g_dl = 0`` exactly, so the treatment of ``ldot`` does not matter to
-first order there; this is verified symbolically in the tests.
+(eq. 48 with ``L`` eliminated).  For a rate-dependent friction law the rate
+blocks do not vanish and :func:`model_closed_form` returns them too (a
+descriptor system; see :mod:`brakesqueal.analysis.linear`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Any, Literal
 
 from .backend import get_backend
-from .model import STATE_SYMBOLS, SymbolicEquations, derive_equations
 
 __all__ = [
     "BLOCKS",
@@ -33,104 +32,99 @@ __all__ = [
     "linear_matrices",
     "ClosedForm",
     "closed_form",
+    "model_closed_form",
 ]
 
 Case = Literal["general", "symmetric", "asymmetric-friction", "minimal"]
 CASES: tuple[str, ...] = ("general", "symmetric", "asymmetric-friction", "minimal")
 
-#: Names of the Jacobian blocks, ``<residual>_<variable group>``.
+#: Names of the Jacobian blocks of the paper's model, ``<residual>_<variable group>``.
 BLOCKS: tuple[str, ...] = ("psi_q", "psi_dq", "psi_ddq", "psi_l", "psi_dl", "g_q", "g_dq", "g_l", "g_dl")
-_GROUPS = {"q": (0, 1), "dq": (2, 3), "ddq": (4, 5), "l": (6, 7), "dl": (8, 9)}
+_GROUPS = ("Q", "dQ", "ddQ", "L", "dL")
+_OLD = {"R": "psi", "G": "g", "Q": "q", "dQ": "dq", "ddQ": "ddq", "L": "l", "dL": "dl"}
 
 
-def jacobian_blocks(eq: SymbolicEquations) -> dict[str, Any]:
-    """Exact symbolic Jacobians of ``psi`` and ``g`` by variable group.
+def _equations(eq: Any) -> Any:
+    """The general :class:`~.assemble.Equations` behind ``eq`` (also accepts the paper view of :mod:`.model`)."""
+    return getattr(eq, "equations", eq)
 
-    The partial derivatives of eq. (48), taken for the full state before any
-    operating point is substituted, plus those with respect to the pads'
-    tangential deformations ``l`` and rates ``ldot``.
+
+def jacobian_blocks(eq: Any) -> dict[str, Any]:
+    """Exact symbolic Jacobians of ``R`` and ``G`` by variable group.
 
     Parameters
     ----------
-    eq : SymbolicEquations
-        The nonlinear equations (:func:`~brakesqueal.symbolic.model.derive_equations`).
+    eq : Equations or SymbolicEquations
+        The nonlinear equations (:func:`~brakesqueal.symbolic.assemble.build_equations`,
+        or the paper view :func:`~brakesqueal.symbolic.model.derive_equations`).
 
     Returns
     -------
     dict
-        The nine blocks of :data:`BLOCKS`, ``{"psi_q": 2×2, "psi_dq": ..., "g_dl": 2×2}``:
-        block ``<r>_<grp>`` is ``d r / d grp`` for the residual ``r`` in
-        ``psi`` (eq. 44), ``g`` (eqs. 33-34) and the group ``grp`` in ``q``
-        ``(q1, q2)``, ``dq``, ``ddq``, ``l`` ``(l1, l2)``, ``dl``; matrices of
-        the backend of ``eq``, functions of the state and parameters.
+        Blocks ``<r>_<grp>`` = ``d r / d grp`` for ``r`` in ``R``, ``G`` and
+        ``grp`` in ``Q, dQ, ddQ, L, dL`` (``G_*`` only when the model has
+        pad deformations ``L``).  For the paper's model the classic keys
+        ``psi_q, ..., g_dl`` of :data:`BLOCKS` are present too.
     """
-    sm = get_backend(eq.backend)  # type: ignore[arg-type]
-    out = {}
-    for res_name, res in (("psi", eq.psi), ("g", eq.g)):
-        for grp, idx in _GROUPS.items():
-            syms = sm.Matrix([eq.state[STATE_SYMBOLS[i]] for i in idx])
-            out[f"{res_name}_{grp}"] = res.jacobian(syms)
+    e = _equations(eq)
+    sm = get_backend(e.backend)  # type: ignore[arg-type]
+    out: dict[str, Any] = {}
+    groups = {"Q": e.Q, "dQ": e.dQ, "ddQ": e.ddQ, "L": e.L, "dL": e.dL}
+    for res_name, res in (("R", e.R), ("G", e.G)):
+        if res is None:
+            continue
+        for grp, syms in groups.items():
+            key = f"{res_name}_{grp}"
+            out[key] = res.jacobian(sm.Matrix(syms)) if syms else sm.zeros(res.rows, 0)
+            if e.spec.name == "paper":
+                out[f"{_OLD[res_name]}_{_OLD[grp]}"] = out[key]
     return out
 
 
-def trivial_blocks(eq: SymbolicEquations) -> dict[str, Any]:
-    """Jacobian blocks evaluated at the trivial silent motion (all states zero).
-
-    The trivial silent motion ``q_m0 = 0``, ``l0 = 0`` exists when
-    ``mu1 h10 = mu2 h20`` (eq. 49); the blocks are then those of eq. (48).
+def trivial_blocks(eq: Any) -> dict[str, Any]:
+    """The blocks of :func:`jacobian_blocks` at the zero state (the trivial silent motion).
 
     Parameters
     ----------
-    eq : SymbolicEquations
+    eq : Equations or SymbolicEquations
         The nonlinear equations.
 
     Returns
     -------
     dict
-        The blocks of :func:`jacobian_blocks` with every state symbol set to
-        0: 2 × 2 matrices of the parameters only.
+        Functions of the parameters only.
     """
-    zero = {s: 0 for s in eq.state_vector}
+    e = _equations(eq)
+    zero = {s: 0 for s in e.x}
     return {k: v.subs(zero) for k, v in jacobian_blocks(eq).items()}
 
 
 def linear_matrices(blocks: dict[str, Any], sm: Any) -> tuple[Any, Any, Any]:
-    """``(Mbar, Dbar, Kbar)`` from Jacobian blocks (quasi-static pads).
+    """``(Mbar, Dbar, Kbar)`` from Jacobian blocks with the pad deformations eliminated through ``G = 0``.
 
-    Works for symbolic blocks (backend ``sm``) evaluated at the silent motion.
-    The pads' deformations ``l`` are eliminated through ``g = 0``:
-    ``Mbar = psi_ddq``, ``Dbar = psi_dq - psi_l g_l^-1 g_dq`` and
-    ``Kbar = psi_q - psi_l g_l^-1 g_q`` (eq. 48 with ``l`` eliminated; the
-    ``dl`` blocks are not used).  ``g_l^-1`` is written out as the adjugate
-    over the determinant (skipped when ``g_l`` is the identity).
+    ``Mbar = R_ddQ``, ``Dbar = R_dQ - R_L G_L^-1 G_dQ``, ``Kbar = R_Q - R_L G_L^-1 G_Q``
+    (eq. 48 with ``L`` eliminated; the ``dL`` blocks are not used, which is
+    exact where they vanish, see the module docstring).
 
     Parameters
     ----------
     blocks : dict
-        Jacobian blocks as returned by :func:`jacobian_blocks` or
-        :func:`trivial_blocks`; needs ``psi_q``, ``psi_dq``, ``psi_ddq``,
-        ``psi_l``, ``g_q``, ``g_dq`` and a 2 × 2 ``g_l``.
+        Blocks as returned by :func:`jacobian_blocks` or :func:`trivial_blocks`.
     sm : module
-        The symbolic backend of the blocks (``symengine`` or ``sympy``), as
-        returned by :func:`~brakesqueal.symbolic.backend.get_backend`.
+        The symbolic backend of the blocks.
 
     Returns
     -------
     Mbar, Dbar, Kbar : Matrix
-        The 2 × 2 matrices of eq. (47), unsimplified.
+        ``n × n``, unsimplified.
     """
-    g_l = blocks["g_l"]
-    if g_l == sm.eye(2):
-        gl_inv = g_l
-    else:
-        a, b, c, d = g_l[0, 0], g_l[0, 1], g_l[1, 0], g_l[1, 1]
-        det = a * d - b * c
-        gl_inv = sm.Matrix([[d, -b], [-c, a]]) / det
-    P = blocks["psi_l"] * gl_inv
-    M = blocks["psi_ddq"]
-    D = blocks["psi_dq"] - P * blocks["g_dq"]
-    K = blocks["psi_q"] - P * blocks["g_q"]
-    return M, D, K
+    M, D, K = blocks["R_ddQ"], blocks["R_dQ"], blocks["R_Q"]
+    if "G_L" not in blocks or blocks["G_L"].rows == 0:
+        return M, D, K
+    G_L = blocks["G_L"]
+    inv = G_L if G_L == sm.eye(G_L.rows) else G_L.inv()
+    P = blocks["R_L"] * inv
+    return M, D - P * blocks["G_dQ"], K - P * blocks["G_Q"]
 
 
 @dataclass(frozen=True)
@@ -140,7 +134,7 @@ class ClosedForm:
     Attributes
     ----------
     case : str
-        One of :data:`CASES`.
+        One of :data:`CASES`, or ``"model:<name>"`` for :func:`model_closed_form`.
     M, D, K : sympy.Matrix
         Simplified matrices of eq. (47), in the paper's parameter names
         (``k_ip1``, ``k_ip2`` rather than compliances; ``h`` and ``mu`` / ``k``
@@ -149,6 +143,12 @@ class ClosedForm:
         The parameter relations of the case, with equation numbers.
     symbols : dict
         The SymPy symbols used, by name (all positive).
+    coords : tuple of str
+        Names of the rows and columns.
+    rate_blocks : dict
+        For rate-dependent friction: the non-vanishing blocks ``R_L``,
+        ``R_dL``, ``G_Q``, ``G_dQ``, ``G_L``, ``G_dL`` of the pads that keep
+        their first-order dynamics (empty otherwise).
     """
 
     case: str
@@ -157,6 +157,8 @@ class ClosedForm:
     K: Any
     assumptions: str
     symbols: dict[str, Any]
+    coords: tuple[str, ...] = ("q1", "q2")
+    rate_blocks: dict[str, Any] = field(default_factory=dict)
 
 
 _ASSUMPTIONS = {
@@ -214,10 +216,13 @@ def closed_form(case: Case = "general") -> ClosedForm:
 
     if case not in CASES:
         raise ValueError(f"case must be one of {', '.join(CASES)}; got {case!r}")
-    eq = derive_equations("symengine")
+    from ..model.library import get_model
+    from .assemble import build_equations
+
+    eq = build_equations(get_model("paper"), "symengine")
     se = get_backend("symengine")
     M, D, K = linear_matrices(trivial_blocks(eq), se)
-    names = [str(s) for s in eq.param_vector] + ["k_ip1", "k_ip2"]
+    names = list(eq.param_names) + ["k_ip1", "k_ip2"]
     S = {n: sp.Symbol(n, positive=True) for n in names}
     S["h10"], S["h20"] = sp.Symbol("h10", real=True), sp.Symbol("h20", real=True)
     subs = case_substitutions(case, S)
@@ -227,3 +232,66 @@ def closed_form(case: Case = "general") -> ClosedForm:
         return out.xreplace(subs).applyfunc(lambda e: sp.factor_terms(sp.cancel(e)))
 
     return ClosedForm(case=case, M=conv(M), D=conv(D), K=conv(K), assumptions=_ASSUMPTIONS[case], symbols=S)
+
+
+def model_closed_form(spec: Any) -> ClosedForm:
+    """Symbolic ``M, D, K`` of any model about the zero state (the silent motion when it is trivial).
+
+    Numeric component fields enter as numbers, named ones as positive SymPy
+    symbols of the same name (``h_upper``/``h_lower`` names as real
+    symbols); tangential compliances are written back as ``1/k_ip``.  Where
+    a pad's rate blocks vanish identically (rate-independent friction) its
+    deformation is eliminated exactly; otherwise the pad keeps its
+    first-order dynamics and its blocks are returned in ``rate_blocks``.
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model (for ``paper`` the result equals ``closed_form("general")``,
+        whose special cases are eqs. (51)-(53) and (59)-(61)).
+
+    Returns
+    -------
+    ClosedForm
+        ``case = "model:<name>"``; entries simplified with ``cancel`` and
+        ``factor_terms``.
+    """
+    import sympy as sp
+
+    from .assemble import build_equations
+
+    eq = build_equations(spec, "symengine")
+    blocks = trivial_blocks(eq)
+    real = {n for n in (spec.disk.h_upper, spec.disk.h_lower) if isinstance(n, str)}
+    S = {n: (sp.Symbol(n, real=True) if n in real else sp.Symbol(n, positive=True)) for n in spec.parameters}
+    back = {}
+    for n, pn in zip(spec.parameters, eq.param_names):
+        back[sp.Symbol(pn)] = 1 / S[n] if pn != n else S[n]
+
+    def conv(m: Any) -> Any:
+        return sp.Matrix(sp.sympify(m)).xreplace(back).applyfunc(lambda e: sp.factor_terms(sp.cancel(e)))
+
+    sb = {k: conv(v) for k, v in blocks.items() if k[0] in "RG" and "_" in k and not k.startswith(("psi", "g_"))}
+    n = len(eq.coords)
+    M, D, K = sb["R_ddQ"], sb["R_dQ"], sb["R_Q"]
+    rate: dict[str, Any] = {}
+    if eq.G is not None:
+        m = len(eq.algebraic)
+        dyn = [j for j in range(m) if any(sp.simplify(e) != 0 for e in list(sb["R_dL"][:, j]) + list(sb["G_dL"][:, j])
+                                            + list(sb["G_dL"][j, :]))]
+        qs = [j for j in range(m) if j not in dyn]
+        if qs:
+            GL = sb["G_L"].extract(qs, qs)
+            P = sb["R_L"].extract(list(range(n)), qs) * GL.inv()
+            simp = lambda e: sp.factor_terms(sp.cancel(e))  # noqa: E731
+            D = (D - P * sb["G_dQ"].extract(qs, list(range(n)))).applyfunc(simp)
+            K = (K - P * sb["G_Q"].extract(qs, list(range(n)))).applyfunc(simp)
+        if dyn:
+            rows, alln = list(range(n)), list(range(n))
+            rate = {"pads": tuple(eq.algebraic[j] for j in dyn),
+                    "R_L": sb["R_L"].extract(rows, dyn), "R_dL": sb["R_dL"].extract(rows, dyn),
+                    "G_Q": sb["G_Q"].extract(dyn, alln), "G_dQ": sb["G_dQ"].extract(dyn, alln),
+                    "G_L": sb["G_L"].extract(dyn, dyn), "G_dL": sb["G_dL"].extract(dyn, dyn)}
+    return ClosedForm(case=f"model:{spec.name}", M=M, D=D, K=K,
+                      assumptions="zero state Q = 0, L = 0 (the silent motion when the residuals vanish there)",
+                      symbols=S, coords=eq.coords, rate_blocks=rate)
