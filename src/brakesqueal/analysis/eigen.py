@@ -22,8 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from ..parameters import PARAMETER_NAMES, Parameters
-from .linear import LinearModel, linearize, state_matrix
+from .linear import LinearModel, linearize
 
 __all__ = ["EigenAnalysis", "eigen_analysis", "Verdict"]
 
@@ -84,6 +83,11 @@ class EigenAnalysis:
     condition: np.ndarray
     _cache: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
+    def __repr__(self) -> str:
+        v = self.verdict()
+        return (f"EigenAnalysis(model={self.model.model.name!r}, n={self.model.n}, "
+                f"eigenvalues={self.eigenvalues.size}, verdict={v.status!r}, max_real={v.max_real:.6g})")
+
     # -------------------------------------------------------------- basic quantities
     @property
     def frequencies(self) -> np.ndarray:
@@ -129,25 +133,29 @@ class EigenAnalysis:
         return self._cache["entry"]
 
     def matrix_derivatives(self, rel_step: float = 1e-6) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
-        """``d(M, D, K)/d ln p`` for every model parameter (central differences of the linearization).
+        """``d(M, D, K)/d ln p`` for every parameter of the model (central differences of the linearization).
 
         Parameters at ``inf`` (rigid pads) and zero-valued ones give zero
-        matrices (a logarithmic derivative does not exist there).
+        matrices (a logarithmic derivative does not exist there), as do
+        parameters whose perturbation leaves the allowed range.
         """
         if "dmat" not in self._cache:
+            from ..errors import BrakesquealError
+
             p0 = self.model.params
+            rates = self.model.pad_rates
             out = {}
-            for name in PARAMETER_NAMES:
-                v = getattr(p0, name)
+            for name in p0.names:
+                v = p0[name]
+                z = np.zeros_like(self.model.M)
                 if not math.isfinite(v) or v == 0.0:
-                    z = np.zeros_like(self.model.M)
                     out[name] = (z, z, z)
                     continue
                 hp, hm = v * math.exp(rel_step), v * math.exp(-rel_step)
                 try:
-                    lp, lm = linearize(p0.replace(**{name: hp})), linearize(p0.replace(**{name: hm}))
-                except Exception:  # noqa: BLE001 - out of bounds / no silent motion: report zeros
-                    z = np.zeros_like(self.model.M)
+                    lp = linearize(p0.replace(**{name: hp}), pad_rates=rates)
+                    lm = linearize(p0.replace(**{name: hm}), pad_rates=rates)
+                except BrakesquealError:
                     out[name] = (z, z, z)
                     continue
                 out[name] = tuple((getattr(lp, k) - getattr(lm, k)) / (2 * rel_step) for k in "MDK")  # type: ignore[assignment]
@@ -155,9 +163,36 @@ class EigenAnalysis:
         return self._cache["dmat"]
 
     def parameter_sensitivities(self) -> dict[str, np.ndarray]:
-        """``{name: dλ_i / d ln p}`` (complex, one entry per eigenvalue) for the 17 model parameters."""
+        """``{name: dλ_i / d ln p}`` (complex, one entry per eigenvalue) for every parameter of the model.
+
+        For a descriptor model (pads with first-order dynamics) the
+        eigenvalues of the perturbed linearizations are differenced directly
+        (each matched to the nearest unperturbed one).
+        """
+        if self.model.pad_states:
+            return self._direct_sensitivities()
         es, dm = self.entry_sensitivities(), self.matrix_derivatives()
-        return {n: sum(np.einsum("ijk,jk->i", es[k], d) for k, d in zip("MDK", dm[n])) for n in PARAMETER_NAMES}
+        return {n: sum(np.einsum("ijk,jk->i", es[k], d) for k, d in zip("MDK", dm[n])) for n in self.model.params.names}
+
+    def _direct_sensitivities(self, rel_step: float = 1e-6) -> dict[str, np.ndarray]:
+        from ..errors import BrakesquealError
+
+        p0, lam0 = self.model.params, self.eigenvalues
+        out = {}
+        for name in p0.names:
+            v = p0[name]
+            if not math.isfinite(v) or v == 0.0:
+                out[name] = np.zeros(lam0.size, dtype=complex)
+                continue
+            try:
+                lp = linearize(p0.replace(**{name: v * math.exp(rel_step)})).eigenvalues
+                lm = linearize(p0.replace(**{name: v * math.exp(-rel_step)})).eigenvalues
+            except BrakesquealError:
+                out[name] = np.zeros(lam0.size, dtype=complex)
+                continue
+            near = lambda lam, z: lam[np.argmin(np.abs(lam - z))]  # noqa: E731
+            out[name] = np.array([(near(lp, z) - near(lm, z)) / (2 * rel_step) for z in lam0])
+        return out
 
     def contributions(self, name: str, mode: int = 0) -> dict[str, float]:
         """Contribution of each matrix entry to ``d Re λ_mode / d ln name`` (keys like ``"D11"``)."""
@@ -182,7 +217,7 @@ class EigenAnalysis:
              "damping_ratio": ("mode", self.damping_ratios),
              "condition": ("mode", self.condition),
              "shape_real": (("dof", "mode"), self.modes.real), "shape_imag": (("dof", "mode"), self.modes.imag)},
-            coords={"mode": np.arange(self.eigenvalues.size), "dof": [f"q{i + 1}" for i in range(n)]},
+            coords={"mode": np.arange(self.eigenvalues.size), "dof": list(self.model.coords)[:n]},
             attrs={"verdict": self.verdict().status})
 
     def plot(self, ax: Any = None) -> Any:
@@ -205,49 +240,54 @@ def _null_vectors(Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return Vh[-1].conj(), U[:, -1]
 
 
-def eigen_analysis(model: LinearModel | Parameters) -> EigenAnalysis:
-    """Eigen-analysis of a linear model (or of ``linearize(params)``).
+def eigen_analysis(model: Any) -> EigenAnalysis:
+    """Eigen-analysis of a linear model (or of ``linearize(params)``), for any model.
 
     The eigenvalues are those of the first-order state matrix of eq. (47)
-    (:func:`~brakesqueal.analysis.linear.state_matrix`), computed with
+    (including the pads kept as first-order states), computed with
     :func:`scipy.linalg.eig` together with left and right eigenvectors.
 
     Parameters
     ----------
     model : LinearModel or Parameters
-        A linear model ``Mbar, Dbar, Kbar`` (eq. 48), or a parameter set that
-        is first linearized about its silent motion with
-        :func:`~brakesqueal.analysis.linear.linearize`.
+        A linear model (eq. 48), or a parameter set that is first linearized
+        about its silent motion with :func:`~brakesqueal.analysis.linear.linearize`.
 
     Returns
     -------
     EigenAnalysis
-        The ``2n`` eigenvalues [1/s] sorted by decreasing real part, then
-        decreasing imaginary part; mode shapes ``(n, 2n)`` (right null vectors
-        of ``λ²M + λD + K``, unit 2-norm, largest entry real positive); left
-        null vectors; and the eigenvalue condition numbers of the state matrix.
+        The eigenvalues [1/s] sorted by decreasing real part, then
+        decreasing imaginary part; mode shapes ``(n, N)`` (the displacement
+        part of the right eigenvectors, unit 2-norm, largest entry real
+        positive); left eigenvectors' displacement parts; and the eigenvalue
+        condition numbers of the state matrix.
 
     Raises
     ------
     SilentMotionError
-        If ``model`` is a parameter set whose silent motion does not exist or
-        where a pad loses contact.
+        If ``model`` is a parameter set without a usable silent motion.
     """
-    lm = model if isinstance(model, LinearModel) else linearize(model)
-    A = state_matrix(lm.M, lm.D, lm.K)
     import scipy.linalg
 
+    lm = model if isinstance(model, LinearModel) else linearize(model)
+    A = lm.A
     w, vl, vr = scipy.linalg.eig(A, left=True, right=True)
     order = np.lexsort((-w.imag, -w.real))
     w, vl, vr = w[order], vl[:, order], vr[:, order]
     cond = np.array([np.linalg.norm(vl[:, i]) * np.linalg.norm(vr[:, i]) / abs(np.vdot(vl[:, i], vr[:, i]))
                      for i in range(w.size)])
-    n = lm.M.shape[0]
+    n = lm.n
     modes = np.zeros((n, w.size), dtype=complex)
     left = np.zeros((n, w.size), dtype=complex)
     for i, lam in enumerate(w):
-        x, y = _null_vectors(lam ** 2 * lm.M + lam * lm.D + lm.K)
+        if not lm.pad_states:
+            x, y = _null_vectors(lam ** 2 * lm.M + lam * lm.D + lm.K)
+        else:
+            x, y = vr[:n, i], vl[n:2 * n, i].conj()
+            if np.linalg.norm(x) == 0:
+                x = vr[:n, i] + 0.0
         k = int(np.argmax(np.abs(x)))
-        x = x * (abs(x[k]) / x[k]) / np.linalg.norm(x)
+        if abs(x[k]) > 0:
+            x = x * (abs(x[k]) / x[k]) / np.linalg.norm(x)
         modes[:, i], left[:, i] = x, y
     return EigenAnalysis(lm, w, modes, left, cond)
