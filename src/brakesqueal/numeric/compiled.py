@@ -73,12 +73,16 @@ def generate_source() -> str:
     return generate_module(_specs(), header)
 
 
-def _load(source: str, namespace: str) -> types.ModuleType:
-    mod = types.ModuleType(f"brakesqueal_generated_{namespace}")
+def _namespace(namespace: str) -> dict[str, Any]:
+    """Globals of generated code: ``sin, cos, tan, sqrt`` from ``math`` or ``numpy``, and ``pi``."""
     lib: Any = math if namespace == "math" else np
-    mod.__dict__.update(sin=lib.sin, cos=lib.cos, tan=lib.tan, sqrt=lib.sqrt, pi=math.pi)
-    exec(compile(source, f"<brakesqueal generated {MODEL_KEY}>", "exec"), mod.__dict__)
-    return mod
+    return dict(sin=lib.sin, cos=lib.cos, tan=lib.tan, sqrt=lib.sqrt, pi=math.pi)
+
+
+def _load(source: str, namespace: str) -> types.ModuleType:
+    """Execute generated source in memory with the ``math`` or ``numpy`` functions bound."""
+    return cache.load_module(MODEL_KEY, "numeric.py", lambda: source, use_cache=False,
+                             namespace=_namespace(namespace), variant=namespace)
 
 
 @dataclass(frozen=True)
@@ -120,13 +124,11 @@ def compiled_model(use_cache: bool = True) -> CompiledModel:
     -------
     CompiledModel
     """
-    source = cache.read_text(MODEL_KEY, "numeric.py") if use_cache else None
-    if source is None:
-        source = generate_source()
-        if use_cache:
-            cache.write_text(MODEL_KEY, "numeric.py", source)
-    scalar = _load(source, "math")
-    vec = _load(source, "numpy")
+    scalar = cache.load_module(MODEL_KEY, "numeric.py", generate_source, use_cache=use_cache,
+                               namespace=_namespace("math"), variant="math")
+    source: str = scalar.__source__
+    vec = cache.load_module(MODEL_KEY, "numeric.py", lambda: source, use_cache=use_cache,
+                            namespace=_namespace("numpy"), variant="numpy")
     return CompiledModel(
         residuals=scalar.residuals,
         jacobians=scalar.jacobians,
