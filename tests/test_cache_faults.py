@@ -254,8 +254,8 @@ def test_read_text_returns_what_was_written_or_nothing(text, data, tmp_path_fact
             bad = raw[:i] + data.draw(st.binary(max_size=40))
         else:  # a header describing other content, or none
             body = raw[raw.index(b"\n") + 1:]
-            bad = data.draw(st.sampled_from([body, b"# brakesqueal-cache sha256=" + b"0" * 64 + b" bytes=%d\n" % len(body)
-                                             + body, raw.replace(b"bytes=", b"bytes=1", 1)]))  # fmt: skip
+            zero = b"# brakesqueal-cache sha256=" + b"0" * 64 + b" bytes=%d\n" % len(body)
+            bad = data.draw(st.sampled_from([body, zero + body, raw.replace(b"bytes=", b"bytes=1", 1)]))
         path.write_bytes(bad)
         got = cache.read_text("k", "f.txt")
         assert got is None if bad != raw else got == text
