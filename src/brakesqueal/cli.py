@@ -77,12 +77,8 @@ def derive(
         sys.stdout.write(render_model_closed_form(resolve_model(model), fmt.value).rstrip("\n") + "\n")
         return
 
-    key, name = "closed-forms", f"{case.value}.{fmt.value}"
-    text = None if no_cache else cache.read_text(key, name)
-    if text is None:
-        text = render_closed_form(case.value, fmt.value)
-        if not no_cache:
-            cache.write_text(key, name, text)
+    text = cache.cached_text("closed-forms", f"{case.value}.{fmt.value}",
+                             lambda: render_closed_form(case.value, fmt.value), use_cache=not no_cache)
     sys.stdout.write(text if text.endswith("\n") else text + "\n")
 
 
@@ -137,7 +133,7 @@ def _register_plugins() -> None:
     """Add the commands that live in their own modules (analysis, simulation)."""
     import importlib
 
-    for name in ("cli_stability", "cli_simulate", "cli_export", "cli_sweep"):
+    for name in ("cli_stability", "cli_simulate", "cli_export", "cli_sweep", "cli_cache"):
         try:
             mod = importlib.import_module(f".{name}", __package__)
         except ModuleNotFoundError as exc:

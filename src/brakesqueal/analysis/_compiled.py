@@ -191,3 +191,12 @@ def critical_batch(E_all, lo, hi, roots_out, dirs_out, counts, start_stable):  #
                 m += 1
                 prev = st
         counts[n] = m
+
+
+def _guard() -> None:
+    from ..numeric.cache import guard_numba_caches
+
+    guard_numba_caches(globals())  # a damaged numba cache file is recompiled, never an error
+
+
+_guard()

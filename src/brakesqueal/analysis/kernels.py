@@ -31,9 +31,7 @@ Three generated / compiled pieces live here:
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import math
-import sys
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any, Callable
@@ -261,29 +259,11 @@ def coefficients(C, t, out):
 
 
 def _load_generated(source: str, tag: str) -> Any:
-    """Import generated kernel source from the on-disk cache (numba caches beside it), or exec it."""
+    """Import generated kernel source from the on-disk cache (numba caches beside it)."""
     from ..numeric import cache
 
     digest = hashlib.sha256(source.encode()).hexdigest()[:16]
-    name = f"brakesqueal_kernel_{tag}_{digest}"
-    if name in sys.modules:
-        return sys.modules[name]
-    path = cache.entry_dir("stability-kernels") / f"{name}.py"
-    if cache.read_text("stability-kernels", f"{name}.py") != source:
-        path = cache.write_text("stability-kernels", f"{name}.py", source)
-    if path is not None and path.exists():
-        spec = importlib.util.spec_from_file_location(name, path)
-        assert spec is not None and spec.loader is not None
-        mod = importlib.util.module_from_spec(spec)
-        sys.modules[name] = mod
-        spec.loader.exec_module(mod)
-        return mod
-    import types
-
-    mod = types.ModuleType(name)
-    exec(compile(source.replace("cache=True", "cache=False"), f"<{name}>", "exec"), mod.__dict__)
-    sys.modules[name] = mod
-    return mod
+    return cache.load_module("stability-kernels", f"brakesqueal_kernel_{tag}_{digest}.py", lambda: source)
 
 
 @lru_cache(maxsize=32)

@@ -67,6 +67,8 @@ def _degree(f: Callable[[np.ndarray], np.ndarray]) -> int | None:
 def _routh_kernel() -> Any:
     import numba
 
+    from ..numeric.cache import guard_numba_caches
+
     @numba.njit(cache=True, fastmath=False)
     def routh(B: np.ndarray, T: np.ndarray, out: np.ndarray) -> None:  # pragma: no cover - compiled
         # B[j, l]: Chebyshev coefficients (in t_x) of coefficient j (highest power first); T[i, l]: T_l(u_i)
@@ -124,6 +126,7 @@ def _routh_kernel() -> Any:
                     break
             out[i] = ok
 
+    guard_numba_caches([routh])  # a damaged numba cache file is recompiled, never an error
     return routh
 
 

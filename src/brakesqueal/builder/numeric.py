@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import ParameterError, SilentMotionError
 from ..expressions import evaluate
 from ..numeric import cache
-from ..numeric.compiled import _load
+from ..numeric.compiled import _namespace
 from ..numeric.newton import damped_newton
 from ..analysis.linear import ModalMixin
 from .components import ModelSpec
@@ -117,13 +117,9 @@ _COMPILED: dict[tuple[str, bool], CompiledBuiltModel] = {}
 def _compile_cached(key: str, spec: ModelSpec, use_cache: bool) -> CompiledBuiltModel:
     if (key, use_cache) in _COMPILED:
         return _COMPILED[(key, use_cache)]
-    source = cache.read_text(key, "numeric.py") if use_cache else None
-    if source is None:
-        source = _generate(spec)
-        if use_cache:
-            cache.write_text(key, "numeric.py", source)
-    mod: types.ModuleType = _load(source, "math")
-    mod.__dict__["exp"] = math.exp
+    mod: types.ModuleType = cache.load_module(key, "numeric.py", lambda: _generate(spec), use_cache=use_cache,
+                                              namespace={**_namespace("math"), "exp": math.exp}, variant="math_exp")
+    source = mod.__source__
     meta = mod.META
     out = CompiledBuiltModel(spec, tuple(meta["coords"]), tuple(meta["algebraic"]), tuple(spec.parameter_names()),
                              mod.residuals, mod.jacobians, mod.contact, source)  # fmt: skip

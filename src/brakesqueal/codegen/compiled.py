@@ -255,13 +255,10 @@ def _structural_zeros(exprs: list[Any], params: list[Any], points: int = 3) -> l
     return result
 
 
-def _bind(source: str, lib: str) -> types.ModuleType:
-    mod = types.ModuleType(f"brakesqueal_model_{lib}")
+def _namespace(lib: str) -> dict[str, Any]:
     ns: Any = math if lib == "math" else np
-    mod.__dict__.update(sin=ns.sin, cos=ns.cos, tan=ns.tan, sqrt=ns.sqrt, exp=ns.exp, log=ns.log,
-                        abs=abs if lib == "math" else np.abs, pi=math.pi)
-    exec(compile(source, f"<brakesqueal generated model {lib}>", "exec"), mod.__dict__)
-    return mod
+    return dict(sin=ns.sin, cos=ns.cos, tan=ns.tan, sqrt=ns.sqrt, exp=ns.exp, log=ns.log,
+                abs=abs if lib == "math" else np.abs, pi=math.pi)
 
 
 _COMPILED: dict[tuple[str, bool], CompiledModel] = {}
@@ -272,12 +269,11 @@ def _compiled(key: str, spec: Any, use_cache: bool) -> CompiledModel:
 
     if (key, use_cache) in _COMPILED:
         return _COMPILED[(key, use_cache)]
-    source = cache.read_text(key, "model.py") if use_cache else None
-    if source is None:
-        source = _generate(spec)
-        if use_cache:
-            cache.write_text(key, "model.py", source)
-    scalar, vec = _bind(source, "math"), _bind(source, "numpy")
+    scalar = cache.load_module(key, "model.py", lambda: _generate(spec), use_cache=use_cache,
+                               namespace=_namespace("math"), variant="math")
+    source: str = scalar.__source__
+    vec = cache.load_module(key, "model.py", lambda: source, use_cache=use_cache, namespace=_namespace("numpy"),
+                            variant="numpy")
     meta = scalar.META
     cm = CompiledModel(spec=spec, coords=tuple(meta["coords"]), algebraic=tuple(meta["algebraic"]),
                        param_names=tuple(meta["params"]), residuals=scalar.residuals,

@@ -86,10 +86,16 @@ def compiled_model(use_cache: bool = True) -> CompiledModel:
                          trivial_matrices=trivial_matrices, vectorized=cm.vectorized, source=cm.source, model=cm)
 
 
-def _load(source: str, namespace: str) -> types.ModuleType:
-    """Execute generated source with ``math`` or ``numpy`` functions bound (transitional, for ``builder``)."""
-    mod = types.ModuleType(f"brakesqueal_generated_{namespace}")
+
+def _namespace(namespace: str) -> dict[str, Any]:
+    """Globals of generated code: ``sin, cos, tan, sqrt`` from ``math`` or ``numpy``, and ``pi``."""
     lib: Any = math if namespace == "math" else np
-    mod.__dict__.update(sin=lib.sin, cos=lib.cos, tan=lib.tan, sqrt=lib.sqrt, pi=math.pi)
-    exec(compile(source, "<brakesqueal generated>", "exec"), mod.__dict__)
-    return mod
+    return dict(sin=lib.sin, cos=lib.cos, tan=lib.tan, sqrt=lib.sqrt, pi=math.pi)
+
+
+def _load(source: str, namespace: str) -> types.ModuleType:
+    """Execute generated source in memory with the ``math`` or ``numpy`` functions bound (transitional)."""
+    from . import cache
+
+    return cache.load_module("transitional", "numeric.py", lambda: source, use_cache=False,
+                             namespace=_namespace(namespace), variant=namespace)

@@ -36,11 +36,14 @@ class SimulationModel:
         (see :mod:`brakesqueal.simulation._kernels`).
     state_names : tuple of str
         ``("q1", "q2", "dq1", "dq2")`` [rad, rad/s].
+    use_cache : bool
+        Whether the silent motion may use the on-disk code cache.
     """
 
     name: str
     kernels: ModuleType
     state_names: tuple[str, ...] = ("q1", "q2", "dq1", "dq2")
+    use_cache: bool = True
 
     def parameter_vector(self, params: Parameters) -> np.ndarray:
         """Parameters in the kernels' order (compliances ``1/k_ip``)."""
@@ -51,8 +54,9 @@ class SimulationModel:
     def silent(self, params: Parameters) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(y_silent, l_silent, v_r_silent (6,))`` of the silent motion (eq. 46)."""
         from ..analysis.equilibrium import silent_motion
+        from ..numeric.compiled import compiled_model
 
-        sm = silent_motion(params)
+        sm = silent_motion(params, model=compiled_model(use_cache=self.use_cache))
         y = np.array([sm.q_m0[0], sm.q_m0[1], 0.0, 0.0])
         l = sm.l0.astype(float).copy()
         c = np.asarray(self.kernels.contact(y, l, self.parameter_vector(params)))
@@ -80,8 +84,8 @@ def default_model(use_cache: bool = True) -> SimulationModel:
     use_cache : bool, optional
         Keep the generated kernel source in the package cache (see
         :mod:`brakesqueal.numeric.cache`), where numba also caches its machine
-        code (default ``True``).  ``False`` writes the source to a temporary
-        directory for this process only.
+        code (default ``True``).  ``False`` generates and compiles in memory
+        and writes no file.
 
     Returns
     -------
@@ -91,7 +95,7 @@ def default_model(use_cache: bool = True) -> SimulationModel:
     """
     from ._kernels import load_kernels
 
-    return SimulationModel(name="general-2dof", kernels=load_kernels(use_cache))
+    return SimulationModel(name="general-2dof", kernels=load_kernels(use_cache), use_cache=use_cache)
 
 
 def _check_tolerances(rtol: float, atol: Any, scale_rate: float) -> np.ndarray:

@@ -25,8 +25,6 @@ cache and imported from there, so numba's own on-disk cache
 from __future__ import annotations
 
 import hashlib
-import importlib.util
-import sys
 import types
 from functools import lru_cache
 from typing import Any, Sequence
@@ -440,28 +438,6 @@ def load_kernels(use_cache: bool = True) -> types.ModuleType:
 
     With ``use_cache`` the source lives in the package cache (see
     :mod:`brakesqueal.numeric.cache`) and numba caches its machine code next
-    to it; otherwise it is written to a temporary directory for this process.
+    to it; otherwise it is generated and compiled in memory (no files).
     """
-    name = f"kernels_{_template_hash()}.py"
-    path = None
-    if use_cache:
-        if cache.read_text(KERNEL_KEY, name) is None:
-            path = cache.write_text(KERNEL_KEY, name, kernel_source())
-        else:
-            path = cache.entry_dir(KERNEL_KEY) / name
-    if path is None:
-        import tempfile
-        from pathlib import Path
-
-        d = Path(tempfile.mkdtemp(prefix="brakesqueal-sim-"))
-        path = d / name
-        path.write_text(kernel_source(), encoding="utf-8")
-    modname = "brakesqueal_simulation_kernels_" + hashlib.sha256(str(path).encode()).hexdigest()[:16]
-    if modname in sys.modules:
-        return sys.modules[modname]
-    spec = importlib.util.spec_from_file_location(modname, path)
-    assert spec is not None and spec.loader is not None
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[modname] = mod
-    spec.loader.exec_module(mod)
-    return mod
+    return cache.load_module(KERNEL_KEY, f"kernels_{_template_hash()}.py", kernel_source, use_cache=use_cache)

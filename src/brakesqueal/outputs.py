@@ -1,0 +1,153 @@
+"""Output files: checked before any computation, written atomically, failures in one line.
+
+Every command that writes a file checks its path first (:func:`check_output`)
+— the directory exists and is writable, the name is not a directory, the
+suffix is one the writer supports — so a typo fails in one line *before* a
+long computation.  Files are written through :func:`atomic_write`: the
+content goes to a temporary file in the same directory which is renamed over
+the final name only when it is complete, so an interrupted or failed write
+(Ctrl-C, a full disk) never leaves a truncated file under the final name and
+never destroys an existing file of that name.  Every ``OSError`` becomes an
+:class:`~brakesqueal.errors.OutputError` with one line naming the file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import os
+import tempfile
+from collections.abc import Callable, Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+from .errors import OutputError
+
+__all__ = ["check_output", "check_output_dir", "atomic_write", "write_with", "describe_oserror"]
+
+
+def describe_oserror(exc: OSError) -> str:
+    """A short reason for an ``OSError`` (``"no space left on device"``, ``"permission denied"``)."""
+    if exc.errno == errno.ENOSPC:
+        return "no space left on device"
+    if exc.errno == errno.EDQUOT:
+        return "disk quota exceeded"
+    return (exc.strerror or str(exc)).lower()
+
+
+def check_output(path: str | os.PathLike[str], *, what: str = "output file",
+                 suffixes: Sequence[str] | None = None) -> Path:
+    """Check that ``path`` can be written, before computing anything.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file to be written.
+    what : str, optional
+        The option or role of the file, for messages (e.g. ``"--out"``).
+    suffixes : sequence of str, optional
+        Allowed suffixes (lower case, with the dot), e.g. ``(".nc",)``.
+
+    Returns
+    -------
+    pathlib.Path
+        The path.
+
+    Raises
+    ------
+    OutputError
+        One line: wrong suffix, missing or unwritable directory, or a
+        directory in the file's place.
+    """
+    p = Path(os.fspath(path))
+    if not p.name:
+        raise OutputError(f"{what}: '{path}' is not a file name")
+    if suffixes is not None and p.suffix.lower() not in suffixes:
+        raise OutputError(f"{what}: '{path}' must end in {' or '.join(suffixes)}")
+    parent = p.parent if str(p.parent) else Path(".")
+    if not parent.exists():
+        raise OutputError(f"{what}: cannot write '{path}': the directory '{parent}' does not exist")
+    if not parent.is_dir():
+        raise OutputError(f"{what}: cannot write '{path}': '{parent}' is not a directory")
+    if p.is_dir():
+        raise OutputError(f"{what}: cannot write '{path}': it is a directory")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputError(f"{what}: cannot write '{path}': the directory '{parent}' is not writable")
+    if p.exists() and not os.access(p, os.W_OK) and not os.access(parent, os.W_OK):
+        raise OutputError(f"{what}: cannot write '{path}': permission denied")
+    return p
+
+
+def check_output_dir(path: str | os.PathLike[str], *, what: str = "output directory") -> Path:
+    """Check that ``path`` is (or can be created as) a writable directory; create it.
+
+    Raises
+    ------
+    OutputError
+        One line when a regular file is in the way or the location is not writable.
+    """
+    p = Path(os.fspath(path))
+    for anc in [p, *p.parents]:
+        if anc.exists():
+            if not anc.is_dir():
+                raise OutputError(f"{what}: cannot use '{path}': '{anc}' is a regular file, not a directory")
+            if not os.access(anc, os.W_OK | os.X_OK):
+                raise OutputError(f"{what}: cannot use '{path}': '{anc}' is not writable")
+            break
+    try:
+        p.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"{what}: cannot create '{path}': {describe_oserror(exc)}") from None
+    return p
+
+
+@contextlib.contextmanager
+def atomic_write(path: str | os.PathLike[str], *, what: str = "output file") -> Iterator[Path]:
+    """Context manager yielding a temporary path in the same directory; renamed over ``path`` on success.
+
+    On any exception (including ``KeyboardInterrupt``) the temporary file is
+    removed and an existing file at ``path`` is left untouched; an
+    ``OSError`` is re-raised as :class:`~brakesqueal.errors.OutputError`.
+
+    Examples
+    --------
+    >>> with atomic_write("map.nc") as tmp:          # doctest: +SKIP
+    ...     dataset.to_netcdf(tmp)
+    """
+    final = Path(os.fspath(path))
+    directory = final.parent if str(final.parent) else Path(".")
+    try:
+        fd, tmp_name = tempfile.mkstemp(prefix=f".{final.name}.", suffix=".part" + final.suffix, dir=directory)
+    except OSError as exc:
+        raise OutputError(f"{what}: cannot write '{path}': {describe_oserror(exc)}") from None
+    os.close(fd)
+    tmp = Path(tmp_name)
+    try:
+        yield tmp
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, final)
+    except OSError as exc:
+        _remove(tmp)
+        raise OutputError(f"{what}: cannot write '{path}': {describe_oserror(exc)}") from None
+    except BaseException:
+        _remove(tmp)
+        raise
+
+
+def write_with(path: str | os.PathLike[str], writer: Callable[[Path], Any], *, what: str = "output file") -> Any:
+    """Call ``writer(temporary_path)`` and move the result to ``path`` atomically (see :func:`atomic_write`).
+
+    Returns
+    -------
+    Any
+        What ``writer`` returned.
+    """
+    with atomic_write(path, what=what) as tmp:
+        out = writer(tmp)
+    return out
+
+
+def _remove(p: Path) -> None:
+    with contextlib.suppress(OSError):
+        p.unlink()
