@@ -33,7 +33,7 @@ PKG = Path(cache.__file__).resolve().parent.parent
 # ------------------------------------------------------------------ the real commands
 #: kind of cache entry -> (command, glob of its entry file below the cache root)
 KINDS = {
-    "numeric": (["linearize", "--format", "json"], "*/general-2dof-kronecker-quasistatic/numeric.py"),
+    "numeric": (["linearize", "--format", "json"], "*/model-*/model.py"),
     "stability": (["map", "--x", "mu=0.1:0.8:12", "--y", "Omega=1:100:9", "--out", "m.nc", "--no-eigen"],
                   "*/stability-kernels/brakesqueal_kernel_map_*.py"),
     "simulation": (["simulate", "--t-end", "0.01", "--format", "json", "--no-progress"], "*/simulate-rhs/kernels_*.py"),
@@ -414,6 +414,10 @@ EXEMPT = {
     "simulation/bench.py": "lambdify baseline of a benchmark, not cached",
     "simulation/_integrate.py": "calls load_kernels; the source comes from simulation/_kernels.py (listed)",
     "cli.py": "caches the output of render.py (listed)",
+    "model/io.py": "model description <-> TOML; the code cache key is a hash of the components (content-addressed)",
+    "model/library.py": "built-in model definitions: their components are hashed into the code cache key",
+    "model/parameters.py": "parameter values and presets: never enter generated code",
+    "model/roles.py": "ranges and units of parameters: validation only",
 }  # fmt: skip
 
 

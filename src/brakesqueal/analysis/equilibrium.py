@@ -307,6 +307,7 @@ def silent_motion(params: Any, *, model: Any = None, use_cache: bool = True) -> 
     from ..codegen import CompiledModel, compile_model
 
     params = as_parameters(params)
+    model = getattr(model, "model", model)  # the transitional paper view wraps the compiled model
     cm = model if isinstance(model, CompiledModel) else compile_model(params.model, use_cache=use_cache)
     p = list(map(float, params.vector()))
     n, m = cm.n, cm.m

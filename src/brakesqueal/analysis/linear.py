@@ -279,6 +279,7 @@ def linearize(params: Any, *, model: Any = None, pad_rates: str = "kept", use_ca
     if pad_rates not in PAD_RATES:
         raise ParameterError(f"pad_rates must be one of {', '.join(PAD_RATES)}; got {pad_rates!r}")
     params = as_parameters(params)
+    model = getattr(model, "model", model)  # the transitional paper view wraps the compiled model
     cm = model if isinstance(model, CompiledModel) else compile_model(params.model, use_cache=use_cache)
     sm = silent_motion(params, model=cm)
     p = parameter_vector(params)
