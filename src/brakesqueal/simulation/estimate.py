@@ -527,8 +527,9 @@ def matrix_pencil(
     x : ndarray, shape (N,) or (N, k)
         Real or complex samples, one channel per column.
     order : int, optional
-        Number of exponentials ``r``.  Default: the singular values larger
-        than ``max(rcond s_0, 10 median(s))`` (the median estimates the noise
+        Number of exponentials ``r``.  Default: at the largest ratio of
+        consecutive singular values among those larger than
+        ``max(rcond s_0, 10 median(s))`` (the median estimates the noise
         floor), at most ``max_order``.
     pencil : int, optional
         Pencil parameter ``L`` (default ``N // 3``).
@@ -569,7 +570,9 @@ def matrix_pencil(
     _, s, Vh = np.linalg.svd(H, full_matrices=False)
     if order is None:
         thr = max(rcond * s[0], 10.0 * float(np.median(s)))
-        r = int(min(max(np.count_nonzero(s > thr), 1), max_order, L))
+        m = int(min(max(np.count_nonzero(s > thr), 1), max_order, L))
+        nxt = np.append(s[1 : m + 1], thr)[:m] if m < s.size else np.append(s[1:m], thr)
+        r = int(np.argmax(s[:m] / np.maximum(nxt, 1e-300))) + 1  # at the largest gap of the singular values
     else:
         r = int(order)
         if not 1 <= r <= L:
@@ -598,8 +601,32 @@ def _decimation(t: np.ndarray, x: np.ndarray, max_samples: int) -> tuple[int, in
     return stride, min(max_samples, (N - 1) // stride + 1)
 
 
-def _nearest(pm: PencilModes, lam: complex) -> complex:
-    return complex(pm.eigenvalues[int(np.argmin(np.abs(pm.eigenvalues - lam)))])
+def _pick(t: np.ndarray, x: np.ndarray, reference: complex | None) -> tuple[PencilModes, complex]:
+    """Pencil fit and its dominant pole (or the one nearest ``reference``), with ``Im >= 0``.
+
+    Poles closer to the chosen one than the resolution ``2 pi / T`` of the
+    window cannot be told apart (a pencil may split a slowly modulated
+    oscillation into such a pair); the order is then lowered by two until
+    the chosen pole stands alone.
+    """
+    order = None
+    res = 2 * math.pi / max(float(t[-1] - t[0]), 1e-300)
+    while True:
+        pm = matrix_pencil(t, x, order=order)
+        lam_all = pm.eigenvalues
+        keep = lam_all.imag >= -1e-9 * np.abs(lam_all)
+        if not keep.any():
+            keep[:] = True
+        size = np.where(keep, pm.size_at(float(t[-1])), -1.0)
+        k = int(np.argmax(size)) if reference is None else int(np.argmin(np.abs(lam_all - reference)))
+        lam = complex(lam_all[k])
+        near = np.abs(lam_all - lam) < res
+        near[k] = False
+        near &= np.abs(lam_all - lam.conjugate()) > 1e-9 * abs(lam) + 1e-12
+        if not near.any() or lam_all.size <= 2:
+            break
+        order = lam_all.size - 2
+    return pm, (lam.conjugate() if lam.imag < 0 else lam)
 
 
 def dominant_mode(
@@ -644,23 +671,14 @@ def dominant_mode(
     stride, n = _decimation(t, x, max_samples)
     idx = np.arange(t.size - 1 - (n - 1) * stride, t.size, stride)
     tt, xx = t[idx], np.asarray(x)[idx]
-    pm = matrix_pencil(tt, xx)
-    keep = pm.eigenvalues.imag >= -1e-9 * np.abs(pm.eigenvalues)
-    if not keep.any():
-        keep[:] = True
-    size = pm.size_at(float(tt[-1]))
-    size = np.where(keep, size, -1.0)
-    k = int(np.argmax(size)) if reference is None else int(np.argmin(np.abs(pm.eigenvalues - reference)))
-    lam = complex(pm.eigenvalues[k])
-    if lam.imag < 0:
-        lam = lam.conjugate()
+    pm, lam = _pick(tt, xx, reference)
     g_err = f_err = math.nan
     h = n // 2
     if h >= 16:
         errs = []
         for sl in (slice(0, h), slice(n - h, n)):
             try:
-                other = _nearest(matrix_pencil(tt[sl], xx[sl]), lam)
+                other = _pick(tt[sl], xx[sl], lam)[1]
             except ParameterError:
                 continue
             if other.imag < 0:
