@@ -138,11 +138,14 @@ def _simulate_built(model: str, preset: Any, params: Any, set_: Any, t_end: floa
 
         matplotlib.use("Agg")
         tr.plot().savefig(plot, dpi=120)
-    data = {**tr.summary.to_dict(), "message": tr.message}
+    summary = tr.summary
+    data = {**summary.to_dict(), "message": tr.message}
     if fmt == "json":
         sys.stdout.write(json.dumps(data, indent=2) + "\n")
     else:
         sys.stdout.write("".join(f"{k:22s} {v}\n" for k, v in data.items()))
+    for w in summary.warnings:
+        sys.stderr.write(f"brakesqueal: warning: {w}\n")
     if tr.status == "failed":
         sys.stderr.write(f"brakesqueal: simulation failed: {tr.message}\n")
         raise SystemExit(1)

@@ -383,9 +383,9 @@ def summarize(
     amp = float(norm[-per:].max())
     lc = None
     N = t.size
-    if status == "finished" and N > 400:
-        env, _ = envelope(x[:, :n])
-        q, e = N // 4, N // 20
+    env = envelope(x[:, :n])[0] if status == "finished" and N > 400 and np.all(np.isfinite(x[:, :n])) else None
+    q, e = N // 4, N // 20
+    if env is not None and env[-q - e : -e].min() > 0:
         seg_t, seg = t[-q - e : -e], env[-q - e : -e]
         local = float(np.polyfit(seg_t, np.log(seg), 1)[0])
         if x_start is not None and f_lead > 0:
