@@ -186,8 +186,8 @@ def test_03_simulation(kernel_dir):
     assert rel(2 * math.pi * m["frequency_hz"], lam.imag) < 1e-3
     st = s["stable"]
     assert st["growth_rate"] < 0 and rel(st["growth_rate"], lam_stable.real) < 0.02
-    # a generic start excites the damped mode too: the fit is further off than from the modal start
-    assert abs(s["generic"]["growth_rate"] - lam.real) > abs(m["growth_rate"] - lam.real)
+    # a generic start excites the damped mode too; the summary's modal projection removes it (issue 10)
+    assert rel(s["generic"]["growth_rate"], lam.real) < 1e-4
     # large start: the upper pad lifts off after ~0.1 s (docs/simulation.md: t = 0.1003179 s at rtol 1e-10)
     assert s["large"]["status"] == "contact-loss"
     assert s["large"]["t_event"] == pytest.approx(0.1003179, abs=2e-4)

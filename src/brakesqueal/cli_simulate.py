@@ -35,8 +35,13 @@ def _simulate_cmd(
     ] = None,
     t_end: Annotated[float, typer.Option("--t-end", help="Simulated time [s].")] = 0.5,
     q0: Annotated[
-        str, typer.Option("--q0", help="Initial deviation from the silent motion: dq1,dq2[,dq1dot,dq2dot] [rad, rad/s].")
-    ] = "1e-5,0",
+        Optional[str],
+        typer.Option(
+            "--q0",
+            help="Initial deviation from the silent motion: dq1,dq2[,dq1dot,dq2dot] [rad, rad/s] "
+            "(default: along the leading mode, 1e-5 rad).",
+        ),
+    ] = None,
     x0: Annotated[
         Optional[str], typer.Option("--x0", help="Absolute initial state q1,q2,dq1,dq2 (instead of --q0).")
     ] = None,
@@ -60,13 +65,20 @@ def _simulate_cmd(
         raise ParameterError(f"The option '--format' must be text or json; got {fmt!r}")
     if not (math.isfinite(t_end) and t_end > 0):
         raise ParameterError(f"The option '--t-end' must be a positive number of seconds; got {t_end!r}")
+    if q0 is not None and x0 is not None:
+        raise ParameterError("give either --q0 (deviation from the silent motion) or --x0 (absolute state), not both")
     if model is not None:
-        _simulate_built(model, preset, params, set_, t_end, q0, x0, method, rtol, out, plot, wav, fmt)
+        _simulate_built(model, preset, params, set_, t_end, q0 if q0 is not None else "1e-5", x0, method, rtol, out,
+                        plot, wav, fmt)  # fmt: skip
         return
     from .parameters import resolve_parameters
 
     p = resolve_parameters(preset, params, list(set_ or []))
-    init: dict[str, Any] = {"x0": _floats(x0, "--x0")} if x0 is not None else {"perturbation": _floats(q0, "--q0")}
+    init: dict[str, Any] = {}
+    if x0 is not None:
+        init["x0"] = _floats(x0, "--x0")
+    elif q0 is not None:
+        init["perturbation"] = _floats(q0, "--q0")
     from .simulation import default_model, simulate
 
     model = default_model(use_cache=not no_cache)
@@ -91,13 +103,16 @@ def _simulate_cmd(
         if tr.t.size < 2:
             raise ParameterError("the trajectory has fewer than two samples; nothing to write to --wav")
         tr.to_wav(wav)
-    data = {**tr.summary.to_dict(), "message": tr.message, "t_end_reached": float(tr.t[-1]) if tr.t.size else 0.0,
-            "wall_s": tr.stats.get("wall_s")}  # fmt: skip
+    summary = tr.summary
+    data = {**summary.to_dict(), "message": tr.message, "start": tr.start,
+            "t_end_reached": float(tr.t[-1]) if tr.t.size else 0.0, "wall_s": tr.stats.get("wall_s")}  # fmt: skip
     if fmt == "json":
         sys.stdout.write(json.dumps(data, indent=2) + "\n")
     else:
         for k, v in data.items():
             sys.stdout.write(f"{k:22s} {v}\n")
+    for w in summary.warnings:
+        sys.stderr.write(f"brakesqueal: warning: {w}\n")
     if tr.status == "failed":
         # outputs are written; exit status 1 distinguishes a solver failure from bad input (2)
         sys.stderr.write(f"brakesqueal: simulation failed: {tr.message}\n")
@@ -123,11 +138,14 @@ def _simulate_built(model: str, preset: Any, params: Any, set_: Any, t_end: floa
 
         matplotlib.use("Agg")
         tr.plot().savefig(plot, dpi=120)
-    data = {**tr.summary.to_dict(), "message": tr.message}
+    summary = tr.summary
+    data = {**summary.to_dict(), "message": tr.message}
     if fmt == "json":
         sys.stdout.write(json.dumps(data, indent=2) + "\n")
     else:
         sys.stdout.write("".join(f"{k:22s} {v}\n" for k, v in data.items()))
+    for w in summary.warnings:
+        sys.stderr.write(f"brakesqueal: warning: {w}\n")
     if tr.status == "failed":
         sys.stderr.write(f"brakesqueal: simulation failed: {tr.message}\n")
         raise SystemExit(1)

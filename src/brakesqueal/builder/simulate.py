@@ -44,6 +44,10 @@ class BuiltTrajectory:
         Coordinate names.
     Q0 : ndarray
         Silent motion.
+    modes : LinearModes or None
+        Linear modes of the silent motion (for the summary).
+    integration_error : float
+        Bound on the integrator's error of growth rate and angular frequency [1/s].
     """
 
     status: str
@@ -54,19 +58,22 @@ class BuiltTrajectory:
     normal_forces: np.ndarray
     coords: tuple[str, ...]
     Q0: np.ndarray
+    modes: Any = None
+    integration_error: float = 0.0
 
     @property
     def summary(self) -> Any:
-        """Frequency, growth rate and final amplitude of the tilt (or first coordinate) deviation."""
-        from ..simulation.trajectory import Summary, fit_growth_frequency
+        """Growth rate and frequency of the leading mode (modal projection), final amplitude.
 
-        k = 2 if self.coords[:2] == ("q1", "q2") else 1
-        dq = self.Q[:, :k] - self.Q0[:k]
-        if self.t.size < 16:
-            return Summary(self.status, math.nan, math.nan, math.nan, None)
-        growth, freq = fit_growth_frequency(self.t, dq)
-        tail = max(2, self.t.size // 10)
-        return Summary(self.status, freq, growth, float(np.abs(dq[-tail:]).max()), None)
+        See :func:`brakesqueal.simulation.summarize`; the output samples are
+        the estimation samples here (at least 20 per period of the fastest
+        linear mode by default).
+        """
+        from ..simulation.trajectory import summarize
+
+        x = np.concatenate([self.Q - self.Q0, self.Qdot], axis=1)
+        return summarize(self.status, self.t, x, self.modes, x_start=x[0] if x.size else None,
+                         integration_error=self.integration_error)  # fmt: skip
 
     def to_xarray(self) -> Any:
         """Dataset with dimension ``t``: one variable per coordinate and rate, and the normal forces."""
@@ -102,9 +109,12 @@ def simulate_model(
     *,
     method: str = "DOP853",
     rtol: float = 1e-8,
-    sample_rate: float = 20000.0,
+    sample_rate: float | None = None,
 ) -> BuiltTrajectory:
     """Integrate a built model from its silent motion plus ``perturbation`` (added to the first coordinates).
+
+    ``sample_rate`` [Hz] defaults to the larger of 20 kHz and 20 samples per
+    period of the fastest linear mode (:func:`brakesqueal.simulation._integrate.estimation_rate`).
 
     Raises
     ------
@@ -117,7 +127,14 @@ def simulate_model(
         raise ParameterError(f"The option '--t-end' must be a positive number of seconds; got {t_end!r}")
     if not 1e-13 <= rtol <= 1e-2:
         raise ParameterError(f"The option '--rtol' must be in [1e-13, 1e-2]; got {rtol!r}")
+    from ..simulation._integrate import estimation_rate
+    from ..simulation.estimate import linear_modes
+    from ..simulation.trajectory import _STAGES, integration_error_bound
+
     lm = linearize_model(spec, overrides)
+    modes = linear_modes(lm.A)
+    if sample_rate is None:
+        sample_rate = max(20000.0, estimation_rate(modes, t_end))
     cm = compile_model(spec)
     n, m = cm.n, cm.m
     pert = np.zeros(2 * n)
@@ -162,8 +179,9 @@ def simulate_model(
     if lift(0.0, y0) <= 0:
         raise ParameterError("the initial state has a pad out of contact (normal force <= 0)")
     t_eval = np.arange(0.0, t_end, 1.0 / sample_rate)
-    sol = solve_ivp(rhs, (0.0, t_end), y0, method=method, rtol=rtol, atol=1e-12 * (1 + np.abs(y0).max()),
-                    t_eval=t_eval, events=lift)  # fmt: skip
+    atol = 1e-12 * (1 + np.abs(y0).max())
+    sol = solve_ivp(rhs, (0.0, t_end), y0, method=method, rtol=rtol, atol=atol, t_eval=t_eval,
+                    events=lift)  # fmt: skip
     Y = sol.y.T
     fn = np.array([contact(y) for y in Y]) if Y.size else np.zeros((0, len(spec.pads)))
     if sol.status == 1:
@@ -172,4 +190,8 @@ def simulate_model(
         status, msg = "finished", "reached the end time"
     else:
         status, msg = "failed", f"solver failed: {sol.message}"
-    return BuiltTrajectory(status, msg, sol.t, Y[:, :n], Y[:, n:], fn, cm.coords, lm.Q0)
+    ie = 0.0
+    if Y.shape[0] > 1:
+        y_s = np.concatenate([lm.Q0, np.zeros(n)])
+        ie = integration_error_bound(Y - y_s, Y, rtol, atol, sol.nfev / _STAGES.get(method, 1), float(sol.t[-1]))
+    return BuiltTrajectory(status, msg, sol.t, Y[:, :n], Y[:, n:], fn, cm.coords, lm.Q0, modes, ie)

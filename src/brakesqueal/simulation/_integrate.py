@@ -10,14 +10,19 @@ from typing import Any, Callable, Literal, Sequence
 
 import numpy as np
 
-from ..errors import ParameterError, SilentMotionError
+from ..errors import BrakesquealError, ParameterError, SilentMotionError
 from ..parameters import Parameters
-from .trajectory import Trajectory
+from .estimate import LinearModes, linear_modes
+from .trajectory import EstimationRecord, Trajectory
 
-__all__ = ["METHODS", "SimulationModel", "default_model", "simulate"]
+__all__ = ["METHODS", "POINTS_PER_PERIOD", "START_AMPLITUDE", "SimulationModel", "default_model", "simulate"]
 
 #: Integration methods: the compiled DOP853 (default) and SciPy's ``solve_ivp`` methods.
 METHODS: tuple[str, ...] = ("DOP853-jit", "DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
+#: Samples per period of the highest linear frequency in the estimation record (summary numbers).
+POINTS_PER_PERIOD = 20
+#: Largest tilt deviation [rad] of the default start (along the leading mode).
+START_AMPLITUDE = 1e-5
 EventMode = Literal["stop", "continue", "off"]
 _EVENT_NAMES = ("contact-loss-pad1", "contact-loss-pad2", "sliding-reversal-pad1", "sliding-reversal-pad2")
 
@@ -61,6 +66,16 @@ class SimulationModel:
         l = sm.l0.astype(float).copy()
         c = np.asarray(self.kernels.contact(y, l, self.parameter_vector(params)))
         return y, l, np.concatenate([c[1:4], c[7:10]])
+
+    def linear_modes(self, params: Parameters) -> LinearModes:
+        """Eigenvalues and left/right eigenvectors of the linearization's state matrix (eq. 47).
+
+        The state matrix acts on ``(q - q_m0, dq)``, the simulated state's
+        deviation from the silent motion.
+        """
+        from ..analysis.linear import linearize
+
+        return linear_modes(linearize(params).A)
 
     def rhs(self, params: Parameters) -> Callable[[float, np.ndarray], np.ndarray]:
         """``f(t, y)`` for SciPy (solves the pad deformations on the way, warm-started)."""
@@ -109,26 +124,44 @@ def _check_tolerances(rtol: float, atol: Any, scale_rate: float) -> np.ndarray:
     return a
 
 
-def _initial_state(x0: Any, perturbation: Any, y_s: np.ndarray) -> np.ndarray:
+def _initial_state(
+    x0: Any, perturbation: Any, y_s: np.ndarray, modes: LinearModes | None
+) -> tuple[np.ndarray, str]:
+    """Initial state and a description of it (``start`` of the trajectory)."""
     if x0 is not None and perturbation is not None:
         raise ParameterError("give either x0 (absolute initial state) or perturbation, not both")
     if x0 is not None:
         v = np.asarray(x0, dtype=float).ravel()
         if v.size != 4:
             raise ParameterError(f"The initial state x0 must have 4 values (q1, q2, dq1, dq2); got {v.size}")
-        y0 = v
+        y0, start = v, "x0 (absolute state)"
+    elif perturbation is None and modes is not None:
+        y0 = y_s + modes.start_vector(START_AMPLITUDE)
+        start = f"leading mode, real part of its eigenvector, max tilt deviation {START_AMPLITUDE:g} rad"
     else:
-        d = np.asarray((1e-5, 0.0) if perturbation is None else perturbation, dtype=float).ravel()
+        d = np.asarray((START_AMPLITUDE, 0.0) if perturbation is None else perturbation, dtype=float).ravel()
         if d.size not in (2, 4):
             raise ParameterError(
                 f"The perturbation must have 2 (dq1, dq2) or 4 values (dq1, dq2, dq1dot, dq2dot); got {d.size}"
             )
         y0 = y_s + np.concatenate([d, np.zeros(4 - d.size)])
+        start = "perturbation of the silent motion"
     if not np.all(np.isfinite(y0)):
         raise ParameterError(f"The initial state must be finite; got {y0.tolist()}")
     if np.any(np.abs(y0[:2]) >= 0.5 * math.pi):
         raise ParameterError(f"The initial tilt angles must be in (-pi/2, pi/2); got {y0[:2].tolist()}")
-    return y0
+    return y0, start
+
+
+def estimation_rate(modes: LinearModes | None, duration: float) -> float:
+    """Sampling rate [Hz] of the estimation record: ``POINTS_PER_PERIOD`` per period of the fastest mode.
+
+    The "frequency" of a mode is ``|lambda| / 2 pi`` (so that a real, fast
+    eigenvalue is resolved too); at least 64 samples cover ``duration``.
+    Without a linear model the rate is 64 samples over the run.
+    """
+    fmax = float(np.abs(modes.eigenvalues).max()) / (2 * math.pi) if modes is not None else 0.0
+    return max(POINTS_PER_PERIOD * fmax, 64.0 / duration)
 
 
 def simulate(
@@ -146,6 +179,7 @@ def simulate(
     max_step: float = math.inf,
     max_steps: int = 50_000_000,
     progress: Callable[[float], None] | None = None,
+    estimate_samples: int = 65536,
 ) -> Trajectory:
     r"""Integrate the nonlinear 2-DOF equations (44) of the wobbling disk.
 
@@ -161,7 +195,10 @@ def simulate(
         Absolute initial state ``(q1, q2, dq1, dq2)`` [rad, rad/s].
     perturbation : array_like, shape (2,) or (4,), optional
         Initial deviation from the silent motion ``q_m0`` (rates zero if two
-        values).  Default when neither is given: ``(1e-5, 0)`` rad.
+        values).  Default when neither is given: along the leading mode of
+        the linearization, ``x(0) = a Re(v_0)`` with ``v_0`` its right
+        eigenvector scaled so that the largest tilt component is 1 and
+        ``a = START_AMPLITUDE = 1e-5`` rad (a single mode, no beating).
     method : str
         ``"DOP853-jit"`` (compiled Dormand–Prince 8(5,3), default) or one of
         SciPy's ``solve_ivp`` methods ``"DOP853", "RK45", "RK23", "Radau",
@@ -172,7 +209,10 @@ def simulate(
         Absolute tolerance(s) in ``(0, 1]``; default ``1e-6 rtol (1, 1, w, w)``
         with ``w = sqrt(k_t/Theta)`` [rad, rad/s].
     sample_rate : float
-        Output samples per second [Hz] (uniform grid, dense output).
+        Output samples per second [Hz] (uniform grid, dense output) of
+        :attr:`Trajectory.t` / :attr:`Trajectory.y` (NetCDF, WAV, plot).  The
+        summary numbers do not use this grid but the estimation record
+        (``estimate_samples``).
     events : {"stop", "continue", "off"}
         ``"stop"`` ends the run at the first contact loss (``F_n <= 0``) or
         sliding reversal (``v_r . v_r0 <= 0``, ``v_r0`` the silent-motion
@@ -186,6 +226,12 @@ def simulate(
         ``"failed"``.
     progress : callable, optional
         Called with the fraction done (0..1) while integrating.
+    estimate_samples : int
+        Length of the estimation record (default 65536): the integrator's
+        dense output at ``POINTS_PER_PERIOD = 20`` samples per period of the
+        fastest linear mode (:func:`estimation_rate`), of which the last
+        ``estimate_samples`` are kept (a ring buffer, so memory stays bounded
+        for long runs).  :attr:`Trajectory.summary` is computed from it.
 
     Returns
     -------
@@ -226,12 +272,18 @@ def simulate(
         raise ParameterError(f"{n_out} output samples requested; lower sample_rate or t_end")
     if not (max_step > 0):
         raise ParameterError(f"The option 'max_step' must be positive; got {max_step!r}")
+    if not (isinstance(estimate_samples, (int, np.integer)) and 64 <= estimate_samples <= 50_000_000):
+        raise ParameterError(f"The option 'estimate_samples' must be an integer in [64, 5e7]; got {estimate_samples!r}")
     p = model.parameter_vector(params)
     try:
         y_s, l_s, vr0 = model.silent(params)
     except SilentMotionError as exc:
         raise SilentMotionError(f"cannot simulate: {exc}") from None
-    y0 = _initial_state(x0, perturbation, y_s)
+    try:
+        modes: LinearModes | None = model.linear_modes(params)
+    except (BrakesquealError, np.linalg.LinAlgError):
+        modes = None
+    y0, start = _initial_state(x0, perturbation, y_s, modes)
     atol_v = _check_tolerances(rtol, atol, math.sqrt(max(params.k_t, 1.0) / params.Theta))
     k = model.kernels
     l0 = l_s.copy()
@@ -250,12 +302,14 @@ def simulate(
         if ev0[i + 2] <= 0 and events != "off":
             raise ParameterError(f"pad {i + 1} does not slide forward at the initial state; use a smaller perturbation")
     t_out = t0 + np.arange(n_out) / sample_rate
+    est = _EstimationGrid(t0, 1.0 / estimation_rate(modes, t1 - t0), int(estimate_samples))
     wall = time.perf_counter()
     if method == "DOP853-jit":
-        res = _run_jit(k, y0, l0, f0, p, vr0, t0, t1, rtol, atol_v, max_step, t_out, events, max_steps, progress)
+        res = _run_jit(k, y0, l0, f0, p, vr0, t0, t1, rtol, atol_v, max_step, t_out, est, events, max_steps,
+                       progress)  # fmt: skip
     else:
-        res = _run_scipy(model, params, k, y0, l0, p, vr0, t0, t1, method, rtol, atol_v, max_step, t_out, events,
-                         progress)  # fmt: skip
+        res = _run_scipy(model, params, k, y0, l0, p, vr0, t0, t1, method, rtol, atol_v, max_step, t_out, est,
+                         events, progress)  # fmt: skip
     wall = time.perf_counter() - wall
     n = res["n"]
     Y = res["Y"][:n]
@@ -265,7 +319,45 @@ def simulate(
         params=params, q_m0=y_s[:2].copy(), method=method, rtol=rtol, atol=atol_v, t_span=(t0, t1),
         t_event=res.get("t_event"), y_event=res.get("y_event"), event_times=res.get("event_times", {}),
         stats={"nfev": res["nfev"], "wall_s": wall, **res.get("stats", {})}, model=model.name,
+        record=est.record(), modes=modes, sample_rate=float(sample_rate), y_start=y0.copy(), start=start,
     )  # fmt: skip
+
+
+class _EstimationGrid:
+    """The estimation record being filled: times ``t0 + i dt`` in a ring buffer of ``size`` rows."""
+
+    def __init__(self, t0: float, dt: float, size: int) -> None:
+        self.t0, self.dt = float(t0), float(dt)
+        self.buf = np.full((size, 4), np.nan)
+        self.count = 0  # samples written so far (index of the next one)
+
+    def put(self, Y: np.ndarray) -> None:
+        """Append samples (rows of ``Y``, at the next grid times)."""
+        size, k = self.buf.shape[0], Y.shape[0]
+        idx = (self.count + np.arange(k)) % size
+        if k > size:
+            idx, Y = idx[-size:], Y[-size:]
+        self.buf[idx] = Y
+        self.count += k
+
+    def times(self, a: float, b: float) -> tuple[int, np.ndarray]:
+        """Index of the first grid time ``>= a`` and the grid times in ``[a, b]``."""
+        i0 = max(int(math.ceil((a - self.t0) / self.dt)) - 1, 0)
+        while self.t0 + i0 * self.dt < a:
+            i0 += 1
+        i1 = int(math.floor((b - self.t0) / self.dt)) + 1
+        while self.t0 + i1 * self.dt > b:
+            i1 -= 1
+        i = np.arange(i0, i1 + 1)
+        return i0, self.t0 + i * self.dt
+
+    def record(self) -> EstimationRecord:
+        """The last ``min(count, size)`` samples in time order."""
+        size = self.buf.shape[0]
+        m = min(self.count, size)
+        i = np.arange(self.count - m, self.count)
+        return EstimationRecord(t=self.t0 + i * self.dt, y=self.buf[i % size].copy(), rate=1.0 / self.dt,
+                                complete=self.count <= size)  # fmt: skip
 
 
 def _dop853_tables() -> tuple[np.ndarray, ...]:
@@ -276,8 +368,9 @@ def _dop853_tables() -> tuple[np.ndarray, ...]:
         np.ascontiguousarray(c.D, dtype=float)  # fmt: skip
 
 
-def _run_jit(k, y0, l0, f0, p, vr0, t0, t1, rtol, atol, max_step, t_out, events, max_steps, progress):  # type: ignore[no-untyped-def]
+def _run_jit(k, y0, l0, f0, p, vr0, t0, t1, rtol, atol, max_step, t_out, est, events, max_steps, progress):  # type: ignore[no-untyped-def]
     tables = _dop853_tables()
+    i_est = 0
     Y = np.full((t_out.size, 4), np.nan)
     mode = {"off": 0, "stop": 1, "continue": 2}[events]
     ev_t = np.zeros(10000)
@@ -293,8 +386,10 @@ def _run_jit(k, y0, l0, f0, p, vr0, t0, t1, rtol, atol, max_step, t_out, events,
     t = t0
     for c in range(chunks):
         out = k.dop853(y, l, f, p, vr0, t, float(edges[c + 1]), h, rtol, atol, max_step, t_out, i_out, Y,
-                       mode, ev_t, ev_k, n_ev, max_steps - nstep, *tables)  # fmt: skip
-        status, t, y, l, f, h, i_out, n_ev, fe, ns, nr, k_event, te, ye = out
+                       est.t0, est.dt, i_est, est.buf, mode, ev_t, ev_k, n_ev, max_steps - nstep,
+                       *tables)  # fmt: skip
+        status, t, y, l, f, h, i_out, n_ev, fe, ns, nr, k_event, te, ye, i_est = out
+        est.count = int(i_est)
         nfev, nstep, nrej = nfev + fe, nstep + ns, nrej + nr
         if progress is not None:
             progress((t - t0) / (t1 - t0))
@@ -326,7 +421,8 @@ def _status(code: int, t: float, k_event: int, t_event: float | None) -> tuple[s
     return "failed", f"integration failed at t = {t:.6g} s: {reason}"
 
 
-def _run_scipy(model, params, k, y0, l0, p, vr0, t0, t1, method, rtol, atol, max_step, t_out, events, progress):  # type: ignore[no-untyped-def]
+def _run_scipy(model, params, k, y0, l0, p, vr0, t0, t1, method, rtol, atol, max_step, t_out, est, events, progress):  # type: ignore[no-untyped-def]
+    """``solve_ivp`` in chunks no longer than the estimation ring buffer (bounded memory)."""
     from scipy.integrate import solve_ivp
 
     lbuf = l0.copy()
@@ -357,23 +453,51 @@ def _run_scipy(model, params, k, y0, l0, p, vr0, t0, t1, method, rtol, atol, max
             return ev
 
         evfuns = [make(i) for i in range(4)]
-    sol = solve_ivp(fun, (t0, t1), y0, method=method, t_eval=t_out, rtol=rtol, atol=atol, max_step=max_step,
-                    events=evfuns or None)  # fmt: skip
-    if progress is not None:
-        progress(1.0)
-    n = sol.t.size
-    Y = np.ascontiguousarray(sol.y.T)
+    Y = np.full((t_out.size, 4), np.nan)
+    n = 0
+    nfev = 0
     t_event, y_event, k_event = None, None, -1
     recorded: dict[str, list[float]] = {}
-    if evfuns:
-        for i, te in enumerate(sol.t_events):
-            if te.size:
-                recorded[_EVENT_NAMES[i]] = [float(v) for v in te]
-                if sol.status == 1 and (t_event is None or te[0] < t_event):
-                    t_event, y_event, k_event = float(te[0]), np.asarray(sol.y_events[i][0]), i
-    code = {0: 0, 1: 1, -1: -2}[sol.status]
-    st, msg = _status(code, float(sol.t[-1]) if n else t0, k_event, t_event)
+    chunk = est.buf.shape[0] * est.dt
+    a, y = t0, np.asarray(y0, dtype=float)
+    code, t_end, sol_msg = 0, t0, ""
+    first = True
+    while True:
+        b = min(a + chunk, t1)
+        if t1 - b < 1e-9 * chunk:
+            b = t1
+        lo = "left" if first else "right"
+        i0, i1 = np.searchsorted(t_out, a, side=lo), np.searchsorted(t_out, b, side="right")
+        _, te = est.times(a, b)
+        if not first:
+            te = te[te > a]
+        ts, inv = np.unique(np.concatenate([t_out[i0:i1], te, [b]]), return_inverse=True)
+        sol = solve_ivp(fun, (a, b), y, method=method, t_eval=ts, rtol=rtol, atol=atol, max_step=max_step,
+                        events=evfuns or None)  # fmt: skip
+        nfev += int(sol.nfev)
+        got = sol.t.size
+        Yc = np.ascontiguousarray(sol.y.T)
+        io, ie = inv[: i1 - i0], inv[i1 - i0 : i1 - i0 + te.size]
+        ok_o, ok_e = io < got, ie < got
+        Y[i0 : i0 + int(ok_o.sum())] = Yc[io[ok_o]]
+        n = i0 + int(ok_o.sum())
+        est.put(Yc[ie[ok_e]])
+        if evfuns:
+            for i, tev in enumerate(sol.t_events):
+                if tev.size:
+                    recorded.setdefault(_EVENT_NAMES[i], []).extend(float(v) for v in tev)
+                    if sol.status == 1 and (t_event is None or tev[0] < t_event):
+                        t_event, y_event, k_event = float(tev[0]), np.asarray(sol.y_events[i][0]), i
+        code = {0: 0, 1: 1, -1: -2}[sol.status]
+        t_end = float(sol.t[-1]) if got else a
+        sol_msg = sol.message
+        if code != 0 or b >= t1:
+            break
+        a, y, first = b, Yc[inv[-1]].copy(), False  # ts ends at b: the state to continue from
+    if progress is not None:
+        progress(1.0)
+    st, msg = _status(code, t_end, k_event, t_event)
     if code == -2:
-        msg = f"solve_ivp ({method}) failed: {sol.message}"
-    return {"status": st, "message": msg, "Y": Y, "n": n, "nfev": int(sol.nfev), "t_event": t_event,
+        msg = f"solve_ivp ({method}) failed: {sol_msg}"
+    return {"status": st, "message": msg, "Y": Y, "n": n, "nfev": nfev, "t_event": t_event,
             "y_event": y_event, "event_times": recorded if events == "continue" else {}}  # fmt: skip

@@ -226,12 +226,14 @@ def _error_norm(K, E5, E3, h, scale):
 
 
 @njit(cache=True)
-def dop853(y0, l0, f0, p, vr0, t0, t1, h0, rtol, atol, max_step, t_out, i_out, Y,
+def dop853(y0, l0, f0, p, vr0, t0, t1, h0, rtol, atol, max_step, t_out, i_out, Y, te0, dte, i_est, Yest,
            event_mode, ev_t, ev_k, n_ev, max_steps, A, B, C, E3, E5, D):
     """Adaptive DOP853 from t0 to t1 (SciPy's algorithm), writing dense output at t_out[i_out:] into Y.
 
+    The estimation record: dense output at te0 + i dte (i = i_est, i_est + 1, ...) is written into the
+    ring buffer Yest (row i % Yest.shape[0]), so that it holds the last Yest.shape[0] samples.
     event_mode: 0 = no events, 1 = stop at the first event, 2 = record events and continue.
-    Returns (status, t, y, l, f, h, i_out, n_ev, nfev, nstep, nreject, k_event, t_event, y_event);
+    Returns (status, t, y, l, f, h, i_out, n_ev, nfev, nstep, nreject, k_event, t_event, y_event, i_est);
     status 0 = reached t1, 1 = stopped at an event, -1 = step size too small,
     -2 = non-finite state or pad equations unsolvable, -3 = max_steps reached.
     """
@@ -269,7 +271,7 @@ def dop853(y0, l0, f0, p, vr0, t0, t1, h0, rtol, atol, max_step, t_out, i_out, Y
         event_values(y, l, p, vr0, ev_old)
     while t < t1:
         if nstep >= max_steps:
-            return (-3, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event)
+            return (-3, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event, i_est)
         min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
         if h_abs > max_step:
             h_abs = max_step
@@ -278,7 +280,7 @@ def dop853(y0, l0, f0, p, vr0, t0, t1, h0, rtol, atol, max_step, t_out, i_out, Y
         rejected = False
         while True:
             if h_abs < min_step:
-                return (-1, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event)
+                return (-1, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event, i_est)
             t_new = t + h_abs
             if t_new > t1:
                 t_new = t1
@@ -323,13 +325,14 @@ def dop853(y0, l0, f0, p, vr0, t0, t1, h0, rtol, atol, max_step, t_out, i_out, Y
                 h_abs *= factor
                 break
             if not finite and h_abs <= 1e3 * min_step:
-                return (-2, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event)
+                return (-2, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event, i_est)
             h_abs *= max(MIN_FACTOR, SAFETY * err ** expo)
             rejected = True
             nrej += 1
         nstep += 1
         # dense output of this step (3 extra stages)
-        need_dense = (i_out < t_out.shape[0] and t_out[i_out] <= t_new) or event_mode > 0
+        need_dense = (i_out < t_out.shape[0] and t_out[i_out] <= t_new) or event_mode > 0 \
+            or te0 + i_est * dte <= t_new
         if need_dense:
             for s in range(13, 16):
                 for j in range(n):
@@ -412,14 +415,22 @@ def dop853(y0, l0, f0, p, vr0, t0, t1, h0, rtol, atol, max_step, t_out, i_out, Y
             for j in range(n):
                 Y[i_out, j] = yint[j]
             i_out += 1
+        nbuf = Yest.shape[0]
+        while te0 + i_est * dte <= t_stop:
+            x = (te0 + i_est * dte - t) / h
+            dense_eval(F, y, x, yint)
+            r = i_est % nbuf
+            for j in range(n):
+                Yest[r, j] = yint[j]
+            i_est += 1
         t = t_new
         for j in range(n):
             y[j] = ynew[j]
             f[j] = fnew[j]
         l[:] = lnew
         if stop:
-            return (1, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event)
-    return (0, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event)
+            return (1, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event, i_est)
+    return (0, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event, i_est)
 '''
 
 

@@ -4,15 +4,17 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
 
 import numpy as np
 
 from ..parameters import Parameters
+from .estimate import LinearModes, ModeEstimate, dominant_mode, modal_projection
 
-__all__ = ["Trajectory", "Summary", "envelope", "fit_growth_frequency"]
+__all__ = ["EstimationRecord", "Trajectory", "Summary", "envelope", "fit_growth_frequency", "integration_error_bound",
+           "summarize"]
 
 
 def envelope(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -102,24 +104,77 @@ def fit_growth_frequency(t: np.ndarray, x: np.ndarray, trim: float = 0.1) -> tup
     return growth, freq
 
 
+def _clean(v: Any) -> Any:
+    """JSON-ready value: non-finite floats become ``None``, tuples lists, dicts and lists recursively."""
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    if isinstance(v, (tuple, list)):
+        return [_clean(u) for u in v]
+    if isinstance(v, dict):
+        return {k: _clean(u) for k, u in v.items()}
+    return v
+
+
 @dataclass(frozen=True)
 class Summary:
-    """Summary numbers of a trajectory.
+    """Summary numbers of a trajectory (see :func:`summarize` and ``docs/simulation.md``).
 
     Attributes
     ----------
     status : str
         ``"finished"``, ``"contact-loss"``, ``"sliding-reversal"`` or ``"failed"``.
     frequency_hz : float
-        Dominant frequency [Hz] (slope of the Hilbert phase of the tilt deviation).
+        Frequency of the leading mode [Hz], ``Im lambda / 2 pi`` estimated
+        from the motion (``estimator``).
     growth_rate : float
-        Envelope growth rate [1/s] (least-squares slope of the log Hilbert
-        envelope of ``q_m - q_m0`` over the central 80 % of the record).
+        Growth rate of the leading mode [1/s], ``Re lambda`` estimated from
+        the motion (negative: decaying).
     amplitude_final : float
-        ``max |q_m - q_m0|`` over the last two periods [rad].
+        ``max |q - q0|`` (Euclidean norm of the coordinates' deviation) over
+        the last two periods of the estimation record.
     limit_cycle_amplitude : float or None
-        Envelope mean over the last quarter when the growth has stopped there
-        (|local rate| x quarter length < 0.02) after growing; else ``None``.
+        Mean envelope over the last quarter of the estimation record when the
+        growth has stopped there (|local rate| x quarter length < 0.02) after
+        the amplitude grew by more than a factor 1.5 from the start; else
+        ``None``.
+    growth_rate_stderr, frequency_stderr : float
+        Uncertainties of ``growth_rate`` [1/s] and ``frequency_hz`` [Hz]: the
+        root sum of squares of the terms in ``uncertainty_terms``.
+    estimator : str
+        ``"modal-projection"`` (onto the leading mode of the linearization),
+        ``"matrix-pencil"`` (no linear model: the dominant mode) or
+        ``"none"``.
+    estimate_window : (float, float)
+        First and last time [s] of the samples the estimate used.
+    estimate_rate_hz : float
+        Their sampling rate [Hz] (the integrator's dense output, 20 samples
+        per period of the fastest linear mode; not the output ``sample_rate``).
+    linear_growth_rate, linear_frequency_hz : float or None
+        ``Re lambda`` [1/s] and ``Im lambda / 2 pi`` [Hz] of the leading
+        eigenvalue of the linearization; the estimate agrees with them while
+        the motion is small (linear).
+    uncertainty_terms : dict
+        ``fit_growth`` [1/s] and ``fit_frequency`` [Hz]: the fit's own
+        uncertainty (:class:`~brakesqueal.simulation.estimate.ModeEstimate`);
+        ``integration`` [1/s]: a bound on the integrator's error of growth
+        rate and angular frequency (per-step relative tolerance of the
+        deviation times accepted steps per second; divided by 2 pi for the
+        frequency).
+    regime : str
+        ``"linear"`` when growth rate and frequency agree with the linear
+        eigenvalue within 3 uncertainties, ``"nonlinear"`` when not (an
+        amplitude-dependent growth rate or frequency: the numbers are averages
+        over the window), ``"unknown"`` without a linear model or estimate.
+    cross_check : dict or None
+        The matrix-pencil estimate of the same mode (keys ``estimator``,
+        ``growth_rate``, ``growth_rate_stderr``, ``frequency_hz``,
+        ``frequency_stderr``, ``window``), an estimate independent of the
+        linear model, over the last (at most 512 decimated) samples; a warning
+        is added when it disagrees with the projection over that window by
+        more than 5 combined fit uncertainties.
+    warnings : tuple of str
+        Conditions that make a number doubtful (aliased output samples,
+        a leading mode that does not dominate, disagreeing estimators, ...).
     """
 
     status: str
@@ -127,14 +182,221 @@ class Summary:
     growth_rate: float
     amplitude_final: float
     limit_cycle_amplitude: float | None
+    growth_rate_stderr: float = math.nan
+    frequency_stderr: float = math.nan
+    estimator: str = "none"
+    estimate_window: tuple[float, float] = (math.nan, math.nan)
+    estimate_rate_hz: float = math.nan
+    linear_growth_rate: float | None = None
+    linear_frequency_hz: float | None = None
+    uncertainty_terms: dict[str, float] | None = None
+    regime: str = "unknown"
+    cross_check: dict[str, Any] | None = None
+    warnings: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict (non-finite numbers become ``None``)."""
+        """JSON-ready dict (non-finite numbers become ``None``; tuples become lists)."""
+        return {k: _clean(v) for k, v in self.__dict__.items()}
 
-        def clean(v: Any) -> Any:
-            return None if isinstance(v, float) and not math.isfinite(v) else v
 
-        return {k: clean(v) for k, v in self.__dict__.items()}
+@dataclass(frozen=True, eq=False)
+class EstimationRecord:
+    """Uniform dense-output samples of the state kept for the summary numbers.
+
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        Times [s], uniform.
+    y : ndarray, shape (N, 2n)
+        States ``(q, dq)`` (absolute, not deviations).
+    rate : float
+        Sampling rate [Hz].
+    complete : bool
+        ``True`` when the record covers the whole run; ``False`` when it is
+        the last ``N`` samples of a longer run (ring buffer).
+    """
+
+    t: np.ndarray
+    y: np.ndarray
+    rate: float
+    complete: bool
+
+
+#: RHS evaluations per accepted step of SciPy's explicit methods (implicit ones: counted as 1, conservative).
+_STAGES = {"DOP853": 12, "RK45": 6, "RK23": 3}
+
+
+def integration_error_bound(
+    x: np.ndarray, y: np.ndarray, rtol: float, atol: np.ndarray | float, steps: float, duration: float
+) -> float:
+    """Bound on an adaptive integrator's error of a growth rate and an angular frequency [1/s].
+
+    Every accepted step keeps its local error estimate below
+    ``rtol |y| + atol``.  Relative to the deviation ``x`` that is
+    ``tau = max_j (rtol max|y_j| + atol_j) / RMS(x_j)``.  Errors in amplitude
+    and phase of a (nearly) neutral oscillation add up from step to step, so
+    growth rate and angular frequency can be off by at most about ``tau``
+    times the accepted steps per second.  DOP853's error estimate is that of
+    a lower-order combination, so the true error is usually much smaller
+    (measured at paper-fig2, ``rtol = 1e-9``: under 1 % of this bound).
+
+    Parameters
+    ----------
+    x : ndarray, shape (N, m)
+        State deviations over the estimation window.
+    y : ndarray, shape (N, m)
+        Absolute states (what the tolerance refers to).
+    rtol : float
+        Relative tolerance.
+    atol : float or ndarray, shape (m,)
+        Absolute tolerance(s).
+    steps : float
+        Accepted steps over the run.
+    duration : float
+        Duration of the run [s].
+
+    Returns
+    -------
+    float
+        The bound [1/s]; 0 when ``steps`` or ``duration`` is not positive or
+        ``x`` is zero.
+    """
+    x = np.asarray(x, dtype=float)
+    if not (steps > 0 and duration > 0) or x.size == 0:
+        return 0.0
+    ymax = np.nanmax(np.abs(np.asarray(y, dtype=float)), axis=0)
+    rms = np.sqrt(np.nanmean(x**2, axis=0))
+    at = np.broadcast_to(np.asarray(atol, dtype=float), rms.shape)
+    ok = rms > 0
+    if not ok.any():
+        return 0.0
+    tau = float(np.max((rtol * ymax[ok] + at[ok]) / rms[ok]))
+    return tau * steps / duration
+
+
+def _agree(a: float, sa: float, b: float, sb: float, slack: float) -> bool:
+    """Two estimates agree within 5 combined uncertainties plus ``slack``."""
+    if not (math.isfinite(a) and math.isfinite(b)):
+        return True
+    tol = 5 * math.hypot(sa if math.isfinite(sa) else 0.0, sb if math.isfinite(sb) else 0.0) + slack
+    return abs(a - b) <= tol
+
+
+def summarize(
+    status: str,
+    t: np.ndarray,
+    x: np.ndarray,
+    modes: LinearModes | None,
+    *,
+    output_rate: float | None = None,
+    x_start: np.ndarray | None = None,
+    integration_error: float = 0.0,
+    cross_check: bool = True,
+) -> Summary:
+    """Summary numbers from uniformly sampled state deviations (any number of coordinates).
+
+    Parameters
+    ----------
+    status : str
+        Status of the run (copied).
+    t : ndarray, shape (N,)
+        Uniform sample times [s] at a rate well above the frequencies of the
+        motion (e.g. :class:`EstimationRecord`).
+    x : ndarray, shape (N, 2n)
+        State deviations from the equilibrium ``(q - q0, dq)``.
+    modes : LinearModes or None
+        Linear modes of the equilibrium (modal projection onto the leading
+        one); ``None``: matrix pencil, dominant mode.
+    output_rate : float, optional
+        Sampling rate [Hz] of the user's output grid; a warning is added when
+        it is below twice the leading frequency.
+    x_start : ndarray, shape (2n,), optional
+        Initial deviation, for the "grew from the start" test of the limit
+        cycle (default: the envelope at 10 % of the record).
+    integration_error : float, optional
+        Bound on the integrator's error of growth rate and angular frequency
+        [1/s] (default 0), added to the uncertainties.
+    cross_check : bool, optional
+        Also run the matrix pencil on the same samples (default ``True``).
+
+    Returns
+    -------
+    Summary
+    """
+    t = np.asarray(t, dtype=float)
+    x = np.asarray(x, dtype=float)
+    n = max(x.shape[1] // 2, 1) if x.ndim == 2 else 1
+    nan = math.nan
+    warns: list[str] = []
+    lin_g = lin_f = None
+    if modes is not None:
+        lin_g, lin_f = float(modes.leading.real), float(modes.leading.imag / (2 * math.pi))
+    if t.size < 16:
+        amp = nan if t.size == 0 else float(np.sqrt((x[:, :n] ** 2).sum(axis=1)).max())
+        return Summary(status, nan, nan, amp, None, linear_growth_rate=lin_g, linear_frequency_hz=lin_f,
+                       warnings=(f"only {t.size} samples: no growth rate or frequency",))  # fmt: skip
+    est: ModeEstimate = modal_projection(t, x, modes) if modes is not None else dominant_mode(t, x)
+    warns.extend(est.warnings)
+    ie = float(integration_error)
+    terms = {"fit_growth": est.growth_rate_stderr, "fit_frequency": est.frequency_stderr, "integration": ie}
+    g_err = math.hypot(est.growth_rate_stderr, ie)
+    f_err = math.hypot(est.frequency_stderr, ie / (2 * math.pi))
+    regime = "unknown"
+    if modes is not None and math.isfinite(g_err) and math.isfinite(f_err):
+        lin = (abs(est.growth_rate - modes.leading.real) <= 3 * g_err
+               and abs(est.frequency_hz - modes.leading.imag / (2 * math.pi)) <= 3 * f_err)  # fmt: skip
+        regime = "linear" if lin else "nonlinear"
+    cc = None
+    if cross_check and modes is not None and math.isfinite(est.growth_rate):
+        try:
+            pen = dominant_mode(t, x, reference=est.eigenvalue, max_samples=512)
+        except Exception as exc:  # noqa: BLE001 - a failed cross-check is reported, never fatal
+            warns.append(f"matrix-pencil cross-check failed: {exc}")
+        else:
+            cc = {k: getattr(pen, k) for k in ("estimator", "growth_rate", "growth_rate_stderr", "frequency_hz",
+                                                "frequency_stderr", "window")}  # fmt: skip
+            # compare with the projection over the pencil's (shorter) window: the same samples, so only the
+            # fits' own uncertainties count (the growth rate of a nonlinear motion varies between windows)
+            inside = (t >= pen.window[0]) & (t <= pen.window[1])
+            ref = modal_projection(t[inside], x[inside], modes) if inside.sum() >= 16 else est
+            scale = 1e-9 * abs(est.eigenvalue)
+            if not (_agree(ref.growth_rate, ref.growth_rate_stderr, pen.growth_rate, pen.growth_rate_stderr, scale)
+                    and _agree(ref.frequency_hz, ref.frequency_stderr, pen.frequency_hz, pen.frequency_stderr,
+                               scale / (2 * math.pi))):  # fmt: skip
+                warns.append(
+                    f"the matrix-pencil cross-check over t = {pen.window[0]:.6g}..{pen.window[1]:.6g} s disagrees "
+                    f"with the projection: growth {pen.growth_rate:.6g} vs {ref.growth_rate:.6g} 1/s, frequency "
+                    f"{pen.frequency_hz:.8g} vs {ref.frequency_hz:.8g} Hz"
+                )
+    f_lead = max(abs(est.frequency_hz) if math.isfinite(est.frequency_hz) else 0.0, abs(lin_f or 0.0))
+    if output_rate is not None and f_lead > 0 and output_rate < 2 * f_lead:
+        warns.append(
+            f"the output sample rate {output_rate:.6g} Hz is below twice the leading frequency "
+            f"({f_lead:.6g} Hz): the output samples (NetCDF, WAV, plot) are aliased; "
+            f"the summary uses the integrator's dense output at {1 / (t[1] - t[0]):.6g} Hz"
+        )
+    # amplitudes from the same record
+    fs = 1.0 / float(t[1] - t[0])
+    per = int(2 * fs / f_lead) if f_lead > 0 else t.size // 10
+    per = max(min(per, t.size), 2)
+    norm = np.sqrt((x[:, :n] ** 2).sum(axis=1))
+    amp = float(norm[-per:].max())
+    lc = None
+    N = t.size
+    env = envelope(x[:, :n])[0] if status == "finished" and N > 400 and np.all(np.isfinite(x[:, :n])) else None
+    q, e = N // 4, N // 20
+    if env is not None and env[-q - e : -e].min() > 0:
+        seg_t, seg = t[-q - e : -e], env[-q - e : -e]
+        local = float(np.polyfit(seg_t, np.log(seg), 1)[0])
+        if x_start is not None and f_lead > 0:
+            xs = np.asarray(x_start, dtype=float)
+            a0 = math.sqrt(float((xs[:n] ** 2).sum()) + float((xs[n:] ** 2).sum()) / (2 * math.pi * f_lead) ** 2)
+        else:
+            a0 = float(env[N // 10])
+        if abs(local) * (seg_t[-1] - seg_t[0]) < 0.02 and seg.mean() > 1.5 * a0:
+            lc = float(seg.mean())
+    return Summary(status, est.frequency_hz, est.growth_rate, amp, lc, g_err, f_err, est.estimator, est.window,
+                   est.rate_hz, lin_g, lin_f, terms, regime, cc, tuple(warns))  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
@@ -169,6 +431,17 @@ class Trajectory:
     stats : dict
         ``nfev``, ``wall_s`` and (compiled method) ``steps``, ``rejected``.
     model : str
+    record : EstimationRecord or None
+        Dense output at a rate set by the linear frequencies (the last part
+        of a long run), from which :attr:`summary` is computed.
+    modes : LinearModes or None
+        Linear modes of the silent motion (state ``(q - q_m0, dq)``).
+    sample_rate : float
+        Rate of the output grid ``t`` [Hz].
+    y_start : ndarray or None
+        Initial state.
+    start : str
+        How the initial state was chosen.
     """
 
     status: str
@@ -189,6 +462,11 @@ class Trajectory:
     event_times: dict[str, list[float]] = field(default_factory=dict)
     stats: dict[str, Any] = field(default_factory=dict)
     model: str = "general-2dof"
+    record: EstimationRecord | None = None
+    modes: LinearModes | None = None
+    sample_rate: float = math.nan
+    y_start: np.ndarray | None = None
+    start: str = ""
 
     @property
     def success(self) -> bool:
@@ -251,26 +529,48 @@ class Trajectory:
 
     @cached_property
     def summary(self) -> Summary:
-        """Dominant frequency, growth rate, final and limit-cycle amplitude."""
-        n = self.t.size
-        nan = math.nan
-        if n < 16:
-            return Summary(self.status, nan, nan, nan if n == 0 else float(np.abs(self.dq).max()), None)
-        dq = self.dq
-        growth, freq = fit_growth_frequency(self.t, dq)
-        fs = 1.0 / (self.t[1] - self.t[0])
-        per = int(2 * fs / freq) if freq > 0 else n // 10
-        per = max(min(per, n), 2)
-        amp = float(np.sqrt((dq[-per:] ** 2).sum(axis=1)).max())
-        lc = None
-        if self.status == "finished" and n > 400:
-            env, _ = envelope(dq)
-            q = n // 4
-            seg_t, seg = self.t[-q - n // 20 : -n // 20], env[-q - n // 20 : -n // 20]
-            local = float(np.polyfit(seg_t, np.log(seg), 1)[0])
-            if abs(local) * (seg_t[-1] - seg_t[0]) < 0.02 and env[n // 10] < 0.9 * seg.mean():
-                lc = float(seg.mean())
-        return Summary(self.status, freq, growth, amp, lc)
+        """Growth rate and frequency of the leading mode with uncertainties, final and limit-cycle amplitude.
+
+        Computed by :func:`summarize` from :attr:`record` (the integrator's
+        dense output, independent of ``sample_rate``); without a record,
+        from the output grid (with a warning).
+        """
+        y_s = np.concatenate([self.q_m0, np.zeros(self.q_m0.size)])
+        x_start = None if self.y_start is None else self.y_start - y_s
+        if self.record is not None:
+            t, y = self.record.t, self.record.y
+            extra: tuple[str, ...] = ()
+        else:
+            t, y = self.t, self.y
+            extra = ("no estimation record: the summary uses the output samples",)
+        fs = self.sample_rate if math.isfinite(self.sample_rate) else None
+        s = summarize(self.status, t, y - y_s, self.modes, output_rate=fs, x_start=x_start,
+                      integration_error=self.integration_error_bound(t, y - y_s))  # fmt: skip
+        if extra:
+            s = replace(s, warnings=s.warnings + extra)
+        return s
+
+    def integration_error_bound(self, t: np.ndarray, x: np.ndarray) -> float:
+        """:func:`integration_error_bound` for this run over the samples ``x`` (deviations) at times ``t``.
+
+        Parameters
+        ----------
+        t : ndarray, shape (N,)
+            Sample times [s].
+        x : ndarray, shape (N, 4)
+            State deviations from the silent motion.
+
+        Returns
+        -------
+        float
+            Bound [1/s] (0 when the step count is unknown).
+        """
+        steps = self.stats.get("steps")
+        if steps is None:  # solve_ivp: estimate the steps from the RHS evaluations
+            steps = self.stats.get("nfev", 0) / _STAGES.get(self.method, 1)
+        dur = (float(self.t[-1]) if self.t.size else self.t_span[1]) - self.t_span[0]
+        y_s = np.concatenate([self.q_m0, np.zeros(self.q_m0.size)])
+        return integration_error_bound(x, x + y_s, self.rtol, self.atol, float(steps), dur)
 
     def spectrum(self) -> tuple[np.ndarray, np.ndarray]:
         """Hann-windowed amplitude spectrum of ``q1 - q10``: ``(frequency [Hz], |X|)``."""
@@ -340,7 +640,14 @@ class Trajectory:
             "event_times": json.dumps(self.event_times),
             "pad_treatment": "quasi-static massless pads: ldot = 0, g(q, qdot, l, 0) = 0",
         }  # fmt: skip
-        attrs.update({k: (math.nan if v is None else v) for k, v in self.summary.to_dict().items() if k != "status"})
+        for k, v in self.summary.to_dict().items():
+            if k == "status":
+                continue
+            if isinstance(v, dict) or (isinstance(v, list) and any(isinstance(u, str) for u in v)) or k == "warnings":
+                attrs[k] = json.dumps(v)
+            else:
+                attrs[k] = math.nan if v is None else (np.asarray(v, dtype=float) if isinstance(v, list) else v)
+        attrs["start"] = self.start
         ds = xr.Dataset(
             {
                 "q": (("time", "dof"), self.y[:, :2], {"units": "rad", "long_name": "tilt angles"}),
