@@ -185,7 +185,7 @@ def _generate(spec: Any) -> str:
     for e in res:
         jac.extend(se.Matrix([e]).jacobian(X))
     zero = {s: 0 for s in eq.x}
-    res0 = [se.sympify(e).subs(zero) for e in res]
+    res0 = _structural_zeros([se.sympify(e).subs(zero) for e in res], eq.params)
     jac0 = _structural_zeros([se.sympify(e).subs(zero) for e in jac], eq.params)
     scale0 = []
     for e in res0:

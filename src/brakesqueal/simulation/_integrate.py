@@ -75,7 +75,7 @@ class SimulationModel:
         """
         from ..analysis.linear import linearize
 
-        return linear_modes(linearize(params).A)
+        return linear_modes(linearize(params, pad_rates="quasi-static").A)  # the simulated pads are quasi-static
 
     def rhs(self, params: Parameters) -> Callable[[float, np.ndarray], np.ndarray]:
         """``f(t, y)`` for SciPy (solves the pad deformations on the way, warm-started)."""
