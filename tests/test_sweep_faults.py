@@ -30,6 +30,7 @@ import sys
 import threading
 import time
 import tracemalloc
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -267,7 +268,7 @@ def test_two_resumes_of_a_partial_store_exactly_one_computes(ref, tmp_path, monk
     assert_bit_identical(store, reference)
 
 
-def test_lock_stale_live_foreign_and_without_flock(tmp_path, monkeypatch):
+def test_lock_stale_live_foreign_and_without_flock(ref, tmp_path, monkeypatch):
     import brakesqueal.sweep.lock as lock_mod
 
     store = tmp_path / "l.zarr"
@@ -291,6 +292,7 @@ def test_lock_stale_live_foreign_and_without_flock(tmp_path, monkeypatch):
         with pytest.raises(StoreError, match=rf"is in use by PID {holder.pid} \(started "):
             StoreLock(store).acquire()
         assert lock_holder(store).pid == holder.pid
+        assert f"in use by PID {holder.pid} (started " in sweep_status(ref["grid"][0], store=store).text()
         # without flock (e.g. some network file systems) the PID decides: alive -> refused
         monkeypatch.setattr(lock_mod, "_flock", lambda fd: None)
         with pytest.raises(StoreError, match=f"PID {holder.pid}"):
@@ -362,7 +364,7 @@ KINDS = ["root-metadata", "data-metadata", "coord-metadata", "markers-metadata",
 @pytest.mark.parametrize("tag", ["grid", "samples"])
 @pytest.mark.parametrize("kind", KINDS + ["data-array", "markers-dir"])
 def test_damaged_file_status_then_resume(ref, tmp_path, monkeypatch, capsys, tag, kind):
-    rng = np.random.default_rng(abs(hash((tag, kind))) % 2**32)
+    rng = np.random.default_rng(zlib.crc32(f"{tag}/{kind}".encode()))
     f, reference = ref[tag]
     study = load_study(f)
     actions = ["delete"] if kind in ("data-array", "markers-dir") else ["delete", "corrupt"]
@@ -579,6 +581,8 @@ def test_read_only_store_complete_is_read_incomplete_is_refused(ref, tmp_path, m
         assert main(["sweep", str(f), "--out", str(ro / reference.name), "--format", "json"]) == 0
         out = json.loads(capsys.readouterr().out)
         assert out["computed_chunks"] == 0 and out["reused_chunks"] == load_study(f).n_chunks
+        assert main(["sweep", str(f), "--out", str(ro / reference.name), "--overwrite"]) == 2
+        one_line(capsys.readouterr().err, str(ro))
     with read_only_dir(tmp_path / "ro2", part) as ro:
         assert main(["sweep", str(f), "--out", str(ro / part.name)]) == 2
         one_line(capsys.readouterr().err, str(ro))
@@ -641,24 +645,28 @@ def test_oversize_studies_refused_before_allocating(tmp_path, capsys):
 def test_axis_resolution_refusal_agrees_with_distinct_values():
     """Ranges are refused only near the floating-point resolution; accepted ones have distinct values."""
     rng = np.random.default_rng(3)
+    eps = np.finfo(float).eps
     refused = 0
     for _ in range(200):
         log = rng.random() < 0.5
         start = float(10 ** rng.uniform(-3, 6)) * (1 if log or rng.random() < 0.5 else -1)
-        ulps = 10 ** rng.uniform(0, 4)  # range width in units of the last place
-        stop = start + ulps * float(np.spacing(abs(start))) * (abs(start) if log else 1) / (abs(start) if log else 1)
+        stop = start + 10 ** rng.uniform(0, 4) * float(np.spacing(abs(start)))  # 1 to 1e4 units of the last place
         num = int(rng.integers(2, 2000))
+        spec = {"start": start, "stop": stop, "num": num, "scale": "log" if log else "linear"}
+        if log:  # comfortably resolvable: the log-spaced step is far above the rounding of 10**t
+            t = max(1.0, abs(np.log10(start)), abs(np.log10(stop)))
+            clear = (np.log10(stop) - np.log10(start)) / (num - 1) > 64 * eps * (t + 1)
+        else:
+            clear = (stop - start) / (num - 1) > 64 * np.spacing(max(abs(start), abs(stop)))
         try:
-            st = load_study({"preset": "paper-fig2", "axes": {"k_ip": {"start": start, "stop": stop, "num": num,
-                                                                       "scale": "log" if log else "linear"}},
-                             "compute": {"quantities": ["stable"]}})
+            st = load_study({"preset": "paper-fig2", "axes": {"k_ip": spec}, "compute": {"quantities": ["stable"]}})
         except ParameterError as exc:
-            if "resolution" not in str(exc):
-                continue  # e.g. a log axis with a negative start
+            assert "floating-point resolution" in str(exc) and "key 'axes.k_ip.num'" in str(exc)
+            assert not clear, spec
             refused += 1
             continue
-        v = st.axes[0].values
-        assert np.all(np.diff(v) > 0), (start, stop, num, log)
+        v = st.axes[0].values  # independent check: np.linspace / np.logspace give distinct, increasing values
+        assert v.size == num and np.all(np.diff(v) > 0), spec
     assert refused > 20
 
 

@@ -403,7 +403,7 @@ def run_sweep(study: Any, *, store: str | Path | None = None, workers: int | Non
     try:
         lock.acquire()
     except _NotWritable as exc:
-        return _read_only(st, path, exc)
+        return _read_only(st, path, exc, overwrite)
     with contextlib.ExitStack() as stack:
         stack.callback(lock.release)
         try:
@@ -422,13 +422,13 @@ def run_sweep(study: Any, *, store: str | Path | None = None, workers: int | Non
                     write_chunk(g, path, st, c, res)
                     bar.update(st.chunk_points(c))
     if unwritable is not None:
-        return _read_only(st, path, unwritable)
+        return _read_only(st, path, unwritable, overwrite)
     return SweepRun(open_sweep(path), str(path), len(todo), len(good), repaired)
 
 
-def _read_only(st: Study, path: Path, exc: StoreError) -> SweepRun:
+def _read_only(st: Study, path: Path, exc: StoreError, overwrite: bool) -> SweepRun:
     """The store cannot be written: fine if it is complete (nothing to do), else raise ``exc``."""
-    if path.is_dir() and any(path.iterdir()):
+    if not overwrite and path.is_dir() and any(path.iterdir()):
         s = sweep_status(st, store=path)
         if s.complete:
             return SweepRun(open_sweep(path), str(path), 0, s.n_chunks)

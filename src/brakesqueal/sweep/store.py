@@ -55,8 +55,9 @@ from ..errors import BrakesquealError, ParameterError
 from .compute import FLOAT_QUANTITIES
 
 __all__ = ["StoreError", "MARKERS", "MANIFEST", "study_attrs", "variable_attrs", "coordinates", "create_store",
-           "prepare_store", "inspect_store", "check_skeleton", "read_manifest", "open_group", "write_chunk", "write_file", "completed_chunks",
-           "verified_chunks", "remove_store", "check_location", "check_writable", "checksum", "StoreCheck"]
+           "prepare_store", "inspect_store", "check_skeleton", "read_manifest", "open_group", "write_chunk",
+           "write_file", "completed_chunks", "verified_chunks", "remove_store", "check_location", "check_writable",
+           "checksum", "StoreCheck", "io_error"]
 
 MARKERS = "_sweep_chunks"
 MANIFEST = f"{MARKERS}/_creation.json"
@@ -422,7 +423,8 @@ def inspect_store(path: Path, study: Any) -> StoreCheck:
     else:
         want = {k: checksum(v) for k, v in coords.items()}
         if want != manifest["coordinates"]:
-            bad = sorted(k for k in set(want) | set(manifest["coordinates"]) if want.get(k) != manifest["coordinates"].get(k))
+            have = manifest["coordinates"]
+            bad = sorted(k for k in set(want) | set(have) if want.get(k) != have.get(k))
             raise StoreError(f"store '{path}': this installation computes coordinates {', '.join(bad)} of the study "
                              "differently from those stored (another SciPy/NumPy version?); results would not "
                              "match: pass --overwrite to recompute the store, or use the installation that made it")
