@@ -39,8 +39,8 @@ def sweep(
 ) -> None:
     """Run a parameter study in chunks (resumable) into a Zarr store; --status reports its progress."""
     from .errors import ParameterError
-    from .sweep import sweep as _sweep, sweep_status
-    from .sweep.runner import default_store
+    from .sweep import run_sweep, sweep_status
+    from .sweep.runner import check_scheduler_address, default_store
     from .sweep.study import load_study
 
     st = load_study(study)
@@ -48,23 +48,25 @@ def sweep(
         s = sweep_status(st, store=out)
         sys.stdout.write(json.dumps(s.to_dict(), indent=2) + "\n" if fmt == _Fmt.json else s.text())
         return
+    if scheduler is not None:
+        scheduler = check_scheduler_address(scheduler)
     store = Path(out) if out else default_store(st)
     if store is None:  # pragma: no cover - a file study always has a default store
         raise ParameterError("no store: give --out")
-    before = sweep_status(st, store=store) if store.exists() and not overwrite else None
     show = sys.stderr.isatty() if progress is None else progress
-    ds = _sweep(st, store=store, workers=workers, scheduler=scheduler, overwrite=overwrite, progress=show)
-    reused = len(before.completed) if before else 0
+    run = run_sweep(st, store=store, workers=workers, scheduler=scheduler, overwrite=overwrite, progress=show)
+    ds = run.dataset
     stable = float(ds["stable"].mean().compute())
     dims = " x ".join(f"{k}={v}" for k, v in zip(st.dims, st.shape))
     summary = {"store": str(store), "dims": dict(zip(st.dims, st.shape)), "points": st.n_points,
-               "chunks": st.n_chunks, "computed_chunks": st.n_chunks - reused, "reused_chunks": reused,
-               "stable_fraction": stable, "variables": list(ds.data_vars)}
+               "chunks": st.n_chunks, "computed_chunks": run.computed, "reused_chunks": run.reused,
+               "repaired": run.repaired, "stable_fraction": stable, "variables": list(ds.data_vars)}
     if fmt == _Fmt.json:
         sys.stdout.write(json.dumps(summary, indent=2) + "\n")
     else:
+        fixed = f"; repaired: {'; '.join(run.repaired)}" if run.repaired else ""
         sys.stdout.write(f"wrote {store}: {dims} ({st.n_points} points, {st.n_chunks} chunks: "
-                         f"{st.n_chunks - reused} computed, {reused} reused); {100 * stable:.1f}% stable\n")
+                         f"{run.computed} computed, {run.reused} reused{fixed}); {100 * stable:.1f}% stable\n")
 
 
 def bench_sweep(

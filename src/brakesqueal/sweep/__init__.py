@@ -3,7 +3,8 @@
 * :func:`sweep` — run a study (in-process, ``workers=N`` local Dask cluster,
   ``scheduler=ADDRESS`` or ``client=``) into a Zarr store and return an
   :class:`xarray.Dataset` with named dimensions;
-* :func:`sweep_status` — completed / missing / corrupt chunks of a store;
+* :func:`run_sweep` — the same, also reporting computed / reused chunks and repairs;
+* :func:`sweep_status` — completed / missing / corrupt chunks of a store, damage, lock holder;
 * :func:`load_study` / :class:`Study` — the validated study file;
 * :func:`open_sweep` — open a store.
 
@@ -12,7 +13,9 @@ See ``docs/sweeps.md`` for the study-file format.
 
 from __future__ import annotations
 
-from .runner import SweepStatus, open_sweep, sweep, sweep_status
+from .runner import SweepRun, SweepStatus, open_sweep, run_sweep, sweep, sweep_status
+from .store import StoreError
 from .study import QUANTITIES, Study, load_study
 
-__all__ = ["QUANTITIES", "Study", "SweepStatus", "load_study", "open_sweep", "sweep", "sweep_status"]
+__all__ = ["QUANTITIES", "Study", "StoreError", "SweepRun", "SweepStatus", "load_study", "open_sweep", "run_sweep",
+           "sweep", "sweep_status"]

@@ -10,8 +10,10 @@ complete (:mod:`.store`).
 from __future__ import annotations
 
 import contextlib
+import json
 import logging
 import math
+import re
 import sys
 import time
 from collections.abc import Iterator
@@ -23,10 +25,17 @@ import numpy as np
 
 from ..errors import ParameterError
 from .compute import FLOAT_QUANTITIES, ChunkSpec, compute_chunk
-from .store import open_store, study_attrs, variable_attrs, verified_chunks, write_chunk
+from .lock import StoreLock, lock_holder
+from .store import (StoreError, _NotWritable, check_location, check_skeleton, check_writable,
+                    inspect_store, open_group, prepare_store, read_manifest, study_attrs, variable_attrs,
+                    verified_chunks, write_chunk)
 from .study import Study, load_study
 
-__all__ = ["sweep", "sweep_status", "open_sweep", "SweepStatus", "default_store", "local_cluster"]
+__all__ = ["sweep", "run_sweep", "sweep_status", "open_sweep", "SweepRun", "SweepStatus", "default_store",
+           "local_cluster", "check_scheduler_address"]
+
+#: Largest result (bytes) of a study computed in memory (no store).
+_MAX_IN_MEMORY = 2 * 10**9
 
 _WORKER_ENV = {"OMP_WAIT_POLICY": "passive", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
                "MKL_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1"}
@@ -85,31 +94,127 @@ def _hms(s: float) -> str:
 
 
 # ---------------------------------------------------------------- executors
+_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
+_HOST = re.compile(r"^(\[[0-9A-Fa-f:.%a-zA-Z]+\]|[A-Za-z0-9_]([A-Za-z0-9_.-]*[A-Za-z0-9_])?)$")
+
+
+def check_scheduler_address(address: Any) -> str:
+    """Validate a Dask scheduler address without connecting; return it (``HOST:PORT`` gets ``tcp://``).
+
+    Parameters
+    ----------
+    address : str
+        ``tcp://HOST:PORT`` (or ``tls://``, ``ws://``, ``wss://``, ``ucx://``,
+        ``inproc://...``), or ``HOST:PORT``.
+
+    Returns
+    -------
+    str
+        The address with its protocol.
+
+    Raises
+    ------
+    ParameterError
+        One line naming the address and the expected form.
+    """
+    form = "expected tcp://HOST:PORT (e.g. tcp://10.0.0.5:8786; also tls://, ws://, wss://, ucx://)"
+    if not isinstance(address, str) or not address.strip():
+        raise ParameterError(f"--scheduler: {address!r} is not a scheduler address; {form}")
+    a = address.strip()
+    scheme, sep, loc = a.partition("://")
+    if not sep:
+        scheme, loc = "tcp", a
+    scheme = scheme.lower()
+    if scheme not in _SCHEMES:
+        raise ParameterError(f"--scheduler: unknown protocol '{scheme}' in {address!r}; {form}")
+    if scheme == "inproc":
+        if not loc:
+            raise ParameterError(f"--scheduler: {address!r} is not a scheduler address; {form}")
+        return f"inproc://{loc}"
+    if loc.startswith("["):
+        host, _, rest = loc.partition("]")
+        host += "]"
+        port = rest[1:] if rest.startswith(":") else ""
+    else:
+        host, _, port = loc.rpartition(":")
+    if not host or not _HOST.match(host) or not port.isdigit() or not 0 < int(port) < 65536:
+        raise ParameterError(f"--scheduler: {address!r} is not a scheduler address; {form}")
+    return f"{scheme}://{host}:{int(port)}"
+
+
+@contextlib.contextmanager
+def _quiet(logger: str) -> Iterator[None]:
+    log = logging.getLogger(logger)
+    level = log.level
+    log.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        log.setLevel(level)
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
+def _probe_scheduler(address: str, timeout: float) -> None:
+    """Open (and close) one connection to the scheduler with the Dask handshake, within ``timeout`` seconds."""
+    import asyncio
+    from concurrent.futures import ThreadPoolExecutor
+
+    from distributed.comm import connect
+    from distributed.security import Security
+
+    async def probe() -> None:
+        comm = await asyncio.wait_for(connect(address, timeout=timeout, **Security().get_connection_args("client")),
+                                      timeout + 1.0)
+        await comm.close()
+
+    with _quiet("distributed"), ThreadPoolExecutor(1) as pool:  # own thread: works inside a running event loop too
+        try:
+            pool.submit(asyncio.run, probe()).result()
+        except (OSError, TimeoutError) as exc:
+            why = _first_line(exc)
+        except Exception as exc:  # noqa: BLE001 - e.g. MemoryError reading a non-Dask server's bytes as a frame
+            why = f"the server does not answer like a Dask scheduler ({type(exc).__name__})"
+        else:
+            return
+    raise ParameterError(f"cannot reach the Dask scheduler at '{address}' within {timeout:g} s: {why}")
+
+
+def _check_executor(workers: Any, scheduler: Any, client: Any) -> str | None:
+    """Validate the executor options before anything else happens; return the scheduler address."""
+    if sum(x is not None for x in (workers, scheduler, client)) > 1:
+        raise ParameterError("give at most one of --workers, --scheduler (or client=)")
+    if workers is not None and (not isinstance(workers, int) or isinstance(workers, bool) or workers < 1):
+        raise ParameterError(f"--workers must be a positive integer; got {workers!r}")
+    return check_scheduler_address(scheduler) if scheduler is not None else None
+
+
 @contextlib.contextmanager
 def _client(workers: int | None, scheduler: str | None, client: Any, timeout: float) -> Iterator[Any]:
     """``None`` (in-process) or a ``distributed.Client``."""
-    if sum(x is not None for x in (workers, scheduler, client)) > 1:
-        raise ParameterError("give at most one of --workers, --scheduler (or client=)")
+    scheduler = _check_executor(workers, scheduler, client)
     if client is not None:
         yield client
         return
     if scheduler is not None:
         from distributed import Client
 
+        _probe_scheduler(scheduler, timeout)
         try:
-            c = Client(scheduler, timeout=f"{timeout}s", set_as_default=False)
-        except (OSError, TimeoutError, ValueError, TypeError) as exc:
-            msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            with _quiet("distributed"):
+                c = Client(scheduler, timeout=f"{timeout}s", set_as_default=False)
+        except Exception as exc:  # noqa: BLE001 - one line, whatever distributed raises
             raise ParameterError(f"cannot reach the Dask scheduler at '{scheduler}' within {timeout:g} s: "
-                                 f"{msg}") from None
+                                 f"{_first_line(exc)}") from None
         try:
             yield c
         finally:
             c.close()
         return
     if workers is not None:
-        if not isinstance(workers, int) or workers < 1:
-            raise ParameterError(f"--workers must be a positive integer; got {workers!r}")
         from distributed import Client
 
         cluster = local_cluster(workers)
@@ -181,6 +286,29 @@ def _results(study: Study, spec: ChunkSpec, todo: list[int], client: Any) -> Ite
 
 
 # ---------------------------------------------------------------- API
+@dataclass
+class SweepRun:
+    """What :func:`run_sweep` did.
+
+    Attributes
+    ----------
+    dataset : xarray.Dataset
+        The results (lazily backed by the store when there is one).
+    store : str or None
+        The store (None: computed in memory).
+    computed, reused : int
+        Chunks computed by this run / verified and kept from earlier runs.
+    repaired : list of str
+        Damage of the store's metadata or coordinates that was found and rewritten.
+    """
+
+    dataset: Any
+    store: str | None
+    computed: int
+    reused: int
+    repaired: list[str] = field(default_factory=list)
+
+
 def sweep(study: Any, *, store: str | Path | None = None, workers: int | None = None, scheduler: str | None = None,
           client: Any = None, overwrite: bool = False, progress: bool | TextIO = False,
           scheduler_timeout: float = 5.0) -> Any:
@@ -217,30 +345,105 @@ def sweep(study: Any, *, store: str | Path | None = None, workers: int | None = 
     Raises
     ------
     ParameterError
-        Bad study, unreachable scheduler, or a store of a different study.
+        Bad study or options, unreachable scheduler, or a store of a different study.
+    StoreError
+        The store is in use by another run, cannot be written (checked before
+        anything is computed), runs out of space, or is damaged beyond repair.
+    """
+    return run_sweep(study, store=store, workers=workers, scheduler=scheduler, client=client, overwrite=overwrite,
+                     progress=progress, scheduler_timeout=scheduler_timeout).dataset
+
+
+def run_sweep(study: Any, *, store: str | Path | None = None, workers: int | None = None,
+              scheduler: str | None = None, client: Any = None, overwrite: bool = False,
+              progress: bool | TextIO = False, scheduler_timeout: float = 5.0) -> SweepRun:
+    """Run a parameter study as :func:`sweep` does, and report what was computed, reused and repaired.
+
+    The order is: the study and the executor options are validated; the store
+    location is checked and the store's lock taken (nothing is computed if the
+    store cannot be written or another run holds it); the executor is started;
+    the store is created atomically, or verified and repaired; the missing
+    chunks are computed and written.
+
+    Parameters
+    ----------
+    study : str, Path, dict or Study
+        As for :func:`sweep`.
+    store : str or Path, optional
+        As for :func:`sweep`.
+    workers : int, optional
+        As for :func:`sweep`.
+    scheduler : str, optional
+        As for :func:`sweep`.
+    client : distributed.Client, optional
+        As for :func:`sweep`.
+    overwrite : bool
+        As for :func:`sweep`.
+    progress : bool or text stream
+        As for :func:`sweep`.
+    scheduler_timeout : float
+        As for :func:`sweep`.
+
+    Returns
+    -------
+    SweepRun
+        The dataset and the counts of computed / reused chunks.
     """
     st = load_study(study)
+    _check_executor(workers, scheduler, client)
     path = Path(store) if store is not None else default_store(st)
     spec = ChunkSpec.from_study(st)
     stream = sys.stderr if progress is True else (progress or None)
     if path is None:
-        return _in_memory(st, spec, workers, scheduler, client, stream, scheduler_timeout)
+        ds = _in_memory(st, spec, workers, scheduler, client, stream, scheduler_timeout)
+        return SweepRun(ds, None, st.n_chunks, 0)
     path = path.resolve()
-    with _client(workers, scheduler, client, scheduler_timeout) as cl:
-        g = open_store(path, st, overwrite=overwrite)
-        good, _ = verified_chunks(g, path, st)
-        todo = [c for c in range(st.n_chunks) if c not in good]
-        bar = _Progress(st, todo, len(good), stream)
-        for c, res in _results(st, spec, todo, cl):
-            write_chunk(g, path, st, c, res)
-            bar.update(st.chunk_points(c))
-    return open_sweep(path)
+    check_location(path)
+    lock = StoreLock(path)
+    try:
+        lock.acquire()
+    except _NotWritable as exc:
+        return _read_only(st, path, exc, overwrite)
+    with contextlib.ExitStack() as stack:
+        stack.callback(lock.release)
+        try:
+            if path.exists():
+                check_writable(path)
+        except _NotWritable as exc:
+            unwritable: _NotWritable | None = exc
+        else:
+            unwritable = None
+            with _client(workers, scheduler, client, scheduler_timeout) as cl:
+                g, repaired = prepare_store(path, st, overwrite=overwrite)
+                good, _ = verified_chunks(g, path, st)
+                todo = [c for c in range(st.n_chunks) if c not in good]
+                bar = _Progress(st, todo, len(good), stream)
+                for c, res in _results(st, spec, todo, cl):
+                    write_chunk(g, path, st, c, res)
+                    bar.update(st.chunk_points(c))
+    if unwritable is not None:
+        return _read_only(st, path, unwritable, overwrite)
+    return SweepRun(open_sweep(path), str(path), len(todo), len(good), repaired)
+
+
+def _read_only(st: Study, path: Path, exc: StoreError, overwrite: bool) -> SweepRun:
+    """The store cannot be written: fine if it is complete (nothing to do), else raise ``exc``."""
+    if not overwrite and path.is_dir() and any(path.iterdir()):
+        s = sweep_status(st, store=path)
+        if s.complete:
+            return SweepRun(open_sweep(path), str(path), 0, s.n_chunks)
+    raise exc
 
 
 def _in_memory(st: Study, spec: ChunkSpec, workers: Any, scheduler: Any, client: Any, stream: Any,
                timeout: float) -> Any:
     import xarray as xr
 
+    per_point = 2 + 8 * sum(q in st.quantities for q in FLOAT_QUANTITIES)
+    if per_point * st.n_points > _MAX_IN_MEMORY:
+        raise ParameterError(f"study '{st.source}' has no store, so its results are kept in memory: "
+                             f"{st.n_points} points need {per_point * st.n_points / 1e9:.3g} GB, more than the "
+                             f"limit of {_MAX_IN_MEMORY / 1e9:g} GB; give a store (store= or [output] store)")
     data: dict[str, np.ndarray] = {"stable": np.zeros(st.shape, bool), "status": np.full(st.shape, -1, np.int8)}
     data.update({q: np.full(st.shape, np.nan) for q in FLOAT_QUANTITIES if q in st.quantities})
     todo = list(range(st.n_chunks))
@@ -269,25 +472,46 @@ def _units(name: str) -> str:
     return u(name)
 
 
-def open_sweep(store: str | Path) -> Any:
+def open_sweep(store: str | Path, *, verify: bool = True) -> Any:
     """Open a study's Zarr store as a lazily loaded :class:`xarray.Dataset`.
 
     Parameters
     ----------
     store : str or Path
         The store directory written by :func:`sweep`.
+    verify : bool
+        Check the store's metadata and coordinates against its creation
+        record first (cheap: data chunks are verified by :func:`sweep_status`).
 
     Returns
     -------
     xarray.Dataset
         Variables ``stable``, ``status`` and the computed quantities first.
+
+    Raises
+    ------
+    ParameterError
+        ``store`` is not a sweep store.
+    StoreError
+        Its metadata or coordinates are damaged (running the study again repairs them).
     """
     import xarray as xr
 
     p = Path(store)
     if not (p / "zarr.json").is_file():
         raise ParameterError(f"'{p}' is not a sweep store (no zarr.json)")
-    ds = xr.open_zarr(str(p), consolidated=False)
+    manifest = read_manifest(p)
+    if verify and manifest is not None:
+        problems = check_skeleton(p, manifest).problems
+        if problems:
+            raise StoreError(f"store '{p}' is damaged ({'; '.join(problems)}); run its study again "
+                             "(brakesqueal sweep STUDY --out STORE) to repair it")
+    try:
+        root = json.loads((p / "zarr.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        raise StoreError(f"store '{p}' is damaged (metadata zarr.json unreadable); run its study again "
+                         "to repair it") from None
+    ds = xr.open_zarr(str(p), consolidated="consolidated_metadata" in root)
     order = ["stable", "status", *[q for q in FLOAT_QUANTITIES if q in ds.data_vars]]
     return ds[order + [v for v in ds.data_vars if v not in order]]
 
@@ -295,7 +519,7 @@ def open_sweep(store: str | Path) -> Any:
 # ---------------------------------------------------------------- status
 @dataclass
 class SweepStatus:
-    """Completed and missing chunks of a study's store.
+    """Completed and missing chunks of a study's store, and any damage found.
 
     Attributes
     ----------
@@ -316,6 +540,11 @@ class SweepStatus:
         but whose data do not match it (recomputed on resume; also in ``missing``).
     version : str or None
         The brakesqueal version that created the store.
+    damaged : list of str
+        Damaged or missing metadata, coordinates or creation record (rewritten
+        on resume; a damaged store is not complete).
+    in_use : str or None
+        The live run that holds the store's lock (``PID n (started ...)``), if any.
     """
 
     store: str
@@ -328,10 +557,12 @@ class SweepStatus:
     missing: list[int] = field(default_factory=list)
     corrupt: list[int] = field(default_factory=list)
     version: str | None = None
+    damaged: list[str] = field(default_factory=list)
+    in_use: str | None = None
 
     @property
     def complete(self) -> bool:
-        return not self.missing
+        return not self.missing and not self.damaged
 
     def to_dict(self) -> dict[str, Any]:
         d = asdict(self)
@@ -345,11 +576,15 @@ class SweepStatus:
                  + f" ({pts} points), chunks of {tuple(self.chunk_shape)}"]
         if self.version:
             lines.append(f"written by brakesqueal {self.version}")
+        if self.in_use:
+            lines.append(f"in use by {self.in_use}")
         lines.append(f"completed: {len(self.completed)}/{self.n_chunks} chunks "
                      f"({100 * len(self.completed) / max(self.n_chunks, 1):.1f} %)")
         lines.append(f"missing: {len(self.missing)}" + (f" [{_ranges(self.missing)}]" if self.missing else ""))
         if self.corrupt:
             lines.append(f"corrupt (will be recomputed): {len(self.corrupt)} [{_ranges(self.corrupt)}]")
+        if self.damaged:
+            lines.append(f"damaged (will be repaired on resume): {'; '.join(self.damaged)}")
         return "\n".join(lines) + "\n"
 
 
@@ -379,22 +614,28 @@ def sweep_status(study: Any, *, store: str | Path | None = None) -> SweepStatus:
     -------
     SweepStatus
         ``.text()`` / ``.to_dict()`` render it.
+
+    Raises
+    ------
+    ParameterError
+        The path is not a sweep store, or holds a different study.
+    StoreError
+        The store is damaged beyond repair.
     """
-    import zarr
-
-    from .store import _existing, check_study
-
     st = load_study(study)
     path = Path(store) if store is not None else default_store(st)
     if path is None:
         raise ParameterError("the study has no store: give store= or [output] store")
+    path = path.resolve()
     dims = dict(zip(st.dims, st.shape))
-    base = dict(store=str(path), study_hash=st.hash(), dims=dims, chunk_shape=list(st.chunks), n_chunks=st.n_chunks)
-    if not path.exists():
+    holder = lock_holder(path)
+    base = dict(store=str(path), study_hash=st.hash(), dims=dims, chunk_shape=list(st.chunks), n_chunks=st.n_chunks,
+                in_use=holder.describe() if holder else None)
+    if not path.exists() or (path.is_dir() and not any(path.iterdir())):
         return SweepStatus(exists=False, missing=list(range(st.n_chunks)), **base)
-    check_study(_existing(path), path, st)
-    g = zarr.open_group(str(path), mode="r", zarr_format=3)
-    good, bad = verified_chunks(g, path, st, remove_bad=False)
+    check = inspect_store(path, st)
+    g = open_group(path, check.manifest, read_only=True)
+    good, bad = verified_chunks(g, path, st)
     return SweepStatus(exists=True, completed=sorted(good), corrupt=sorted(bad),
                        missing=[c for c in range(st.n_chunks) if c not in good],
-                       version=g.attrs.get("brakesqueal_version"), **base)
+                       version=check.manifest.get("brakesqueal_version"), damaged=check.problems, **base)

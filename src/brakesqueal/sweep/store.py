@@ -1,40 +1,76 @@
-"""The Zarr result store of a study: layout, provenance, per-chunk completion markers, verification.
+"""The Zarr result store of a study: layout, creation record, verification, repair, completion markers.
 
 Layout (Zarr format 3, one directory)::
 
-    STORE/zarr.json                 group; attributes: study text, study hash, package version, ...
+    STORE/zarr.json                 group; attributes: study text, study hash, package version, ...;
+                                    consolidated metadata of every node
     STORE/<dim>/                    coordinates (grid axes, or ``sample`` + sampled names)
     STORE/stable, status, ...       data variables, chunked exactly like the study
     STORE/_sweep_chunks/<id>.json   completion marker of chunk ``id``: its region and the
                                     BLAKE2b checksum of every variable's values
+    STORE/_sweep_chunks/_creation.json
+                                    creation record: the exact metadata (``zarr.json``) of every
+                                    node and the checksum of every coordinate array
 
-A chunk's data are written first and its marker last (temporary file +
-``os.replace``, so a marker is either complete or absent).  On resume every
-marker is verified by reading the chunk back and comparing checksums; a chunk
-whose data are truncated, corrupt or missing is recomputed.  Only the process
-that runs :func:`~brakesqueal.sweep.sweep` writes to the store.
+**Creation is atomic.**  The skeleton (metadata, coordinates, consolidated
+metadata, creation record last) is built in a hidden sibling directory
+``.STORE.creating-*`` and renamed into place, so a store either does not exist
+or is complete; an interrupted creation leaves only the sibling, removed by
+the next run.
+
+**Every array is verified.**  Metadata and coordinates are checked against the
+creation record (coordinates are also recomputed from the study and compared),
+data chunks against their markers.  Damaged metadata or coordinates are
+rewritten (they follow from the study); damaged data chunks are recomputed.
+All reads use the metadata of the creation record, so a deleted or damaged
+``zarr.json`` on disk never changes what is read.  A marker is only ever
+replaced by a newer one (never deleted), so a failed run never loses
+completed chunks.
+
+**Writes are atomic per file** (:func:`write_file`: temporary file +
+``os.replace``): data chunks first, the chunk's marker last.  Only the process
+that holds the store's lock (:mod:`.lock`) writes.
 """
 
 from __future__ import annotations
 
+import asyncio
+import errno
 import hashlib
 import json
 import os
 import shutil
+import tempfile
 import time
+import uuid
+import warnings
+from contextlib import suppress
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import BrakesquealError, ParameterError
 from .compute import FLOAT_QUANTITIES
 
-__all__ = ["MARKERS", "study_attrs", "variable_attrs", "create_store", "open_store", "write_chunk", "completed_chunks", "verified_chunks",
-           "remove_store", "checksum"]
+__all__ = ["StoreError", "MARKERS", "MANIFEST", "study_attrs", "variable_attrs", "coordinates", "create_store",
+           "prepare_store", "inspect_store", "check_skeleton", "read_manifest", "open_group", "write_chunk",
+           "write_file", "completed_chunks", "verified_chunks", "remove_store", "check_location", "check_writable",
+           "checksum", "StoreCheck", "io_error"]
 
 MARKERS = "_sweep_chunks"
+MANIFEST = f"{MARKERS}/_creation.json"
+_FORMAT = "brakesqueal-sweep-store/1"
 _STATUS_MEANINGS = "not_computed ok ok_nontrivial_silent_motion no_silent_motion pad_loses_contact invalid_parameters"
+
+
+class StoreError(BrakesquealError):
+    """A sweep store cannot be created, locked, read, repaired or written (one line naming the store)."""
+
+
+class _NotWritable(StoreError):
+    """The store's location cannot be written (a complete store may still be read)."""
 
 
 def _units(name: str) -> str:
@@ -58,6 +94,100 @@ def _compressor() -> Any:
     return ZstdCodec(level=1, checksum=True)
 
 
+# ---------------------------------------------------------------- errors
+_WHY = {errno.ENOSPC: "no space left on device", errno.EDQUOT: "disk quota exceeded",
+        errno.EROFS: "read-only file system", errno.EACCES: "permission denied", errno.EPERM: "permission denied"}
+
+
+def io_error(exc: OSError, doing: str, path: Path, *, resume: bool = True) -> StoreError:
+    """One-line :class:`StoreError` for an I/O error while ``doing`` something to the store ``path``."""
+    why = _WHY.get(exc.errno or 0) or (exc.strerror or str(exc) or type(exc).__name__).lower()
+    tail = "; completed chunks are kept: fix this and run the same command again to resume" if resume else ""
+    cls = _NotWritable if exc.errno in (errno.EROFS, errno.EACCES, errno.EPERM) else StoreError
+    return cls(f"{why} while {doing} of store '{path}'{tail}")
+
+
+# ---------------------------------------------------------------- file writes
+def write_file(path: Path, data: Any) -> None:
+    """Write ``data`` (bytes-like) to ``path`` atomically: a temporary sibling file, then ``os.replace``.
+
+    Every file of a store is written through this function (Zarr chunks and
+    metadata via the store class, markers and the creation record directly).
+    """
+    tmp = path.parent / f".{path.name}.{uuid.uuid4().hex[:12]}.partial"
+    try:
+        with open(tmp, "wb") as f:
+            f.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        with suppress(OSError):
+            tmp.unlink()
+        raise
+
+
+def _zarr_store_class() -> type:
+    from zarr.core.buffer import default_buffer_prototype
+    from zarr.storage import LocalStore
+
+    class SweepZarrStore(LocalStore):
+        """LocalStore writing through :func:`write_file`, optionally reading ``zarr.json`` from a fixed record."""
+
+        def __init__(self, root: Any, *, read_only: bool = False, metadata: dict[str, str] | None = None) -> None:
+            super().__init__(root, read_only=read_only)
+            self.metadata = metadata or {}
+
+        def with_read_only(self, read_only: bool = False) -> Any:
+            return type(self)(self.root, read_only=read_only, metadata=self.metadata)
+
+        def _pinned(self, key: str, prototype: Any) -> Any:
+            return (prototype or default_buffer_prototype()).buffer.from_bytes(self.metadata[key].encode())
+
+        async def get(self, key: str, prototype: Any = None, byte_range: Any = None) -> Any:
+            if key in self.metadata and byte_range is None:
+                return self._pinned(key, prototype)
+            return await super().get(key, prototype, byte_range)
+
+        def get_sync(self, key: str, *, prototype: Any = None, byte_range: Any = None) -> Any:
+            if key in self.metadata and byte_range is None:
+                return self._pinned(key, prototype)
+            return super().get_sync(key, prototype=prototype, byte_range=byte_range)
+
+        def _put(self, key: str, value: Any, exclusive: bool) -> None:
+            self._check_writable()
+            path = self.root / key
+            if exclusive and path.exists():
+                raise FileExistsError(str(path))
+            path.parent.mkdir(parents=True, exist_ok=True)
+            write_file(path, value.as_buffer_like())
+
+        async def set(self, key: str, value: Any) -> None:
+            if not self._is_open:
+                await self._open()
+            await asyncio.to_thread(self._put, key, value, False)
+
+        async def set_if_not_exists(self, key: str, value: Any) -> None:
+            if not self._is_open:
+                await self._open()
+            with suppress(FileExistsError):
+                await asyncio.to_thread(self._put, key, value, True)
+
+        def set_sync(self, key: str, value: Any) -> None:
+            self._ensure_open_sync()
+            self._put(key, value, False)
+
+    return SweepZarrStore
+
+
+_STORE_CLASS: list[type] = []
+
+
+def _zstore(root: Path, *, read_only: bool = False, metadata: dict[str, str] | None = None) -> Any:
+    if not _STORE_CLASS:
+        _STORE_CLASS.append(_zarr_store_class())
+    return _STORE_CLASS[0](root, read_only=read_only, metadata=metadata)
+
+
+# ---------------------------------------------------------------- attributes and coordinates
 def study_attrs(study: Any) -> dict[str, Any]:
     """Provenance attributes stored with the results (study text and hash, package version, ...)."""
     from .. import __version__
@@ -91,29 +221,40 @@ def variable_attrs(study: Any) -> dict[str, dict[str, Any]]:
     return out
 
 
-def create_store(path: Path, study: Any) -> Any:
-    """Create the store: metadata, coordinates and empty (fill-valued) variables."""
+def coordinates(study: Any) -> dict[str, np.ndarray]:
+    """The coordinate arrays of a study's store (recomputed from the study): name -> values."""
+    if study.kind == "grid":
+        return {ax.name: ax.values for ax in study.axes}
+    return {"sample": np.arange(study.n_samples, dtype=np.int64), **study.samples()}
+
+
+# ---------------------------------------------------------------- creation
+def _build_skeleton(root: Path, study: Any, attrs: dict[str, Any], *, write_coordinates: bool = True) -> dict[str, Any]:
+    """Create the store skeleton at ``root`` (must not exist); return its creation record (also written last)."""
     import zarr
 
     dims, shape, chunks = study.dims, study.shape, study.chunks
-    attrs = study_attrs(study)
-    g = zarr.open_group(str(path), mode="w-", zarr_format=3, attributes=attrs)
+    coords = coordinates(study)
+    store = _zstore(root)
+    g = zarr.open_group(store=store, mode="w-", zarr_format=3, attributes=attrs)
     if study.kind == "grid":
         for ax in study.axes:
             a = g.create_array(ax.name, shape=(ax.size,), dtype="f8", chunks=(ax.size,), dimension_names=(ax.name,),
                                attributes={"units": _units(ax.name), "scale": ax.scale})
-            a[:] = ax.values
+            if write_coordinates:
+                a[:] = coords[ax.name]
     else:
         n = study.n_samples
         a = g.create_array("sample", shape=(n,), dtype="i8", chunks=(chunks[0],), dimension_names=("sample",),
                            attributes={"long_name": "sample number"})
-        a[:] = np.arange(n)
-        for name, vals in study.samples().items():
-            r = next(r for r in study.ranges if r.name == name)
-            a = g.create_array(name, shape=(n,), dtype="f8", chunks=(chunks[0],), dimension_names=("sample",),
-                               attributes={"units": _units(name), "scale": "log" if r.log else "linear",
+        if write_coordinates:
+            a[:] = coords["sample"]
+        for r in study.ranges:
+            a = g.create_array(r.name, shape=(n,), dtype="f8", chunks=(chunks[0],), dimension_names=("sample",),
+                               attributes={"units": _units(r.name), "scale": "log" if r.log else "linear",
                                            "sampling": f"{study.method} seed={study.seed}"})
-            a[:] = vals
+            if write_coordinates:
+                a[:] = coords[r.name]
     va = variable_attrs(study)
     comp = _compressor()
     g.create_array("stable", shape=shape, dtype="bool", chunks=chunks, dimension_names=dims, fill_value=False,
@@ -125,114 +266,395 @@ def create_store(path: Path, study: Any) -> Any:
             g.create_array(q, shape=shape, dtype="f8", chunks=chunks, dimension_names=dims, fill_value=np.nan,
                            compressors=comp, attributes=va[q])
     g.create_group(MARKERS, attributes={"description": "completion markers: <chunk>.json, written after the data"})
-    return g
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=".*[Cc]onsolidated metadata.*")
+        zarr.consolidate_metadata(store)
+    nodes = {p.relative_to(root).as_posix(): p.read_text(encoding="utf-8") for p in sorted(root.rglob("zarr.json"))}
+    manifest = {"format": _FORMAT, "study_hash": study.hash(), "created": attrs.get("created"),
+                "brakesqueal_version": attrs.get("brakesqueal_version"), "variables": _variables(study),
+                "coordinates": {k: checksum(v) for k, v in coords.items()}, "nodes": nodes}
+    write_file(root / MANIFEST, _record_bytes(manifest))
+    return manifest
 
 
-def open_store(path: Path, study: Any, *, overwrite: bool) -> Any:
-    """Open the store of ``study`` at ``path``, creating it if needed.
+def _record_sum(manifest: dict[str, Any]) -> str:
+    body = {k: v for k, v in manifest.items() if k != "record_sha256"}
+    return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
 
-    Raises ParameterError (one line, naming the store) if ``path`` holds
-    something else, or results of a different study, unless ``overwrite``.
+
+def _record_bytes(manifest: dict[str, Any]) -> bytes:
+    """The creation record as written: its content plus a SHA-256 of that content (so damage is detected)."""
+    return json.dumps({**manifest, "record_sha256": _record_sum(manifest)}, indent=1).encode()
+
+
+def _siblings(path: Path, kind: str) -> list[Path]:
+    try:
+        return [p for p in path.parent.iterdir() if p.name.startswith(f".{path.name}.{kind}-")]
+    except OSError:
+        return []
+
+
+def create_store(path: Path, study: Any) -> dict[str, Any]:
+    """Create the store atomically (build in a hidden sibling directory, then rename); return its record.
+
+    ``path`` must not exist or be an empty directory.  Raises
+    :class:`StoreError` (one line) if the skeleton cannot be written; nothing
+    is then left at ``path``.
     """
-    import zarr
-
-    if path.exists():
-        if overwrite:
-            remove_store(path)
-        else:
-            check_study(_existing(path), path, study)
-            g = zarr.open_group(str(path), mode="r+", zarr_format=3)
-            if MARKERS not in g:
-                g.create_group(MARKERS)
-            return g
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return create_store(path, study)
+    tmp = path.parent / f".{path.name}.creating-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+    try:
+        manifest = _build_skeleton(tmp, study, study_attrs(study))
+        os.rename(tmp, path)
+    except OSError as exc:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise io_error(exc, "creating the skeleton", path, resume=False) from None
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return manifest
 
 
-def _existing(path: Path) -> Any:
-    import zarr
+def _expected_manifest(study: Any, created: str | None, version: str | None) -> dict[str, Any]:
+    """The creation record a store of ``study`` has (built in a temporary directory, without coordinates)."""
+    attrs = study_attrs(study)
+    if created:
+        attrs["created"] = created
+    if version:
+        attrs["brakesqueal_version"] = version
+    with tempfile.TemporaryDirectory(prefix="brakesqueal-skeleton-") as d:
+        return _build_skeleton(Path(d) / "s.zarr", study, attrs, write_coordinates=False)
 
-    if not (path / "zarr.json").is_file():
+
+# ---------------------------------------------------------------- inspection and repair
+def _read_json(p: Path) -> Any:
+    try:
+        return json.loads(p.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+
+
+def read_manifest(path: Path) -> dict[str, Any] | None:
+    """The store's creation record, or None if it is missing, unreadable or damaged (its SHA-256 differs)."""
+    m = _read_json(path / MANIFEST)
+    if not (isinstance(m, dict) and m.get("format") == _FORMAT and m.get("record_sha256") == _record_sum(m)
+            and isinstance(m.get("nodes"), dict) and isinstance(m.get("coordinates"), dict)
+            and isinstance(m.get("study_hash"), str) and "zarr.json" in m["nodes"]
+            and all(isinstance(v, str) for v in m["nodes"].values())):
+        return None
+    m.pop("record_sha256")
+    return m
+
+
+@dataclass
+class StoreCheck:
+    """What :func:`inspect_store` found (read-only).
+
+    Attributes
+    ----------
+    manifest : dict
+        The creation record (read from the store, or rebuilt from the study).
+    record_missing : bool
+        The store had no valid creation record (interrupted repair, or made by an older version).
+    metadata : list of str
+        Keys of ``zarr.json`` files that are missing or differ from the record.
+    coords : list of str
+        Coordinate arrays that are missing, unreadable or changed.
+    problems : list of str
+        The same, as short sentences.
+    """
+
+    manifest: dict[str, Any]
+    record_missing: bool = False
+    metadata: list[str] = field(default_factory=list)
+    coords: list[str] = field(default_factory=list)
+    problems: list[str] = field(default_factory=list)
+
+    @property
+    def damaged(self) -> bool:
+        return bool(self.problems)
+
+
+def _different(path: Path, study: Any, h: Any, source: Any) -> ParameterError:
+    return ParameterError(
+        f"store '{path}' holds results of a different study (key 'study_hash' = {str(h)[:12]}..., "
+        f"this study {study.hash()[:12]}..., written from '{source or '?'}'); "
+        "pass --overwrite to replace it or choose another store")
+
+
+def inspect_store(path: Path, study: Any) -> StoreCheck:
+    """Identify the study of an existing store and check its metadata and coordinates (read-only).
+
+    Raises
+    ------
+    ParameterError
+        The store holds a different study, or ``path`` is not a sweep store.
+    StoreError
+        The store is damaged beyond repair (no metadata and no creation
+        record name its study), or this installation computes different
+        coordinates for the study than those stored.
+    """
+    if not path.is_dir():
+        raise StoreError(f"'{path}' is a file, not a sweep store; choose another store (--out)")
+    manifest = read_manifest(path)
+    root = _read_json(path / "zarr.json")
+    attrs = root.get("attributes") if isinstance(root, dict) and isinstance(root.get("attributes"), dict) else None
+    h = manifest["study_hash"] if manifest else (attrs or {}).get("study_hash")
+    if h is None:
+        if attrs is not None:
+            raise ParameterError(f"store '{path}' is not a brakesqueal sweep store (no key 'study_hash'); "
+                                 "pass --overwrite to replace it")
+        if (path / MANIFEST).exists() or (path / MARKERS).exists() or (path / "zarr.json").exists():
+            raise StoreError(f"store '{path}' is damaged beyond repair: neither its metadata (zarr.json) nor its "
+                             f"creation record ({MANIFEST}) can be read; pass --overwrite to recompute it")
         raise ParameterError(f"'{path}' exists and is not a brakesqueal sweep store; "
                              "choose another store (--out) or remove it")
-    try:
-        g = zarr.open_group(str(path), mode="r", zarr_format=3)
-    except Exception as exc:  # noqa: BLE001 - any unreadable store is reported the same way
-        raise ParameterError(f"store '{path}' cannot be read ({type(exc).__name__}: {exc})") from None
-    if "study_hash" not in g.attrs:
-        raise ParameterError(f"store '{path}' is not a brakesqueal sweep store (no key 'study_hash'); "
-                             "pass --overwrite to replace it")
-    return g
-
-
-def check_study(g: Any, path: Path, study: Any) -> None:
-    """Raise ParameterError unless the store at ``path`` was written by ``study``."""
-    h = g.attrs.get("study_hash")
     if h != study.hash():
-        raise ParameterError(
-            f"store '{path}' holds results of a different study (key 'study_hash' = {str(h)[:12]}..., "
-            f"this study {study.hash()[:12]}..., written from '{g.attrs.get('study_file', '?')}'); "
-            "pass --overwrite to replace it or choose another store")
+        src = (manifest and _read_study_file(manifest)) or (attrs or {}).get("study_file")
+        raise _different(path, study, h, src)
+    coords = coordinates(study)
+    check = StoreCheck(manifest={})
+    if manifest is None:
+        created = (attrs or {}).get("created")
+        version = (attrs or {}).get("brakesqueal_version")
+        manifest = _expected_manifest(study, created if isinstance(created, str) else None,
+                                      version if isinstance(version, str) else None)
+        check.record_missing = True
+        check.problems.append(f"creation record {MANIFEST} missing or unreadable")
+    else:
+        want = {k: checksum(v) for k, v in coords.items()}
+        if want != manifest["coordinates"]:
+            have = manifest["coordinates"]
+            bad = sorted(k for k in set(want) | set(have) if want.get(k) != have.get(k))
+            raise StoreError(f"store '{path}': this installation computes coordinates {', '.join(bad)} of the study "
+                             "differently from those stored (another SciPy/NumPy version?); results would not "
+                             "match: pass --overwrite to recompute the store, or use the installation that made it")
+    found = check_skeleton(path, manifest)
+    found.record_missing = check.record_missing
+    found.problems[:0] = check.problems
+    return found
+
+
+def check_skeleton(path: Path, manifest: dict[str, Any]) -> StoreCheck:
+    """Compare every node's metadata and every coordinate array of a store with its creation record (read-only)."""
+    check = StoreCheck(manifest=manifest)
+    for key, text in manifest["nodes"].items():
+        disk = _read_json(path / key)
+        if disk is None:
+            check.metadata.append(key)
+            check.problems.append(f"metadata {key} missing or unreadable")
+        elif disk != json.loads(text):
+            check.metadata.append(key)
+            check.problems.append(f"metadata {key} differs from the creation record")
+    g = open_group(path, manifest, read_only=True)
+    for name, want_sum in manifest["coordinates"].items():
+        try:
+            ok = checksum(np.asarray(g[name][...])) == want_sum
+        except Exception:  # noqa: BLE001 - missing / truncated / corrupt chunk files raise codec-specific errors
+            ok = False
+        if not ok:
+            check.coords.append(name)
+            check.problems.append(f"coordinate '{name}' missing, unreadable or changed")
+    return check
+
+
+def _read_study_file(manifest: dict[str, Any]) -> str | None:
+    root = _read_json_text(manifest["nodes"].get("zarr.json", ""))
+    return (root or {}).get("attributes", {}).get("study_file")
+
+
+def _read_json_text(text: str) -> Any:
+    try:
+        return json.loads(text)
+    except ValueError:
+        return None
+
+
+def open_group(path: Path, manifest: dict[str, Any], *, read_only: bool = False) -> Any:
+    """The store's Zarr group, with every node's metadata taken from the creation record ``manifest``."""
+    import zarr
+
+    return zarr.open_group(store=_zstore(path, read_only=read_only, metadata=manifest["nodes"]),
+                           mode="r" if read_only else "r+", zarr_format=3)
+
+
+def _repair(path: Path, study: Any, check: StoreCheck) -> None:
+    """Rewrite the creation record, damaged metadata and coordinates (they follow from the study)."""
+    m = check.manifest
+    try:
+        if check.record_missing:
+            (path / MARKERS).mkdir(exist_ok=True)
+            write_file(path / MANIFEST, _record_bytes(m))
+        for key in check.metadata:
+            (path / key).parent.mkdir(parents=True, exist_ok=True)
+            write_file(path / key, m["nodes"][key].encode())
+        if check.coords:
+            g = open_group(path, m)
+            coords = coordinates(study)
+            for name in check.coords:
+                g[name][...] = coords[name]
+    except OSError as exc:
+        raise io_error(exc, "repairing the metadata", path) from None
+
+
+def _remove_siblings(path: Path) -> None:
+    """Remove the hidden sibling directories of interrupted creations and deletions of ``path``."""
+    for p in _siblings(path, "creating") + _siblings(path, "deleting"):
+        shutil.rmtree(p, ignore_errors=True)
+
+
+def _remove_partials(path: Path) -> None:
+    """Remove temporary files of interrupted writes inside a store (only call this on an identified store)."""
+    for d, _, files in os.walk(path):
+        for f in files:
+            if f.endswith(".partial") or (f.startswith(".") and f.endswith(".tmp")):
+                with suppress(OSError):
+                    os.unlink(os.path.join(d, f))
+
+
+def prepare_store(path: Path, study: Any, *, overwrite: bool) -> tuple[Any, list[str]]:
+    """Create, or verify and repair, the store of ``study`` at ``path`` (the caller holds the lock).
+
+    Returns
+    -------
+    group : zarr.Group
+        The store's group (metadata from the creation record), open for writing.
+    repaired : list of str
+        What was damaged and has been rewritten (empty for a sound store).
+
+    Raises
+    ------
+    ParameterError
+        ``path`` is not a sweep store, or one of a different study (without ``overwrite``).
+    StoreError
+        The store cannot be created, repaired or written.
+    """
+    _remove_siblings(path)
+    if overwrite and path.exists():
+        remove_store(path)
+    if not path.exists() or (path.is_dir() and not any(path.iterdir())):
+        return open_group(path, create_store(path, study)), []
+    check = inspect_store(path, study)
+    _remove_partials(path)
+    if check.damaged:
+        _repair(path, study, check)
+        again = inspect_store(path, study)
+        if again.damaged:
+            raise StoreError(f"store '{path}' could not be repaired ({'; '.join(again.problems)}); "
+                             "pass --overwrite to recompute it")
+    return open_group(path, check.manifest), check.problems
 
 
 def remove_store(path: Path) -> None:
-    """Delete a store directory, refusing anything that does not look like a Zarr store."""
-    if path.is_dir() and ((path / "zarr.json").is_file() or not any(path.iterdir())):
-        shutil.rmtree(path)
+    """Delete a store directory (renamed away first, so the path never holds a half-deleted store).
+
+    Refuses anything that does not look like a sweep or Zarr store.
+    """
+    if path.is_dir() and ((path / "zarr.json").is_file() or (path / MANIFEST).is_file()
+                          or (path / MARKERS).is_dir() or not any(path.iterdir())):
+        gone = path.parent / f".{path.name}.deleting-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+        try:
+            os.rename(path, gone)
+        except OSError as exc:
+            raise io_error(exc, "removing the old store", path, resume=False) from None
+        shutil.rmtree(gone, ignore_errors=True)
     elif path.exists():
         raise ParameterError(f"refusing to overwrite '{path}': it is not a Zarr store")
 
 
+# ---------------------------------------------------------------- location checks
+def check_location(path: Path) -> None:
+    """Check, before anything is computed, that a store can be made at ``path`` (creating missing parents).
+
+    Raises
+    ------
+    StoreError
+        ``path`` is a file, a parent is not a directory or cannot be created.
+    """
+    if path.exists() and not path.is_dir():
+        raise StoreError(f"'{path}' is a file, not a sweep store; choose another store (--out)")
+    anc = path.parent
+    while not anc.exists() and anc != anc.parent:
+        anc = anc.parent
+    if not anc.is_dir():
+        raise StoreError(f"cannot create the store '{path}': '{anc}' is not a directory")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise _NotWritable(f"cannot create the store '{path}': cannot create directory '{path.parent}' "
+                           f"({(exc.strerror or str(exc)).lower()})") from None
+
+
+def check_writable(path: Path) -> None:
+    """Check that an existing store can be written (a probe file in it and in its marker directory)."""
+    for d in (path, path / MARKERS):
+        if not d.is_dir():
+            continue
+        probe = d / f".write-probe-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+        try:
+            os.close(os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644))
+            os.unlink(probe)
+        except OSError as exc:
+            raise _NotWritable(f"cannot write the store '{path}': {(exc.strerror or str(exc)).lower()} "
+                               f"in '{d}'") from None
+
+
+# ---------------------------------------------------------------- chunks
 def write_chunk(g: Any, path: Path, study: Any, chunk: int, result: dict[str, np.ndarray]) -> None:
-    """Write one chunk's data, then its completion marker (atomically)."""
+    """Write one chunk's data, then its completion marker (each file atomically).
+
+    Raises
+    ------
+    StoreError
+        One line if a file cannot be written (e.g. no space left); the
+        chunk's old marker, if any, is left as it was, so the chunk stays
+        unverified and is recomputed on resume.
+    """
     region = study.region(chunk)
     sums = {}
-    for name in _variables(study):
-        data = result[name]
-        g[name][region] = data
-        sums[name] = checksum(data)
-    marker = {"chunk": chunk, "region": [[s.start, s.stop] for s in region], "checksums": sums}
-    d = path / MARKERS
-    tmp = d / f".{chunk}.{os.getpid()}.tmp"
-    tmp.write_text(json.dumps(marker), encoding="utf-8")
-    os.replace(tmp, d / f"{chunk}.json")
+    try:
+        for name in _variables(study):
+            data = result[name]
+            g[name][region] = data
+            sums[name] = checksum(data)
+        marker = {"chunk": chunk, "region": [[s.start, s.stop] for s in region], "checksums": sums}
+        d = path / MARKERS
+        d.mkdir(exist_ok=True)
+        write_file(d / f"{chunk}.json", json.dumps(marker).encode())
+    except OSError as exc:
+        raise io_error(exc, f"writing chunk {chunk}", path) from None
 
 
-def completed_chunks(path: Path) -> dict[int, dict[str, Any]]:
-    """Markers found in the store (unverified): chunk id -> marker."""
-    out: dict[int, dict[str, Any]] = {}
+def completed_chunks(path: Path) -> dict[int, dict[str, Any] | None]:
+    """Markers found in the store (unverified): chunk id -> marker (None if the marker file is unreadable)."""
+    out: dict[int, dict[str, Any] | None] = {}
     d = path / MARKERS
     if not d.is_dir():
         return out
     for f in d.glob("[0-9]*.json"):
+        if not f.stem.isdigit():
+            continue
         try:
             m = json.loads(f.read_text(encoding="utf-8"))
-            out[int(m["chunk"])] = m
+            ok = isinstance(m, dict) and int(m["chunk"]) == int(f.stem) and isinstance(m.get("checksums"), dict)
         except (OSError, ValueError, KeyError, TypeError):
-            continue
+            ok = False
+        out[int(f.stem)] = m if ok else None
     return out
 
 
-def verified_chunks(g: Any, path: Path, study: Any, *, remove_bad: bool = True) -> tuple[set[int], set[int]]:
-    """Verify every marker against the data: ``(good, bad)`` chunk ids; bad markers are removed if asked."""
+def verified_chunks(g: Any, path: Path, study: Any) -> tuple[set[int], set[int]]:
+    """Verify every marker against the data: ``(good, bad)`` chunk ids (markers are never removed)."""
     good, bad = set(), set()
     names = _variables(study)
     for chunk, m in sorted(completed_chunks(path).items()):
-        ok = 0 <= chunk < study.n_chunks and m.get("region") == [[s.start, s.stop] for s in study.region(chunk)]
+        if not 0 <= chunk < study.n_chunks:
+            continue
+        region = study.region(chunk)
+        ok = m is not None and m.get("region") == [[s.start, s.stop] for s in region]
         if ok:
-            region = study.region(chunk)
             try:
                 ok = all(checksum(np.asarray(g[n][region])) == m["checksums"].get(n) for n in names)
             except Exception:  # noqa: BLE001 - truncated / corrupt chunk files raise codec-specific errors
                 ok = False
-        if ok:
-            good.add(chunk)
-        else:
-            bad.add(chunk)
-            if not remove_bad:
-                continue
-            try:
-                (path / MARKERS / f"{chunk}.json").unlink()
-            except OSError:
-                pass
+        (good if ok else bad).add(chunk)
     return good, bad

@@ -42,7 +42,8 @@ import numpy as np
 from ..errors import ParameterError
 from ..parameters import Value
 
-__all__ = ["Study", "GridAxis", "SampleRange", "load_study", "QUANTITIES", "DEFAULT_QUANTITIES"]
+__all__ = ["Study", "GridAxis", "SampleRange", "load_study", "QUANTITIES", "DEFAULT_QUANTITIES", "MAX_AXIS_POINTS",
+           "MAX_POINTS", "MAX_CHUNKS", "MAX_CHUNK_POINTS"]
 
 #: Quantities a study may compute per point (``stable`` and ``status`` are always computed).
 QUANTITIES = ("stable", "margin", "max_real", "frequency", "critical_speed")
@@ -52,6 +53,17 @@ DEFAULT_CHUNK_POINTS = (1 << 22, 1 << 18)
 _TOP_KEYS = ("name", "description", "preset", "params", "model", "parameters", "tied", "axes", "samples", "compute",
              "execution", "output")
 _MAX_SAMPLES = 10**7
+#: Size limits of a study, checked from the study's numbers before anything is allocated:
+#: points of one grid axis (its values are held in memory by every process: 0.8 GB at the limit),
+MAX_AXIS_POINTS = 10**8
+#: points of a study (the store then holds 2-34 TB uncompressed),
+MAX_POINTS = 10**12
+#: chunks of a study (one completion marker file per chunk, all verified on resume),
+MAX_CHUNKS = 10**6
+#: points of one chunk, which is computed in memory: verdict-only grids (about 3 bytes per point
+#: of working memory) / eigenvalue quantities, samples or built models (about 600 bytes per point).
+MAX_CHUNK_POINTS = (1 << 26, 1 << 22)
+_EPS = float(np.finfo(float).eps)
 
 
 def _is_num(v: object) -> bool:
@@ -324,6 +336,8 @@ def _grid_axis(ctx: _Ctx, name: str, v: Any) -> GridAxis:
     if values is not None:
         if not values:
             raise ctx.err(key, "empty axis (no values)")
+        if len(values) > MAX_AXIS_POINTS:
+            raise ctx.err(key, f"{len(values)} values exceed the limit of {MAX_AXIS_POINTS:.0e} points per axis")
         arr = np.array([ctx.number(x, f"{key}.values[{i}]") for i, x in enumerate(values)])
         if np.unique(arr).size != arr.size:
             raise ctx.err(key, "values must be distinct")
@@ -332,11 +346,39 @@ def _grid_axis(ctx: _Ctx, name: str, v: Any) -> GridAxis:
             ref = float(math.sqrt(arr.min() * arr.max()))
         return GridAxis(name, arr, "values", tuple(float(x) for x in arr), ref)
     start, stop, num, log = _parse_range(ctx, key, v, True)
+    nkey = f"{key}.num" if isinstance(v, dict) else key
+    if num > MAX_AXIS_POINTS:
+        raise ctx.err(nkey, f"{num} points ({num:.3g}) exceed the limit of {MAX_AXIS_POINTS:.0e} points per axis "
+                            f"(its values alone would take {_size(8 * num)} of memory); use fewer points or split "
+                            "the study")
     try:
         ax = Axis(name, start, stop, num, log)
     except ParameterError as exc:
         raise ctx.err(key, str(exc)) from None
+    _check_resolution(ctx, nkey, start, stop, num, log)
     return GridAxis(name, ax.values(), "log" if log else "linear", (start, stop, num), ax.ref)
+
+
+def _size(nbytes: float) -> str:
+    """``nbytes`` in human units (decimal)."""
+    for unit, f in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if nbytes >= f:
+            return f"{nbytes / f:.3g} {unit}"
+    return f"{int(nbytes)} bytes"
+
+
+def _check_resolution(ctx: _Ctx, key: str, start: float, stop: float, num: int, log: bool) -> None:
+    """Refuse a range whose ``num`` points would not be distinct floating-point numbers (with a margin)."""
+    if num < 2:
+        return
+    if log:
+        t0, t1 = math.log10(start), math.log10(stop)
+        ok = (t1 - t0) / (num - 1) > 4 * _EPS * (max(1.0, abs(t0), abs(t1)) + 1)
+    else:
+        ok = (stop - start) / (num - 1) > 4 * float(np.spacing(max(abs(start), abs(stop))))
+    if not ok:
+        raise ctx.err(key, f"{num} points between {start!r} and {stop!r} are closer than the floating-point "
+                           "resolution (they would not be distinct values); use fewer points or a wider range")
 
 
 def _default_chunks(shape: tuple[int, ...], points: int) -> tuple[int, ...]:
@@ -579,6 +621,13 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
 
     # ---- execution / output
     shape = tuple(a.size for a in axes) if kind == "grid" else (n_samples,)
+    n_points = math.prod(shape)
+    per_point = 2 + 8 * sum(q in quant for q in ("margin", "max_real", "frequency", "critical_speed"))
+    if n_points > MAX_POINTS:
+        dims_txt = " x ".join(f"{a.name}={a.size}" for a in axes)
+        raise ctx.err("axes", f"the grid has {n_points:.3g} points ({dims_txt}), more than the limit of "
+                              f"{MAX_POINTS:.0e} points per study (its store would hold {_size(per_point * n_points)} "
+                              "uncompressed); use fewer points or split the study")
     etab = ctx.table(data.get("execution", {}), "execution", ("chunk_points", "chunks"))
     eigen = any(q in quant for q in ("margin", "max_real", "frequency", "critical_speed"))
     points = DEFAULT_CHUNK_POINTS[1 if eigen else 0]
@@ -590,6 +639,17 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
         ch = ctx.table(etab["chunks"], "execution.chunks", tuple(dims))
         chunks = tuple(min(ctx.integer(ch[d], f"execution.chunks.{d}", 1), s) if d in ch else c
                        for d, c, s in zip(dims, chunks, shape))
+    ckey = "execution.chunks" if "chunks" in etab else "execution.chunk_points"
+    heavy = eigen or kind == "samples" or model_json is not None
+    limit = MAX_CHUNK_POINTS[1 if heavy else 0]
+    if math.prod(chunks) > limit:
+        mem = _size(math.prod(chunks) * (600 if heavy else 3 + per_point))
+        raise ctx.err(ckey, f"chunks of {math.prod(chunks)} points exceed the limit of {limit} points per chunk "
+                            f"for this study (each chunk is computed in memory: about {mem}); give smaller chunks")
+    n_chunks = math.prod(-(-s // c) for s, c in zip(shape, chunks))
+    if n_chunks > MAX_CHUNKS:
+        raise ctx.err(ckey, f"{n_chunks} chunks exceed the limit of {MAX_CHUNKS:.0e} chunks per study (one "
+                            "completion marker file each); give larger chunks")
     otab = ctx.table(data.get("output", {}), "output", ("store",))
     store = otab.get("store")
     if store is not None:
