@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["render_closed_form", "render_linear_model", "render_model_closed_form", "render_built_linear", "FORMATS"]
+__all__ = ["render_closed_form", "render_linear_model", "render_eigen", "render_model_closed_form", "FORMATS"]
 
 FORMATS = ("text", "latex", "json")
 
@@ -47,43 +47,108 @@ def _fmt_matrix(name: str, m: np.ndarray) -> list[str]:
     return [f"{name} ="] + rows
 
 
+def _unit(coord: str) -> str:
+    return "rad" if coord.startswith("q") else "m"
+
+
 def render_linear_model(lm: Any, fmt: str) -> str:
-    """Render a :class:`~brakesqueal.analysis.linear.LinearModel` as text or JSON."""
+    """Render a :class:`~brakesqueal.analysis.linear.LinearModel` (any model) as text or JSON.
+
+    The verdict is that of :meth:`EigenAnalysis.verdict
+    <brakesqueal.analysis.eigen.EigenAnalysis.verdict>` (stable, unstable or
+    undecided within its error bound), the same everywhere.
+    """
+    from .analysis.eigen import eigen_analysis
+
+    v = eigen_analysis(lm).verdict()
     if fmt == "json":
-        return json.dumps(lm.to_dict(), indent=2)
-    lines = ["Parameters:"]
-    for k, v in lm.params.to_json_dict().items():
-        lines.append(f"  {k:6s} = {v}")
-    kind = "trivial (eq. 49 holds)" if lm.silent.trivial else f"non-trivial, {lm.silent.iterations} Newton steps"
-    lines.append(f"Silent motion: q_m0 = [{lm.q_m0[0]:.6e}, {lm.q_m0[1]:.6e}] rad ({kind})")
-    lines.append(f"  normal forces F_n1, F_n2 = {lm.silent.normal_forces[0]:.6g}, {lm.silent.normal_forces[1]:.6g} N")
+        d = lm.to_dict()
+        d["verdict"] = {"status": v.status, "max_real": v.max_real, "error_bound": float(v.error_bound)}
+        return json.dumps(d, indent=2)
+    sm = lm.silent
+    lines = [f"Model '{lm.model.name}' ({lm.n} DOF: {', '.join(lm.coords)})", "Parameters:"]
+    for k, val in lm.params.to_json_dict().items():
+        lines.append(f"  {k:8s} = {val}")
+    kind = "trivial" if sm.trivial else f"non-trivial ({sm.method}, {sm.iterations} iterations)"
+    lines.append("Silent motion (eq. 46): " + ", ".join(f"{c} = {x:.6e} {_unit(c)}" for c, x in zip(lm.coords, lm.q0))
+                 + f"  [{kind}]")
+    pads = [p.name for p in lm.model.pads]
+    lines.append("  normal forces: " + ", ".join(f"pad {n}: {f:.6g} N" for n, f in zip(pads, sm.normal_forces)))
     lines += _fmt_matrix("M", lm.M) + _fmt_matrix("D", lm.D) + _fmt_matrix("K", lm.K)
+    if lm.pad_states:
+        lines.append(f"Pads kept as first-order states (tangential rates matter here): {', '.join(lm.pad_states)}")
     lines.append("Eigenvalues [1/s]          frequency [Hz]   damping ratio")
     for z in lm.eigenvalues:
         f = abs(z.imag) / (2 * np.pi)
         zeta = -z.real / abs(z) if abs(z) > 0 else 0.0
         lines.append(f"  {z.real: .6e} {z.imag:+.6e}j  {f:12.4f}  {zeta: .3e}")
-    verdict = "UNSTABLE (squeal)" if lm.max_real > 0 else "stable"
-    lines.append(f"Silent motion is {verdict}: max Re(lambda) = {lm.max_real:.6e} 1/s")
+    word = {"stable": "stable", "unstable": "UNSTABLE (squeal)", "undecided": "UNDECIDED"}[v.status]
+    lines.append(f"Silent motion is {word}: max Re(lambda) = {v.max_real:.6e} 1/s "
+                 f"(error bound {float(v.error_bound):.1e} 1/s)")
+    return "\n".join(lines) + "\n"
+
+
+def render_eigen(ea: Any, fmt: str, *, mode: int = 0) -> str:
+    """Render an :class:`~brakesqueal.analysis.eigen.EigenAnalysis`: modes, sensitivities, attribution of Re λ."""
+    lm = ea.model
+    v = ea.verdict()
+    sens = ea.parameter_sensitivities()
+    contrib = {} if lm.pad_states else {n: ea.contributions(n, mode) for n in lm.params.names}
+    if fmt == "json":
+        return json.dumps({
+            "model": lm.model.name, "parameters": lm.params.to_json_dict(), "coords": list(lm.coords),
+            "verdict": {"status": v.status, "max_real": v.max_real, "error_bound": float(v.error_bound)},
+            "modes": [{"eigenvalue": [float(z.real), float(z.imag)], "frequency_hz": float(f),
+                       "damping_ratio": float(zt), "condition": float(c),
+                       "shape": [[float(x.real), float(x.imag)] for x in ea.modes[:, i]]}
+                      for i, (z, f, zt, c) in enumerate(zip(ea.eigenvalues, ea.frequencies, ea.damping_ratios,
+                                                             ea.condition))],
+            "sensitivities": {n: [[float(x.real), float(x.imag)] for x in s] for n, s in sens.items()},
+            "attribution": {"mode": mode, "d_Re_lambda_d_ln_p": contrib},
+        }, indent=2) + "\n"
+    lines = [f"Model '{lm.model.name}': verdict {v.status}, max Re(lambda) = {v.max_real:.6e} 1/s "
+             f"(error bound {float(v.error_bound):.1e})", "",
+             "mode  Re(lambda) [1/s]   frequency [Hz]  damping ratio  condition   shape (|x|, largest first)"]
+    for i, (z, f, zt, c) in enumerate(zip(ea.eigenvalues, ea.frequencies, ea.damping_ratios, ea.condition)):
+        x = ea.modes[:, i]
+        order = np.argsort(-np.abs(x))[:3]
+        shape = ", ".join(f"{lm.coords[k]} {abs(x[k]):.3f}" for k in order)
+        lines.append(f"{i:4d}  {z.real: .6e}  {f:14.4f}  {zt: .3e}  {c:9.3g}   {shape}")
+    lines += ["", f"Sensitivities d Re(lambda_{mode}) / d ln p [1/s]:"]
+    ranked = sorted(sens.items(), key=lambda kv: -abs(kv[1][mode].real))
+    for n, s in ranked:
+        if s[mode] != 0:
+            lines.append(f"  {n:8s} {s[mode].real: .6e}")
+    if contrib:
+        lines += ["", f"Attribution of d Re(lambda_{mode}) / d ln p to matrix entries (largest parameters):"]
+        for n, _ in ranked[:3]:
+            parts = sorted(contrib[n].items(), key=lambda kv: -abs(kv[1]))[:4]
+            total = sum(contrib[n].values()) or 1.0
+            lines.append(f"  {n:8s} " + ", ".join(f"{k} {100 * val / total:.1f}%" for k, val in parts))
     return "\n".join(lines) + "\n"
 
 
 def render_model_closed_form(spec: Any, fmt: str) -> str:
-    """Render the symbolic ``M, D, K`` of a built model about the zero state."""
+    """Render the symbolic ``M, D, K`` of any model about the zero state (and kept pad blocks)."""
     import sympy as sp
 
-    from .builder import model_closed_form
+    from .symbolic.linearize import model_closed_form
 
-    M, D, K, coords = model_closed_form(spec)
-    mats = {"M": M, "D": D, "K": K}
+    cf = model_closed_form(spec)
+    coords = cf.coords
+    mats = {"M": cf.M, "D": cf.D, "K": cf.K}
     note = "about the zero state (the silent motion when it is trivial)"
+    extra = {k: v for k, v in cf.rate_blocks.items() if k != "pads"}
     if fmt == "json":
         data = {"model": spec.name, "coordinates": list(coords), "operating_point": note,
                 **{k: [[str(e) for e in m.row(i)] for i in range(m.rows)] for k, m in mats.items()}}  # fmt: skip
+        if extra:
+            data["pad_states"] = list(cf.rate_blocks["pads"])
+            data.update({k: [[str(e) for e in m.row(i)] for i in range(m.rows)] for k, m in extra.items()})
         return json.dumps(data, indent=2)
     if fmt == "latex":
         body = [f"% brakesqueal model {spec.name}, coordinates {', '.join(coords)}, {note}"]
-        body += [rf"\mathbf{{{k}}} = {sp.latex(m, mat_delim='[')}" for k, m in mats.items()]
+        body += [rf"\mathbf{{{k}}} = {sp.latex(m, mat_delim='[')}" for k, m in {**mats, **extra}.items()]
         return "\n\n".join(body)
     lines = [f"Model '{spec.name}': {spec.description}", f"Coordinates: {', '.join(coords)}; linearized {note}", ""]
     for k, m in mats.items():
@@ -92,26 +157,8 @@ def render_model_closed_form(spec: Any, fmt: str) -> str:
                 if m[i, j] != 0:
                     lines.append(f"{k}[{coords[i]},{coords[j]}] = {sp.sstr(m[i, j])}")
         lines.append("")
+    if extra:
+        lines.append(f"Pads with first-order dynamics at the zero state: {', '.join(cf.rate_blocks['pads'])}")
+        for k, m in extra.items():
+            lines.append(f"{k} = {sp.sstr(m)}")
     return "\n".join(lines).rstrip() + "\n"
-
-
-def render_built_linear(lm: Any, fmt: str) -> str:
-    """Render a :class:`~brakesqueal.builder.BuiltLinearModel` as text or JSON."""
-    params = {k: ("inf" if v == float("inf") else v) for k, v in lm.values.items()}
-    if fmt == "json":
-        return json.dumps({
-            "model": lm.spec.name, "parameters": params, "coordinates": list(lm.coords),
-            "Q0": [float(v) for v in lm.Q0], "M": lm.M.tolist(), "D": lm.D.tolist(), "K": lm.K.tolist(),
-            "eigenvalues": [[float(z.real), float(z.imag)] for z in lm.eigenvalues],
-        }, indent=2)  # fmt: skip
-    lines = [f"Model '{lm.spec.name}' ({len(lm.coords)} DOF: {', '.join(lm.coords)})", "Parameters:"]
-    lines += [f"  {k:8s} = {v}" for k, v in params.items()]
-    lines.append("Silent motion: " + ", ".join(f"{c} = {v:.6e}" for c, v in zip(lm.coords, lm.Q0)))
-    lines += _fmt_matrix("M", lm.M) + _fmt_matrix("D", lm.D) + _fmt_matrix("K", lm.K)
-    lines.append("Eigenvalues [1/s]          frequency [Hz]   damping ratio")
-    for z in lm.eigenvalues:
-        zeta = -z.real / abs(z) if abs(z) > 0 else 0.0
-        lines.append(f"  {z.real: .6e} {z.imag:+.6e}j  {abs(z.imag) / (2 * np.pi):12.4f}  {zeta: .3e}")
-    verdict = "UNSTABLE (squeal)" if lm.max_real > 0 else "stable"
-    lines.append(f"Silent motion is {verdict}: max Re(lambda) = {lm.max_real:.6e} 1/s")
-    return "\n".join(lines) + "\n"

@@ -13,7 +13,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 __all__ = ["register"]
 
@@ -38,9 +38,9 @@ _Model = Annotated[Optional[str], typer.Option("--model", help="Model TOML file 
 
 def _model_space(model: str, preset: Optional[str], params: Optional[str], sets: Optional[list[str]]):  # type: ignore[no-untyped-def]
     """A built model with ``--set`` overrides (``--preset``/``--params`` do not apply to built models)."""
-    from .builder import resolve_model
-    from .builder.analysis import ModelSpace
-    from .parameters import parse_sets
+    from ..builder import resolve_model
+    from ..builder.analysis import ModelSpace
+    from ..parameters import parse_sets
 
     if preset or params:
         raise ParameterError("--model cannot be combined with --preset or --params (use --set for its parameters)")
@@ -48,7 +48,7 @@ def _model_space(model: str, preset: Optional[str], params: Optional[str], sets:
 
 
 def _space(preset: Optional[str], params: Optional[str], sets: Optional[list[str]]):  # type: ignore[no-untyped-def]
-    from .analysis.space import ParameterSpace
+    from ..analysis.space import ParameterSpace
 
     return ParameterSpace.from_options(preset, params, list(sets or []))
 
@@ -71,12 +71,12 @@ def crossings(
     model: _Model = None,
 ) -> None:
     """Every parameter value on a path where the stability of the silent motion changes (exact)."""
-    from .analysis.crossings import crossings as _crossings
-    from .analysis.maps import parse_axis
+    from ..analysis.crossings import crossings as _crossings
+    from ..analysis.maps import parse_axis
 
     axis = parse_axis(along, with_num=False)
     if model is not None:
-        from .builder.analysis import model_crossings
+        from ..builder.analysis import model_crossings
 
         r = model_crossings(_model_space(model, preset, params, set_), axis)
     else:
@@ -90,12 +90,12 @@ def critical_speed(
     model: _Model = None,
 ) -> None:
     """All onsets and re-stabilisations of squeal along the spin rate Omega, and Omega_crit."""
-    from .analysis.crossings import critical_speeds
-    from .analysis.maps import parse_axis
+    from ..analysis.crossings import critical_speeds
+    from ..analysis.maps import parse_axis
 
     axis = parse_axis(f"Omega={range_}:log", with_num=False)
     if model is not None:
-        from .builder.analysis import model_critical_speeds
+        from ..builder.analysis import model_critical_speeds
 
         r = model_critical_speeds(_model_space(model, preset, params, set_), axis.start, axis.stop)
     else:
@@ -114,15 +114,15 @@ def map_(
     model: _Model = None,
 ) -> None:
     """Stability map over two parameters: NetCDF with max_real, stable, frequency, status; optional plot."""
-    from .analysis.maps import parse_axis, stability_map
-    from .plotting import save
+    from ..analysis.maps import parse_axis, stability_map
+    from ..plotting import save
 
     ax_x, ax_y = parse_axis(x), parse_axis(y)
     if not out.endswith(".nc"):
         raise ParameterError(f"--out must name a NetCDF file ending in .nc; got {out!r}")
     prog = _progress("map") if sys.stderr.isatty() else None
     if model is not None:
-        from .builder.analysis import model_stability_map
+        from ..builder.analysis import model_stability_map
 
         if ax_x.num * ax_y.num > 1e9 and not force:
             raise ParameterError(f"the map has {ax_x.num * ax_y.num:.3g} points (> 1e9); add --force to run it")
@@ -144,7 +144,7 @@ def reproduce(
     out: Annotated[str, typer.Option("--out", help="Output directory.")] = "results",
 ) -> None:
     """Reproduce the paper's Figures 2 and 3 (PNG, NetCDF, CSV, JSON) into a directory."""
-    from .reproduce import reproduce_fig2, reproduce_fig3
+    from ..reproduce import reproduce_fig2, reproduce_fig3
 
     summaries = []
     if figure in (_Fig.fig2, _Fig.all):
@@ -168,8 +168,8 @@ def bench_map(
     large: Annotated[bool, typer.Option("--large", help="Also run a chunked 1e8-point map and report memory.")] = False,
 ) -> None:
     """Stability-map throughput: compiled kernel, NumPy path, Dataset path vs naive scipy eigvals loop."""
-    from .analysis._bench import bench_map as _b
-    from .bench import report
+    from ..analysis._bench import bench_map as _b
+    from ..bench import report
 
     sys.stdout.write(report(_b(size=size, large=large), fmt.value))
 
@@ -179,8 +179,8 @@ def bench_critical_speed(
     n: Annotated[int, typer.Option("--n", help="Number of parameter sets.")] = 100000,
 ) -> None:
     """Critical speeds per second (all crossings) vs numeric scan + brentq."""
-    from .analysis._bench import bench_critical_speed as _b
-    from .bench import report
+    from ..analysis._bench import bench_critical_speed as _b
+    from ..bench import report
 
     sys.stdout.write(report(_b(n=n), fmt.value))
 
@@ -191,8 +191,8 @@ def bench_model_map(
     size: Annotated[int, typer.Option("--size", help="Grid size N for the N x N map.")] = 1000,
 ) -> None:
     """Built-model map throughput (Routh classification, eigenvalue path) vs batched numpy.linalg.eigvals."""
-    from .bench import report
-    from .builder.analysis import bench_model_map as _b
+    from ..bench import report
+    from ..builder.analysis import bench_model_map as _b
 
     sys.stdout.write(report(_b(model, size), fmt.value))
 

@@ -38,10 +38,10 @@ def sweep(
     fmt: Annotated[_Fmt, typer.Option("--format", help="Output format.")] = _Fmt.text,
 ) -> None:
     """Run a parameter study in chunks (resumable) into a Zarr store; --status reports its progress."""
-    from .errors import ParameterError
-    from .sweep import run_sweep, sweep_status
-    from .sweep.runner import check_scheduler_address, default_store
-    from .sweep.study import load_study
+    from ..errors import ParameterError
+    from ..sweep import run_sweep, sweep_status
+    from ..sweep.runner import check_scheduler_address, default_store
+    from ..sweep.study import load_study
 
     st = load_study(study)
     if status:
@@ -78,8 +78,8 @@ def bench_sweep(
     = True,
 ) -> None:
     """Sweep throughput in-process vs. LocalCluster with 1 and 2 workers; peak memory of a 1e8-point study."""
-    from .bench import report
-    from .sweep.bench import bench_sweep as _b
+    from ..bench import report
+    from ..sweep.bench import bench_sweep as _b
 
     sys.stdout.write(report(_b(points=points, large=large), fmt.value))
 

@@ -1,0 +1,245 @@
+"""Command-line interface: ``brakesqueal derive | linearize | eigen | map | simulate | ...``.
+
+One module per command group; the options ``--model/--preset/--params/--set``
+mean the same on every command (:mod:`._options`).  Every user error is one
+line on stderr with exit status 2, an interrupt exits with 130; heavy modules
+are imported inside the commands so that ``--help`` and a warm ``linearize``
+start fast.
+"""
+
+from __future__ import annotations
+
+import sys
+from enum import Enum
+from typing import Annotated, Optional
+
+import typer
+from typer.exceptions import Abort, Exit, TyperException
+
+from ..errors import BrakesquealError
+from ._options import FormatOpt, ModelOpt, NoCacheOpt, OutFormat, ParamsOpt, PresetOpt, SetOpt, space_from
+
+__all__ = ["app", "main"]
+
+app = typer.Typer(
+    name="brakesqueal",
+    help="Derive, linearize and analyse wobbling-disk models of disk-brake squeal.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    rich_markup_mode=None,
+)
+bench_app = typer.Typer(help="Measure speed on this machine against a baseline run in the same process.")
+app.add_typer(bench_app, name="bench")
+
+
+def _version(value: bool) -> None:
+    if value:
+        from .. import __version__
+
+        print(f"brakesqueal {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[Optional[bool], typer.Option("--version", callback=_version, is_eager=True,
+                                                    help="Print the version and exit.")] = None,
+) -> None:
+    """Derive, linearize and analyse wobbling-disk models of disk-brake squeal.
+
+    Models: brakesqueal list models; presets: brakesqueal list presets; one of them: brakesqueal show NAME.
+    """
+
+
+class Case(str, Enum):
+    """Closed-form cases of the paper's model."""
+
+    general = "general"
+    symmetric = "symmetric"
+    asymmetric_friction = "asymmetric-friction"
+    minimal = "minimal"
+
+
+class DeriveFormat(str, Enum):
+    """Formats of ``derive``."""
+
+    text = "text"
+    latex = "latex"
+    json = "json"
+
+
+class PadRates(str, Enum):
+    """Treatment of the massless pads' tangential rates."""
+
+    kept = "kept"
+    quasi_static = "quasi-static"
+
+
+@app.command()
+def derive(
+    case: Annotated[Case, typer.Option("--case", help="Closed-form case of the paper's model.")] = Case.general,
+    fmt: Annotated[DeriveFormat, typer.Option("--format", help="Output format.")] = DeriveFormat.text,
+    model: ModelOpt = None,
+    no_cache: NoCacheOpt = False,
+) -> None:
+    """Print the symbolic M, D, K about the zero state (eqs. 51-54, 59-61 for the paper's model)."""
+    from ..numeric import cache
+    from ..render import render_closed_form, render_model_closed_form
+
+    if model is not None:
+        from ..model import resolve_model
+
+        sys.stdout.write(render_model_closed_form(resolve_model(model), fmt.value).rstrip("\n") + "\n")
+        return
+    text = cache.cached_text("closed-forms", f"{case.value}.{fmt.value}",
+                             lambda: render_closed_form(case.value, fmt.value), use_cache=not no_cache)
+    sys.stdout.write(text if text.endswith("\n") else text + "\n")
+
+
+@app.command()
+def linearize(
+    model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
+    fmt: FormatOpt = OutFormat.text,
+    pad_rates: Annotated[PadRates, typer.Option("--pad-rates", help="Massless pads' tangential rates: kept "
+                                                "(exact) or quasi-static (ldot := 0).")] = PadRates.kept,
+    no_cache: NoCacheOpt = False,
+) -> None:
+    """Find the silent motion, linearize (eqs. 46-48) and print M, D, K, the eigenvalues and the verdict."""
+    from ..analysis.linear import linearize as _linearize
+    from ..render import render_linear_model
+
+    p = space_from(model, preset, params, set_).resolve({})
+    lm = _linearize(p, pad_rates=pad_rates.value, use_cache=not no_cache)
+    sys.stdout.write(render_linear_model(lm, fmt.value))
+
+
+@app.command()
+def eigen(
+    model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
+    fmt: FormatOpt = OutFormat.text,
+    mode: Annotated[int, typer.Option("--mode", help="Mode whose Re(lambda) is attributed to matrix entries "
+                                      "(0 = least stable).", min=0)] = 0,
+) -> None:
+    """Eigen-analysis at one point: frequencies, damping ratios, mode shapes, sensitivities, attribution of Re(lambda)."""
+    from ..analysis.eigen import eigen_analysis
+    from ..render import render_eigen
+
+    ea = eigen_analysis(space_from(model, preset, params, set_).resolve({}))
+    sys.stdout.write(render_eigen(ea, fmt.value, mode=mode))
+
+
+class ListWhat(str, Enum):
+    """What ``list`` lists."""
+
+    models = "models"
+    presets = "presets"
+
+
+@app.command("list")
+def list_(what: Annotated[ListWhat, typer.Argument(help="models or presets")],
+          fmt: FormatOpt = OutFormat.text) -> None:
+    """List the built-in models or presets with a one-line description."""
+    import json
+
+    from ..model import get_model, get_preset
+    from ..model.library import MODELS, preset_names
+
+    if what == ListWhat.models:
+        rows = []
+        for name in MODELS:
+            spec = get_model(name)
+            from ..codegen import compile_model
+
+            rows.append({"name": name, "coordinates": list(compile_model(spec).coords),
+                         "presets": spec.preset_names(), "description": spec.description})
+        if fmt == OutFormat.json:
+            sys.stdout.write(json.dumps(rows, indent=2) + "\n")
+        else:
+            for r in rows:
+                sys.stdout.write(f"{r['name']:<13} {len(r['coordinates'])} DOF  {r['description']}\n")
+        return
+    out = []
+    for name in preset_names():
+        pr = get_preset(name)
+        out.append({"name": name, "model": pr.model.name, "free": list(pr.free), "description": pr.description})
+    if fmt == OutFormat.json:
+        sys.stdout.write(json.dumps(out, indent=2) + "\n")
+    else:
+        for r in out:
+            sys.stdout.write(f"{r['name']:<14} model {r['model']:<13} free: {', '.join(r['free'][:6])}"
+                             f"{' ...' if len(r['free']) > 6 else ''}\n")
+
+
+@app.command()
+def show(name: Annotated[str, typer.Argument(help="A preset or a model (built-in name or TOML file).")],
+         fmt: FormatOpt = OutFormat.text) -> None:
+    """Show a preset's free, fixed and tied parameters (units, defaults) or a model's components and presets."""
+    import json
+
+    from ..errors import ParameterError
+    from ..model import get_preset, resolve_model
+
+    try:
+        pr = get_preset(name)
+    except ParameterError:
+        try:
+            pr = resolve_model(name).get_preset()
+        except ParameterError:
+            from ..model.library import MODELS, preset_names
+            from ..suggest import did_you_mean
+
+            raise ParameterError(f"'{name}' is neither a preset nor a model{did_you_mean(name, [*preset_names(), *MODELS])}"
+                                 f"; see brakesqueal list presets / list models") from None
+    if fmt == OutFormat.json:
+        sys.stdout.write(json.dumps({
+            "name": pr.name, "model": pr.model.name, "description": pr.description, "reference": pr.reference,
+            **{k: {n: {"value": v if isinstance(v, str) else float(v), "unit": pr.unit(n),
+                       "description": pr.describe_name(n)} for n, v in getattr(pr, k).items()}
+               for k in ("free", "fixed")},
+            "tied": dict(pr.tied)}, indent=2) + "\n")
+        return
+    sys.stdout.write(pr.describe() + "\n")
+    if pr.name == pr.model.name:
+        spec = pr.model
+        sys.stdout.write(f"  components: {len(spec.pads)} pad(s) ({', '.join(p.name for p in spec.pads)})"
+                         + (f", caliper(s) {', '.join(c.name for c in spec.calipers)}" if spec.calipers else "")
+                         + f"; presets: {', '.join(spec.preset_names())}\n")
+
+
+def _register_plugins() -> None:
+    """Add the command groups that live in their own modules."""
+    import importlib
+
+    for name in (".stability", ".sweep", ".cache", "..cli_simulate", "..cli_export"):
+        mod = importlib.import_module(name, __package__)
+        mod.register(app, bench_app)
+
+
+_register_plugins()
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point: run the CLI, turning user errors into one stderr line (exit 2) and interrupts into exit 130."""
+    args = sys.argv[1:] if argv is None else list(argv)
+    if not args:
+        args = ["--help"]
+    try:
+        rv = app(args=args, prog_name="brakesqueal", standalone_mode=False)
+    except BrakesquealError as exc:
+        print(f"brakesqueal: error: {exc}", file=sys.stderr)
+        return 2
+    except TyperException as exc:
+        msg = exc.format_message().replace("\n", " ")
+        print(f"brakesqueal: error: {msg}", file=sys.stderr)
+        return 2
+    except Exit as exc:
+        return exc.exit_code
+    except (Abort, KeyboardInterrupt):
+        print("brakesqueal: interrupted", file=sys.stderr)
+        return 130
+    return rv if isinstance(rv, int) else 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

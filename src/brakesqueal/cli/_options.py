@@ -1,0 +1,54 @@
+"""Options shared by every command: ``--model``, ``--preset``, ``--params``, ``--set``, ``--format``.
+
+They mean the same on every command and are resolved once, by
+:func:`brakesqueal.model.options.resolve_space` (the function the Python API uses).
+"""
+
+from __future__ import annotations
+
+import sys
+from enum import Enum
+from typing import Annotated, Any, Optional
+
+import typer
+
+__all__ = ["ModelOpt", "PresetOpt", "ParamsOpt", "SetOpt", "FormatOpt", "OutFormat", "NoCacheOpt", "ProgressOpt",
+           "space_from", "note"]
+
+
+class OutFormat(str, Enum):
+    """Text for people, JSON for scripts."""
+
+    text = "text"
+    json = "json"
+
+
+ModelOpt = Annotated[Optional[str], typer.Option(
+    "--model", help="Built-in model (brakesqueal list models) or a model TOML file.", rich_help_panel="Model")]
+PresetOpt = Annotated[Optional[str], typer.Option(
+    "--preset", help="Preset of the model (brakesqueal list presets); default: the model's own, or paper-fig2.",
+    rich_help_panel="Model")]
+ParamsOpt = Annotated[Optional[str], typer.Option(
+    "--params", help="Parameter file (TOML: model, preset, [parameters]).", rich_help_panel="Model")]
+SetOpt = Annotated[Optional[list[str]], typer.Option(
+    "--set", help="NAME=VALUE in SI units (repeatable; 'inf' = rigid; setting a tied name replaces its tie).",
+    rich_help_panel="Model")]
+FormatOpt = Annotated[OutFormat, typer.Option("--format", help="Output format.")]
+NoCacheOpt = Annotated[bool, typer.Option("--no-cache", help="Derive in-process; do not read or write the cache.")]
+ProgressOpt = Annotated[Optional[bool], typer.Option(
+    "--progress/--no-progress", help="Progress on stderr (default: a bar on a terminal, periodic lines otherwise).")]
+
+
+def note(message: str) -> None:
+    """One informational line on stderr (``brakesqueal: note: ...``)."""
+    print(f"brakesqueal: note: {message}", file=sys.stderr)
+
+
+def space_from(model: str | None, preset: str | None, params: str | None, sets: list[str] | None) -> Any:
+    """The :class:`~brakesqueal.model.parameters.ParameterSpace` of the shared options (notes replaced ties)."""
+    from ..model.options import resolve_space
+
+    space = resolve_space(model, preset, params, list(sets or []))
+    for name in space.untied:
+        note(f"--set {name}=... replaces the tie {name} = {space.preset.tied[name]} of preset '{space.label}'")
+    return space
