@@ -215,44 +215,33 @@ def _generate(spec: Any) -> str:
     return generate_module(specs, header) + f"META = {meta!r}\n"
 
 
-def _structural_zeros(exprs: list[Any], params: list[Any], points: int = 3) -> list[Any]:
+def _structural_zeros(exprs: list[Any], params: list[Any], points: int = 2) -> list[Any]:
     """Replace expressions that vanish identically by the exact 0.
 
-    At ``x = 0`` several Jacobian entries are identically zero but are
-    generated as cancelling terms (e.g. ``N0 mu/|Omega r| - N0 mu r^2 Omega^2/|Omega r|^3``),
-    which floating point turns into rounding noise.  Each entry is evaluated
-    with 60-digit arithmetic (mpmath) at ``points`` random positive parameter
-    points (every parameter's range contains positive values); an entry whose
-    values are zero to 1e-40 relative to its terms at every point is an
-    identity 0 on the domain (a polynomial-identity test).
+    At ``x = 0`` several residuals and Jacobian entries are identically zero
+    but are generated as cancelling terms (e.g.
+    ``N0 mu/sqrt(Omega^2 r^2) - N0 mu r^2 Omega^2/(Omega^2 r^2)^(3/2)``), which
+    floating point turns into rounding noise.  Each entry is evaluated
+    *exactly* (symengine rational arithmetic) at ``points`` random points
+    where every parameter is the square of a positive rational (so the square
+    roots of the contact kinematics stay rational); an entry that is exactly
+    0 at every point is an identity 0 on the domain (a polynomial-identity
+    test; an entry that does not reduce to a rational is left alone).
     """
-    import mpmath
     import symengine as se
-    import sympy as sp
 
     rng = np.random.default_rng(20261123)
-    cand = [i for i, e in enumerate(exprs) if not (e.is_Number and float(e) == 0.0)]
-    if not cand:
-        return exprs
-    syms = [sp.Symbol(str(p)) for p in params]
-    sexprs = [sp.sympify(str(exprs[i])) for i in cand]
-    fns = sp.lambdify(syms, sexprs, modules="mpmath")
-    zero = np.ones(len(cand), dtype=bool)
-    with mpmath.workdps(60):
-        for _ in range(points):
-            vals = [mpmath.mpf(float(v)) for v in rng.uniform(0.5, 2.0, size=len(syms))]
-            try:
-                out = fns(*vals)
-            except (ZeroDivisionError, ValueError, TypeError):
-                return exprs
-            for j, v in enumerate(out):
-                if zero[j] and not (abs(v) <= mpmath.mpf("1e-40")):
-                    zero[j] = False
-    result = list(exprs)
-    for j, i in enumerate(cand):
-        if zero[j]:
-            result[i] = se.Integer(0)
-    return result
+    zero = [not (e.is_Number and float(e) == 0.0) for e in exprs]
+    for _ in range(points):
+        vals = {}
+        for p in params:
+            a, b = (int(v) for v in rng.integers(2, 97, size=2))
+            vals[p] = se.Rational(a * a, b * b)
+        for i, e in enumerate(exprs):
+            if zero[i]:
+                v = se.sympify(e).xreplace(vals)
+                zero[i] = bool(v.is_Number and v == 0)
+    return [se.Integer(0) if z else e for z, e in zip(zero, exprs)]
 
 
 def _namespace(lib: str) -> dict[str, Any]:
