@@ -111,7 +111,9 @@ def test_keeping_pad_rates_adds_stiff_pad_modes_away_from_trivial_point():
 def test_missing_silent_motion_is_established_by_a_fold():
     # a very soft rotational support against a large friction moment (eq. 49): the branch of silent motions
     # connected to the trivial one folds back before the parameters are reached (found by a random search)
-    params = get_preset("general").resolve().replace(
+    from brakesqueal.model import get_preset as preset_of_any_model
+
+    params = preset_of_any_model("general").resolve().replace(
         k_t=2.491695571611462, mu1=1.6826345592247665, mu2=0.1333800175342028, h10=0.027874097668453765,
         h20=0.0435995744628355, N0=79101.77744387428, k1=4860663.169200994, k2=597852.128134904,
         k_ip1=926195.9047145735)
