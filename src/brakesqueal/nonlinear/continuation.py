@@ -52,8 +52,8 @@ import numpy as np
 from ..errors import BrakesquealError, ParameterError
 from .flow import FlowError
 from .hopf import HopfResult
-from .periodic import (PeriodicOrbit, _evaluate, _make_flow, _orbit_from, _resampled, _scale_from, _system_of,
-                       _vector_field)
+from .periodic import (PeriodicOrbit, _best_phase, _evaluate, _guard_clearance, _make_flow, _orbit_from, _resampled,
+                       _scale_from, _system_of, _vector_field)
 
 __all__ = ["CycleBranch", "SpecialPoint", "continue_cycles", "SPECIAL_KINDS"]
 
@@ -263,6 +263,8 @@ class _Engine:
         self.tol = tol
         self.n_samples = n_samples
         self.max_newton = max_newton
+        pw = self.system.as_piecewise()
+        self.guarded = any(len(t) for t in pw.transitions)
 
     def unpack(self, y: np.ndarray) -> tuple[np.ndarray, float, float]:
         return y[: self.N].reshape(self.m, self.n), float(y[self.N]), float(y[self.N + 1])
@@ -287,13 +289,19 @@ class _Engine:
         DG[N, :n] = prow
         return DG
 
-    def correct(self, y_pred: np.ndarray, t_ref: np.ndarray, y_ref: np.ndarray) -> tuple[np.ndarray, Any, np.ndarray, int]:
-        """Newton with phase condition w.r.t. ``y_ref`` and arclength ``t_ref . (yhat - yhat_pred) = 0``."""
+    def correct(self, y_pred: np.ndarray, t_ref: np.ndarray, y_ref: np.ndarray,
+                relaxed: bool = False) -> tuple[np.ndarray, Any, np.ndarray, int]:  # fmt: skip
+        """Newton with phase condition w.r.t. ``y_ref`` and arclength ``t_ref . (yhat - yhat_pred) = 0``.
+
+        ``relaxed``: up to 4 times more iterations and only monotone decrease required (near grazing the
+        shooting map is only once differentiable and Newton converges linearly).
+        """
         prow = self.phase_row(y_ref)
         Xr = y_ref[: self.n]
         y = y_pred.copy()
         last = np.inf
-        for it in range(1, self.max_newton + 1):
+        max_it = self.max_newton * (4 if relaxed else 1)
+        for it in range(1, max_it + 1):
             X, T, p = self.unpack(y)
             if not (T > 0 and math.isfinite(T)):
                 raise _NoConvergence("non-positive period")
@@ -314,11 +322,11 @@ class _Engine:
                 raise _NoConvergence("non-finite Newton step")
             if step < self.tol:
                 return y, ev, DG, it
-            if it >= 3 and step > 0.5 * last:
+            if it >= 3 and step > (last if relaxed else 0.5 * last):
                 raise _NoConvergence("Newton is not converging")
             y = y + d * self.sv
             last = step
-        raise _NoConvergence(f"no convergence in {self.max_newton} iterations")
+        raise _NoConvergence(f"no convergence in {max_it} iterations")
 
     def tangent(self, y: np.ndarray, DG: np.ndarray, t_prev: np.ndarray) -> np.ndarray:
         DGn = DG.copy()
@@ -331,8 +339,8 @@ class _Engine:
         return t if t @ t_prev >= 0 else -t
 
     def point(self, y_pred: np.ndarray, t_ref: np.ndarray, y_ref: np.ndarray, *, samples: bool = True,
-              t_orient: np.ndarray | None = None) -> _Point:  # fmt: skip
-        y, ev, DG, it = self.correct(y_pred, t_ref, y_ref)
+              t_orient: np.ndarray | None = None, relaxed: bool = False) -> _Point:  # fmt: skip
+        y, ev, DG, it = self.correct(y_pred, t_ref, y_ref, relaxed)
         X, T, p = self.unpack(y)
         orbit = _orbit_from(self.flow, X, T, p, ev, self.xscale, it, 0.0, self.n_samples if samples else 0)
         t = self.tangent(y, DG, t_ref if t_orient is None else t_orient)
@@ -340,6 +348,40 @@ class _Engine:
         pt.tests = _tests(pt)
         pt.events = tuple(sorted(e.name for e in orbit.events))
         return pt
+
+    def rephase(self, pt: _Point) -> _Point:
+        """Move the phase point away from switching surfaces (piecewise systems), keeping the orbit.
+
+        The tangent's state block is transported to the new phase by the flow's sensitivities and
+        used to orient the tangent recomputed there.
+        """
+        if not self.guarded:
+            return pt
+        X, T, p = self.unpack(pt.y)
+        c0 = _guard_clearance(self.system, X[0], p, self.xscale)
+        S = pt.orbit.samples
+        if c0 >= 0.05 or S.shape[0] == 0:
+            return pt
+        k = _best_phase(self.system, S, p, self.xscale)
+        if _guard_clearance(self.system, S[k], p, self.xscale) < 3 * c0 or k == 0:
+            return pt
+        tau = T * k / S.shape[0]
+        fr = self.flow(X[0], tau, p, sensitivities=True, scale=self.xscale)
+        n, N = self.n, self.N
+        t = pt.tangent * self.sv
+        dX0 = fr.monodromy @ t[:n] + fr.f_end * (k / S.shape[0]) * t[N] + fr.dp * t[N + 1]
+        Xn = self.flow(fr.x, T, p, sensitivities=False, n_samples=self.m, scale=self.xscale).x_samples
+        y_new = np.concatenate([Xn.ravel(), [T, p]])
+        t_or = np.zeros_like(t)
+        t_or[:n], t_or[N:] = dX0, t[N:]
+        t_or /= self.sv
+        t_or /= np.linalg.norm(t_or)
+        try:
+            new = self.point(y_new, t_or, y_new, t_orient=t_or)
+        except _NoConvergence:
+            return pt
+        new.label, new.iterations = pt.label, pt.iterations
+        return new
 
     def with_samples(self, pt: _Point) -> _Point:
         if pt.orbit.samples.shape[0] == 0:
@@ -442,7 +484,7 @@ def _bisect_events(eng: _Engine, a: _Point, ds: float, ev_a: tuple[str, ...]) ->
     for _ in range(30):
         s = 0.5 * (lo + hi)
         try:
-            pt = eng.point((yhat0 + s * a.tangent) * eng.sv, a.tangent, a.y, samples=False)
+            pt = eng.point((yhat0 + s * a.tangent) * eng.sv, a.tangent, a.y, samples=False, relaxed=True)
         except _NoConvergence:
             break
         if pt.events == ev_a:
@@ -635,7 +677,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
             from .periodic import ShootingError
 
             raise ShootingError(f"the start orbit did not converge: {exc}") from None
-        points.append(first)
+        points.append(eng.rephase(first))
         base_amp = float(np.max(first.orbit.amplitude / xs))
     max_period = 50 * T0 if max_period is None else float(max_period)
     status, message = "max_points", f"reached max_points = {max_points}"
@@ -699,6 +741,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
             pt_s.label = kind
             points.append(eng.with_samples(pt_s))
             special.append((kind, len(points) - 1, desc))
+        b = eng.rephase(b)
         points.append(b)
         # stopping tests
         amp = float(np.max(b.orbit.amplitude / xs))

@@ -260,33 +260,67 @@ class ScipyFlow:
             trans = pw.transitions[mode]
             rhs = _augmented_rhs(msys, p, n) if sens else (lambda _t, yy, _m=msys: _m.rhs(yy, p))
             evs = []
+            dirs = [float(start_dirs.get(i, tr.direction)) for i, tr in enumerate(trans)]
+            # a guard that is zero at the segment start (just after an event) would report a root there:
+            # its event function is shifted by a tiny bias to the side the flow leaves to, and the true
+            # crossing is located afterwards on the dense output
+            xs0 = y[:n]
+            bias = []
+            for tr in trans:
+                w = 1e-8 * float(np.sum(np.abs(tr.grad(xs0, p)) * np.maximum(np.abs(xs0), sref)))
+                bias.append(w if abs(float(tr.guard(xs0, p))) <= 1e-2 * w else 0.0)
             for i, tr in enumerate(trans):
-                def ev(_t: float, yy: np.ndarray, _tr=tr) -> float:
-                    return float(_tr.guard(yy[:n], p))
+                def ev(_t: float, yy: np.ndarray, _tr=tr, _b=-dirs[i] * bias[i]) -> float:
+                    return float(_tr.guard(yy[:n], p)) + _b
                 ev.terminal = True  # type: ignore[attr-defined]
-                ev.direction = float(start_dirs.get(i, tr.direction))  # type: ignore[attr-defined]
+                ev.direction = dirs[i]  # type: ignore[attr-defined]
                 evs.append(ev)
+            # extrema of each guard (dh/dt = 0): a crossing in and out within one step is missed by the
+            # sign test; it is found afterwards from the extremum's sign and the dense output
+            for i, tr in enumerate(trans):
+                def ext(_t: float, yy: np.ndarray, _tr=tr, _m=msys) -> float:
+                    xx = yy[:n]
+                    return float(_tr.grad(xx, p) @ _m.rhs(xx, p))
+                ext.terminal = False  # type: ignore[attr-defined]
+                ext.direction = -dirs[i]  # type: ignore[attr-defined]  # a max of h for +1, a min for -1
+                evs.append(ext)
             t_eval = None
             if t_samp is not None:
                 t_eval = np.append(t_samp[k_next:], T)
             sol = solve_ivp(rhs, (t, T), y, method=self.method, rtol=self.rtol, atol=atol, events=evs or None,
-                            t_eval=t_eval)  # fmt: skip
+                            t_eval=t_eval, dense_output=bool(trans))  # fmt: skip
             nfev += int(sol.nfev)
             if sol.status == -1:
                 raise FlowError(f"integration failed at t = {t:.6g} s: {sol.message}")
+            cands: list[tuple[float, int]] = []
+            for i in range(len(trans)):
+                if sol.t_events[i].size:
+                    te_ = float(sol.t_events[i][0])
+                    if bias[i]:
+                        te_ = _true_root(sol, trans[i], dirs[i], n, p, t, te_)
+                    cands.append((te_, i))
+            t_stop = min(cands)[0] if cands else float(sol.t[-1]) if np.size(sol.t) else T
+            missed = _missed_crossing(sol, trans, dirs, n, p, t, t_stop) if trans else None
+            if missed is not None:
+                cands.append(missed)
+            if cands:
+                t_stop = min(cands)[0]
             if t_eval is not None:
-                m = int(np.count_nonzero(np.asarray(sol.t, dtype=float) < T))
+                tt = np.asarray(sol.t, dtype=float)
+                m = int(np.count_nonzero((tt < T) & (tt <= t_stop)))
                 if m:
                     xs[k_next:k_next + m] = np.asarray(sol.y)[:n, :m].T  # type: ignore[index]
                 smodes.extend([mode] * m)
                 k_next += m
-            if sol.status == 0:
+            if not cands:
+                if sol.status != 0:  # pragma: no cover - a terminal event always gives a candidate
+                    raise FlowError(f"integration stopped at t = {sol.t[-1]:.6g} s without an event")
                 y = sol.y[:, -1]
                 break
             # a guard crossed zero: locate, reset, saltation
-            i = next(j for j, te in enumerate(sol.t_events) if te.size)
-            te = float(sol.t_events[i][0])
-            ye = sol.y_events[i][0]
+            te, i = min(cands)
+            exact = missed is None and not bias[i] and sol.t_events[i].size and te == float(sol.t_events[i][0])
+            ye = sol.y_events[i][0] if exact else sol.sol(te)
             tr = trans[i]
             xm = ye[:n]
             fm = msys.rhs(xm, p)
@@ -350,6 +384,59 @@ class ScipyFlow:
         base.nfev += a.nfev + b.nfev
         base.monodromy_method = "finite-difference"
         return base
+
+
+def _true_root(sol: Any, tr: Transition, direction: float, n: int, p: float, t0: float, te: float) -> float:
+    """Zero of the unbiased guard before ``te`` (the biased event), on the dense output."""
+    from scipy.optimize import brentq
+
+    side0 = -direction
+    hfun = lambda tq: float(tr.guard(sol.sol(tq)[:n], p))  # noqa: E731
+    ts = np.linspace(t0, te, 65)[1:]
+    hs = np.array([hfun(tq) for tq in ts])
+    j = np.flatnonzero(hs * side0 > 0)
+    if j.size == 0 or j[-1] + 1 >= ts.size:
+        return te
+    j = int(j[-1])
+    if hs[j + 1] * side0 > 0:  # pragma: no cover - the biased event lies past the true root
+        return te
+    return float(brentq(hfun, ts[j], ts[j + 1], xtol=4 * np.finfo(float).eps * max(1.0, abs(te))))
+
+
+def _missed_crossing(sol: Any, trans: tuple, dirs: list[float], n: int, p: float, t0: float,
+                     t_stop: float) -> tuple[float, int] | None:  # fmt: skip
+    """Earliest guard crossing hidden inside a step: ``(time, transition index)`` or ``None``.
+
+    At every extremum of a guard before ``t_stop`` whose value has the triggering sign, the guard crossed
+    zero unseen; the crossing is located on the dense output (scan + Brent) after the previous extremum.
+    """
+    from scipy.optimize import brentq
+
+    best: tuple[float, int] | None = None
+    k = len(trans)
+    for i, tr in enumerate(trans):
+        prev = t0
+        h0 = float(tr.guard(sol.sol(t0)[:n], p))
+        side0 = -dirs[i] if dirs[i] != 0 else -np.sign(h0)  # sign of h before a crossing
+        for tm in sol.t_events[k + i]:
+            if tm >= t_stop:
+                break
+            hm = float(tr.guard(sol.sol(tm)[:n], p))
+            if side0 == 0 or hm * side0 >= 0:
+                prev = tm
+                continue
+            ts = np.linspace(prev, tm, 33)
+            hs = np.array([float(tr.guard(sol.sol(tq)[:n], p)) for tq in ts])
+            j = np.flatnonzero(hs * side0 > 0)
+            if j.size == 0:
+                break
+            j = int(j[-1])
+            hfun = lambda tq: float(tr.guard(sol.sol(tq)[:n], p))  # noqa: E731
+            tc = brentq(hfun, ts[j], ts[j + 1], xtol=4 * np.finfo(float).eps * max(1.0, abs(tm)))
+            if best is None or tc < best[0]:
+                best = (tc, i)
+            break
+    return best
 
 
 def _start_directions(pw: PiecewiseSystem, mode: int, x: np.ndarray, p: float, sref: np.ndarray, t: float,

@@ -281,6 +281,24 @@ def _resampled(flow: Any, orbit: PeriodicOrbit, scale: np.ndarray, n_samples: in
     return replace(orbit, **_sampled(flow, orbit.x, orbit.period, orbit.p, scale, n_samples))
 
 
+def _guard_clearance(system: Any, x: np.ndarray, p: float, scale: np.ndarray) -> float:
+    """Scaled distance ``min |h| / |grad h * scale|`` of ``x`` from every guard (``inf`` without guards)."""
+    pw = system.as_piecewise()
+    out = math.inf
+    for trs in pw.transitions:
+        for tr in trs:
+            g = tr.grad(x, p) * scale
+            ng = float(np.linalg.norm(g))
+            if ng > 0:
+                out = min(out, abs(float(tr.guard(x, p))) / ng)
+    return out
+
+
+def _best_phase(system: Any, samples: np.ndarray, p: float, scale: np.ndarray) -> int:
+    """Index of the sample farthest from every guard."""
+    return int(np.argmax([_guard_clearance(system, x, p, scale) for x in samples]))
+
+
 def _return_time(flow: Any, system: Any, x0: np.ndarray, T: float, p: float) -> float:
     """First return time to the section ``<f(x0), x - x0> = 0`` (crossed upwards) within ``2 T``, else ``T``."""
     f0 = _vector_field(system, x0, p)
@@ -402,6 +420,9 @@ def find_periodic_orbit(system: SmoothSystem | PiecewiseSystem, guess: CycleGues
     m = X.shape[0]
     pre = flow(X[0], T, pv, sensitivities=False, n_samples=n_samples)
     scale = _scale_from(X, pre.x_samples)
+    if m == 1 and _guard_clearance(system, X[0], pv, scale) < 1e-3:
+        # a phase point on a switching surface makes the monodromy ill-defined: start elsewhere on the guess
+        X = pre.x_samples[_best_phase(system, pre.x_samples, pv, scale)][None, :].copy()
     xref = X[0].copy()
     fref = _vector_field(system, xref, pv)
     fnorm = float(np.linalg.norm(fref / scale))
