@@ -150,3 +150,29 @@ def test_wrong_side_and_bad_inputs():
     with pytest.raises(BrakesquealError, match="equilibrium"):
         first_lyapunov(none, [0.5, 0.0], 0.1)
     assert h.as_dict()["criticality"] == "supercritical"
+
+
+def test_mode_coupling_hopf_tracks_the_critical_pair():
+    """2-DOF friction-type oscillator with equal damping: at the Hopf point both pairs have the same
+    frequency (mode coupling).  Refinement from either side must follow the pair that crosses, and
+    dRe_lambda_dp must match a finite difference of that eigenvalue (tracked by its eigenvector)."""
+    from brakesqueal.nonlinear.bench import _jac, benchmark_system
+
+    s, sfd = benchmark_system(), benchmark_system(exact=False)
+    ref = first_lyapunov(s, np.zeros(4), 0.2509980079602)
+    assert abs(ref.eigenvalue.real) < 1e-12
+    for p0 in (0.2509, 0.2511):
+        h = first_lyapunov(s, np.zeros(4), p0)
+        assert h.p0 == pytest.approx(ref.p0, abs=1e-12)
+        assert h.l1 == pytest.approx(ref.l1, rel=1e-9)
+    hf = first_lyapunov(sfd, np.zeros(4), ref.p0)
+    assert abs(hf.l1 - ref.l1) <= hf.l1_error
+    assert ref.criticality == "supercritical"
+
+    def crit(p):
+        lam, V = np.linalg.eig(_jac(np.zeros(4), p))
+        k = np.argmax([abs(np.vdot(ref.q, V[:, j])) for j in range(4)])
+        return lam[k]
+
+    d = 1e-7
+    assert ref.dRe_lambda_dp == pytest.approx(((crit(ref.p0 + d) - crit(ref.p0 - d)) / (2 * d)).real, rel=1e-5)

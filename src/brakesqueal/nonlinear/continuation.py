@@ -537,7 +537,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
     max_points : int
         Maximum number of points (special points included).
     ds : float, optional
-        Initial step in scaled arclength (default ``0.02``).
+        Initial step in scaled arclength (default ``min(0.02, ds_max)``).
     ds_min, ds_max : float
         Step limits in scaled arclength.
     n_segments : int
@@ -601,7 +601,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
     bad = detect - {"LPC", "PD", "NS", "BPC", "GR"}
     if bad:
         raise ParameterError(f"The option 'detect' allows LPC, PD, NS, BPC, GR; got {sorted(bad)}")
-    ds = 0.02 if ds is None else float(ds)
+    ds = min(0.02, ds_max) if ds is None else float(ds)
     if not (ds_min <= ds <= ds_max):
         raise ParameterError(f"The option 'ds' must be in [ds_min, ds_max] = [{ds_min}, {ds_max}]; got {ds!r}")
     m = int(n_segments)

@@ -321,14 +321,24 @@ def _equilibrium(system: SmoothSystem, x: np.ndarray, p: float, max_iter: int = 
     return x
 
 
-def _critical_pair(A: np.ndarray, omega: float | None) -> tuple[np.ndarray, int, np.ndarray, np.ndarray]:
+def _critical_pair(A: np.ndarray, omega: float | None,
+                   q_prev: np.ndarray | None = None) -> tuple[np.ndarray, int, np.ndarray, np.ndarray]:  # fmt: skip
+    """Eigen-decomposition and the index of the critical eigenvalue (``Im > 0``).
+
+    Selection: the eigenvector closest in direction to ``q_prev`` (tracking during refinement: mode
+    coupling puts two pairs at nearly the same frequency), else the imaginary part closest to ``omega``,
+    else the pair closest to the imaginary axis.
+    """
     lam, vl, vr = sla.eig(A, left=True, right=True)
     normA = max(float(np.linalg.norm(A, 2)), 1e-300)
     cand = np.flatnonzero(lam.imag > 1e-10 * normA)
     if cand.size == 0:
         raise ParameterError("no complex eigenvalue pair at (x0, p0): not a Hopf point "
                              f"(eigenvalues {np.array2string(lam, precision=4)})")  # fmt: skip
-    if omega is not None:
+    if q_prev is not None:
+        score = [abs(np.vdot(q_prev, vr[:, j])) / np.linalg.norm(vr[:, j]) for j in cand]
+        k = int(cand[int(np.argmax(score))])
+    elif omega is not None:
         k = int(cand[np.argmin(np.abs(lam[cand].imag - omega))])
     else:
         k = int(cand[np.argmin(np.abs(lam[cand].real))])
@@ -447,7 +457,7 @@ def first_lyapunov(system: SmoothSystem, x0: Any, p0: float, *, refine: bool = T
             x = _equilibrium(system, x + _xp * step, p_new)
             p = p_new
             A = system.jacobian(x, p)
-            lam, k, q, pv = _critical_pair(A, lam[k].imag if omega is None else omega)
+            lam, k, q, pv = _critical_pair(A, None, q)
             q, pv = _normalise(q, pv)
             if abs(step) <= 4 * EPS * max(1.0, abs(p)) or abs(lam[k].real) <= 4 * EPS * float(np.linalg.norm(A, 2)):
                 refined = True
