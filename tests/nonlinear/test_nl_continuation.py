@@ -151,3 +151,24 @@ def test_bad_options(bautin_branch):
     deg = first_lyapunov(bautin(beta=0.0), [0, 0], 0.0)
     with pytest.raises(ParameterError, match="degenerate"):
         continue_cycles(bautin(beta=0.0), deg, (-0.5, 0.5))
+
+
+def test_branch_in_si_units_matches_the_dimensionless_system():
+    """Brake-like scaling (omega ~ 1e4 rad/s, angles ~ 1e-5 rad): every branch point is an orbit of the
+    dimensionless system (independent shooting there) with period x 1e-4 and amplitudes x diag(S)."""
+    from test_nl_hopf import _si_scaled
+
+    from brakesqueal.nonlinear.bench import benchmark_system
+
+    base = benchmark_system()
+    S, s = _si_scaled(base)
+    h = first_lyapunov(s, np.zeros(4), 0.2509980079602)
+    br = continue_cycles(s, h, (h.p0, h.p0 + 0.002), max_points=8)
+    d = br.data
+    assert np.all(d["trivial_multiplier_error"].values[1:] < 1e-8)
+    for k in (2, 7):
+        x0 = np.linalg.solve(S, d["x0"].values[k])
+        o = find_periodic_orbit(base, x0, period=float(d["period"].values[k]) * 1e4, p=float(d["p"].values[k]))
+        assert float(d["period"].values[k]) * 1e4 == pytest.approx(o.period, rel=1e-10)
+        np.testing.assert_allclose(d["amplitude"].values[k], o.amplitude * np.diag(S), rtol=1e-8)
+        np.testing.assert_allclose(d["floquet_abs"].values[k], np.abs(o.floquet), rtol=1e-7)

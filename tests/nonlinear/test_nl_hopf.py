@@ -176,3 +176,33 @@ def test_mode_coupling_hopf_tracks_the_critical_pair():
 
     d = 1e-7
     assert ref.dRe_lambda_dp == pytest.approx(((crit(ref.p0 + d) - crit(ref.p0 - d)) / (2 * d)).real, rel=1e-5)
+
+
+def _si_scaled(base, W=1.0e4, L=1e-5, exact=True):
+    """The benchmark oscillator in brake-like SI units: t_SI = t / W, angles x L, rates x L W."""
+    S = np.diag([L, L, L * W, L * W])
+    Si = np.linalg.inv(S)
+    kw = {}
+    if exact:
+        kw = {"B": lambda x, p, u, v: W * S @ base.B(Si @ x, p, Si @ u, Si @ v),
+              "C": lambda x, p, u, v, w: W * S @ base.C(Si @ x, p, Si @ u, Si @ v, Si @ w)}  # fmt: skip
+    return S, SmoothSystem(lambda x, p: W * S @ base.f(Si @ x, p), lambda x, p: W * S @ base.jac(Si @ x, p) @ Si, 4,
+                           dfdp=lambda x, p: W * S @ base.dfdp(Si @ x, p), **kw)  # fmt: skip
+
+
+def test_badly_scaled_si_states_keep_a_sharp_error_estimate():
+    """Stiffness entries ~1e8 next to ones (SI states) must not inflate the error estimate into a false
+    'degenerate' verdict: l1 from exact and from finite-difference forms agree to 1e-10 and the
+    estimate stays small; a_j carry the units (angles x L, rates x L W), omega0 x W."""
+    from brakesqueal.nonlinear.bench import benchmark_system
+
+    base = benchmark_system()
+    h0 = first_lyapunov(base, np.zeros(4), 0.2509980079602)
+    for exact in (True, False):
+        S, s = _si_scaled(base, exact=exact)
+        h = first_lyapunov(s, np.zeros(4), 0.2509980079602)
+        assert h.criticality == "supercritical"
+        assert h.l1_error < 1e-8 * abs(h.l1)
+        assert h.omega0 == pytest.approx(1e4 * h0.omega0, rel=1e-12)
+        np.testing.assert_allclose(h.amplitude_coefficients, np.diag(S) * h0.amplitude_coefficients, rtol=1e-8)
+        assert h.frequency_slope == pytest.approx(1e4 * h0.frequency_slope, rel=1e-7)

@@ -622,7 +622,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
                                  f"{hopf.p0:.12g}, outside p_range = {p_range!r}")  # fmt: skip
         acoef = hopf.amplitude_coefficients
         xs = acoef * math.sqrt(reach)
-        xs = np.maximum(xs, 1e-6 * float(np.max(xs)))
+        xs = np.maximum(xs, 1e-4 * float(np.max(xs)))
         T0 = hopf.period0
         sv = np.concatenate([np.tile(xs, m), [T0, width]])
         eng = _Engine(flow, m, n, sv, xs, tol, n_samples, max_newton)

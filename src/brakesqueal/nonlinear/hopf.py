@@ -367,7 +367,7 @@ def _eigen_derivative(system: SmoothSystem, x: np.ndarray, p: float, A: np.ndarr
 
 def _c1(system: SmoothSystem, x: np.ndarray, p: float, A: np.ndarray, omega: float, q: np.ndarray,
         pv: np.ndarray, step_factor: float = 1.0) -> tuple[complex, np.ndarray, np.ndarray, float, float]:  # fmt: skip
-    """``(c1, h20, h11, sum of |terms|, propagated FD error)``."""
+    """``(c1, h20, h11, sum of |terms|, Skeel condition of the two solves)``."""
     n = x.size
     if step_factor == 1.0:
         stepB = stepC = None  # the system's own (default or fd_step) steps
@@ -377,21 +377,39 @@ def _c1(system: SmoothSystem, x: np.ndarray, p: float, A: np.ndarray, omega: flo
         stepB = (fd if fd is not None else H_FIRST * sc) * step_factor
         stepC = (fd * H_SECOND / H_FIRST if fd is not None else H_SECOND * sc) * step_factor
     qb = np.conj(q)
-    Bqq, e1 = system.bilinear(x, p, q, q, step=stepB)
-    Bqqb, e2 = system.bilinear(x, p, q, qb, step=stepB)
+    Bqq, _ = system.bilinear(x, p, q, q, step=stepB)
+    Bqqb, _ = system.bilinear(x, p, q, qb, step=stepB)
     h20 = np.linalg.solve(2j * omega * np.eye(n) - A, Bqq)
     h11 = -np.linalg.solve(A, np.real(Bqqb))
-    Cqqqb, e3 = system.trilinear(x, p, q, q, qb, step=stepC)
-    Bqbh20, e4 = system.bilinear(x, p, qb, h20, step=stepB)
-    Bqh11, e5 = system.bilinear(x, p, q, h11.astype(complex), step=stepB)
+    Cqqqb, _ = system.trilinear(x, p, q, q, qb, step=stepC)
+    Bqbh20, _ = system.bilinear(x, p, qb, h20, step=stepB)
+    Bqh11, _ = system.bilinear(x, p, q, h11.astype(complex), step=stepB)
     t1, t2, t3 = np.vdot(pv, Cqqqb), np.vdot(pv, Bqbh20), 2 * np.vdot(pv, Bqh11)
     c1 = 0.5 * complex(t1 + t2 + t3)
-    pn = float(np.sum(np.abs(pv)))
-    Ainv = np.linalg.norm(np.linalg.inv(A), 2)
-    A2inv = np.linalg.norm(np.linalg.inv(2j * omega * np.eye(n) - A), 2)
-    bnorm = max(abs(t2), abs(t3)) / max(float(np.linalg.norm(h20)) + float(np.linalg.norm(h11)), 1e-300)
-    fd_err = 0.5 * pn * (e3 + e4 + 2 * e5 + bnorm * (A2inv * e1 + 2 * Ainv * e2))
-    return c1, h20, h11, float(abs(t1) + abs(t2) + abs(t3)), fd_err
+    terms = float(abs(t1) + abs(t2) + abs(t3))
+    # rounding of the two solves: Skeel's condition numbers (invariant to row scaling, so badly scaled
+    # SI states do not inflate them)
+    kap = _skeel(A, h11) + _skeel(2j * omega * np.eye(n) - A, h20)
+    return c1, h20, h11, terms, kap
+
+
+def _skeel(M: np.ndarray, x: np.ndarray) -> float:
+    """Skeel's condition number ``|| |M^-1| |M| |x| ||_inf / ||x||_inf`` of the solve giving ``x``."""
+    nx = float(np.max(np.abs(x)))
+    if nx == 0:
+        return 1.0
+    return float(np.max(np.abs(np.linalg.inv(M)) @ (np.abs(M) @ np.abs(x)))) / nx
+
+
+def _eig_condition(A: np.ndarray, w0: float, q: np.ndarray, pv: np.ndarray) -> float:
+    """Condition of the critical eigenvector: the bordered system of the balanced matrix (as LAPACK sees it)."""
+    Ab, (scale, perm) = sla.matrix_balance(A, permute=False, separate=True)
+    qb = q / scale
+    pb = np.conj(pv) * scale
+    nb = max(float(np.linalg.norm(Ab, 2)), 1e-300)
+    K = np.block([[Ab - 1j * w0 * np.eye(A.shape[0]), nb * (qb / np.linalg.norm(qb))[:, None]],
+                  [nb * (pb / np.linalg.norm(pb))[None, :], np.zeros((1, 1))]])  # fmt: skip
+    return float(np.linalg.cond(K))
 
 
 def first_lyapunov(system: SmoothSystem, x0: Any, p0: float, *, refine: bool = True, omega: float | None = None,
@@ -482,15 +500,15 @@ def first_lyapunov(system: SmoothSystem, x0: Any, p0: float, *, refine: bool = T
     if np.min(np.abs(lam)) <= 1e-12 * normA:
         raise BrakesquealError("A has a zero eigenvalue at the Hopf point (fold-Hopf): l1 is not defined")
     dl, xp = _eigen_derivative(system, x, p, A, q, pv)
-    c1, h20, h11, terms, fd_err = _c1(system, x, p, A, w0, q, pv)
+    c1, h20, h11, terms, kap = _c1(system, x, p, A, w0, q, pv)
     exact = system.exact_multilinear
+    fd_err = 0.0
     if not exact:
+        # the same with doubled steps: the difference bounds the truncation error (many times over)
+        # and measures the round-off noise of the finite differences
         c1b, *_ = _c1(system, x, p, A, w0, q, pv, step_factor=2.0)
-        fd_err = max(fd_err, abs(c1 - c1b) / 15)  # Richardson: c1(h) - c1(2h) ~ 15 x the error of c1(h)
-    # rounding: eigenvector conditioning and the two linear solves
-    K = np.block([[A - 1j * w0 * np.eye(x.size), normA * q[:, None]], [normA * np.conj(pv)[None, :] / np.linalg.norm(pv), np.zeros((1, 1))]])
-    kappa = float(np.linalg.cond(K)) + float(np.linalg.cond(A)) + float(np.linalg.cond(2j * w0 * np.eye(x.size) - A))
-    err_round = 10 * EPS * kappa * terms
+        fd_err = abs(c1 - c1b)
+    err_round = 10 * EPS * (kap + _eig_condition(A, w0, q, pv)) * terms
     err_off = abs(lam_k.real) / max(abs(lam_k), 1e-300) * terms
     c1_err = fd_err + err_round + err_off
     l1 = c1.real / w0

@@ -323,13 +323,13 @@ def _minimal_period_factor(flow: Any, x0: np.ndarray, T: float, p: float, scale:
 
 
 def _scale_from(X: np.ndarray, samples: np.ndarray | None) -> np.ndarray:
-    """Per-coordinate scale: half the range over the orbit (floored), used for tolerances."""
+    """Per-coordinate scale: half the range over the orbit, floored at 1e-4 of the largest (tolerances)."""
     data = samples if samples is not None and samples.size else X
     half = 0.5 * (data.max(axis=0) - data.min(axis=0))
     top = float(np.max(half)) if half.size else 0.0
     if top == 0.0:
         top = max(float(np.max(np.abs(X))), 1.0)
-    return np.maximum(half, 1e-6 * top)
+    return np.maximum(half, 1e-4 * top)
 
 
 def _make_flow(system: Any, flow: Any) -> Any:
