@@ -226,3 +226,25 @@ def test_sliding_is_reported_not_integrated():
     s = PiecewiseSystem((a, b), ((Transition(h, 1, +1),), (Transition(h, 0, -1),)), lambda x, p: int(x[0] > 0))
     with pytest.raises(FlowError, match="sliding"):
         ScipyFlow(s)(np.array([-0.5, 0.0]), 2.0, 0.0)
+
+
+@pytest.mark.parametrize("direction", [1, 0])
+def test_shallow_crossing_inside_one_step_is_found(direction):
+    """x'' = -x from (0, 1), amplitude 1; guard x - (1 - d) with d = 1e-7: the orbit
+    is above the threshold for only 2 sqrt(2 d) ~ 9e-4 s, far shorter than a DOP853 step, so the sign test
+    alone misses it.  Exact crossing times: arcsin(1 - d) and pi - arcsin(1 - d); the flow and its
+    monodromy are those of the harmonic oscillator (both modes are the same field)."""
+    d = 1e-7
+    osc = SmoothSystem(lambda x, p: np.array([x[1], -x[0]]), lambda x, p: np.array([[0.0, 1.0], [-1.0, 0.0]]), 2)
+    h = lambda x, p: x[0] - (1 - d)  # noqa: E731
+    s = PiecewiseSystem((osc, osc), ((Transition(h, 1, direction, name="in"),),
+                                     (Transition(h, 0, -direction, name="out"),)),
+                        mode_of=lambda x, p: int(h(x, p) > 0))  # fmt: skip
+    fr = ScipyFlow(s)(np.array([0.0, 1.0]), 3.0, 0.0)
+    assert [e.name for e in fr.events] == ["in", "out"]
+    # a crossing at slope sqrt(2 d) ~ 4.5e-4 is ill-conditioned in time: state error 1e-11 -> 2e-8 s
+    assert fr.events[0].t == pytest.approx(math.asin(1 - d), abs=5e-8)
+    assert fr.events[1].t == pytest.approx(math.pi - math.asin(1 - d), abs=5e-8)
+    assert fr.events[0].x[0] == pytest.approx(1 - d, abs=1e-12)
+    np.testing.assert_allclose(fr.x, [math.sin(3.0), math.cos(3.0)], atol=1e-10)
+    np.testing.assert_allclose(fr.monodromy, [[math.cos(3.0), math.sin(3.0)], [-math.sin(3.0), math.cos(3.0)]], atol=1e-9)

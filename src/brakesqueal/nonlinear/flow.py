@@ -417,7 +417,7 @@ def _missed_crossing(sol: Any, trans: tuple, dirs: list[float], n: int, p: float
     for i, tr in enumerate(trans):
         prev = t0
         h0 = float(tr.guard(sol.sol(t0)[:n], p))
-        side0 = -dirs[i] if dirs[i] != 0 else -np.sign(h0)  # sign of h before a crossing
+        side0 = -dirs[i] if dirs[i] != 0 else np.sign(h0)  # sign of h before a crossing
         for tm in sol.t_events[k + i]:
             if tm >= t_stop:
                 break
