@@ -16,19 +16,19 @@ from brakesqueal.nonlinear.compiled import F_SIGNATURE, JAC_SIGNATURE  # noqa: E
 
 
 @numba.njit(F_SIGNATURE)
-def bautin_f(x, mu, out):
+def bautin_f(x, mu, th, out):
     r2 = x[0] ** 2 + x[1] ** 2
-    g = mu + r2 - r2**2
+    g = mu + th[0] * r2 - r2**2
     out[0] = g * x[0] - x[1]
     out[1] = g * x[1] + x[0]
 
 
 @numba.njit(JAC_SIGNATURE)
-def bautin_jac(x, mu, out):
+def bautin_jac(x, mu, th, out):
     r2 = x[0] ** 2 + x[1] ** 2
-    g = mu + r2 - r2**2
-    d0 = (1 - 2 * r2) * 2 * x[0]
-    d1 = (1 - 2 * r2) * 2 * x[1]
+    g = mu + th[0] * r2 - r2**2
+    d0 = (th[0] - 2 * r2) * 2 * x[0]
+    d1 = (th[0] - 2 * r2) * 2 * x[1]
     out[0, 0] = g + x[0] * d0
     out[0, 1] = x[0] * d1 - 1
     out[1, 0] = x[1] * d0 + 1
@@ -36,14 +36,14 @@ def bautin_jac(x, mu, out):
 
 
 @numba.njit(F_SIGNATURE)
-def bautin_dfdp(x, mu, out):
+def bautin_dfdp(x, mu, th, out):
     out[0] = x[0]
     out[1] = x[1]
 
 
 @pytest.fixture(scope="module")
 def system():
-    return compiled_system(bautin_f, bautin_jac, bautin_dfdp, 2, parameter_name="mu")
+    return compiled_system(bautin_f, bautin_jac, bautin_dfdp, 2, theta=[1.0], parameter_name="mu")  # beta = 1
 
 
 def test_compiled_flow_matches_scipy_flow(system, rng):
@@ -73,6 +73,17 @@ def test_compiled_continuation_finds_the_bautin_fold(system):
     o = find_periodic_orbit(system, [1.0, 0.0], period=6.0, p=0.1, flow=CompiledFlow(system))
     r2 = (1 + math.sqrt(1.4)) / 2
     assert o.floquet[0].real == pytest.approx(math.exp(2 * math.pi * (2 * r2 - 4 * r2**2)), rel=1e-8)
+
+
+def test_theta_reaches_the_kernels(system):
+    """beta = theta[0] = 0 makes the Hopf point degenerate (l1 = 0); beta = 1 gives l1 = 2 (test_nl_hopf)."""
+    f, jac, dfdp = system._kernels
+    s0 = compiled_system(f, jac, dfdp, 2, theta=[0.0])
+    assert first_lyapunov(s0, [0.0, 0.0], 0.0).criticality == "degenerate"
+    assert first_lyapunov(system, [0.0, 0.0], 0.0).l1 == pytest.approx(2.0, rel=1e-8)
+    a = CompiledFlow(system, theta=[0.0])(np.array([0.5, 0.0]), 1.0, 0.1, sensitivities=False)
+    b = ScipyFlow(s0)(np.array([0.5, 0.0]), 1.0, 0.1, sensitivities=False)
+    np.testing.assert_allclose(a.x, b.x, atol=1e-10)
 
 
 def test_compiled_flow_needs_kernels(system):

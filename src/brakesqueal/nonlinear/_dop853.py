@@ -12,10 +12,11 @@ import numpy as np
 from numba import njit, types
 from scipy.integrate._ivp import dop853_coefficients as _co
 
-#: ``f(x, p, out)`` and ``dfdp(x, p, out)``: ``x`` and ``out`` C-contiguous float64 vectors.
-F_SIGNATURE = types.void(types.float64[::1], types.float64, types.float64[::1])
-#: ``jac(x, p, out)`` with ``out`` a C-contiguous float64 ``(n, n)`` matrix.
-JAC_SIGNATURE = types.void(types.float64[::1], types.float64, types.float64[:, ::1])
+#: ``f(x, p, theta, out)`` and ``dfdp(x, p, theta, out)``: ``x``, ``theta`` (fixed model parameters) and
+#: ``out`` C-contiguous float64 vectors, ``p`` the continuation parameter.
+F_SIGNATURE = types.void(types.float64[::1], types.float64, types.float64[::1], types.float64[::1])
+#: ``jac(x, p, theta, out)`` with ``out`` a C-contiguous float64 ``(n, n)`` matrix.
+JAC_SIGNATURE = types.void(types.float64[::1], types.float64, types.float64[::1], types.float64[:, ::1])
 
 _NS = _co.N_STAGES
 _A = np.ascontiguousarray(_co.A[:_NS, :_NS])
@@ -29,15 +30,15 @@ _JT = types.FunctionType(JAC_SIGNATURE)
 
 
 @njit(cache=True)
-def _rhs(f, jac, dfdp, y, p, n, sens, xb, J, fp, out):  # pragma: no cover - compiled
+def _rhs(f, jac, dfdp, y, p, th, n, sens, xb, J, fp, out):  # pragma: no cover - compiled
     for i in range(n):
         xb[i] = y[i]
-    f(xb, p, fp)
+    f(xb, p, th, fp)
     for i in range(n):
         out[i] = fp[i]
     if sens:
-        jac(xb, p, J)
-        dfdp(xb, p, fp)
+        jac(xb, p, th, J)
+        dfdp(xb, p, th, fp)
         n1 = n + 1
         for i in range(n):
             for j in range(n1):
@@ -49,13 +50,14 @@ def _rhs(f, jac, dfdp, y, p, n, sens, xb, J, fp, out):  # pragma: no cover - com
 
 
 _SIG = types.Tuple((types.int64, types.int64, types.float64))(
-    _FT, _JT, _FT, types.float64[::1], types.float64, types.float64, types.float64, types.float64[::1],
+    _FT, _JT, _FT, types.float64[::1], types.float64, types.float64[::1], types.float64, types.float64,
+    types.float64[::1],
     types.boolean, types.float64[::1], types.float64[:, ::1], types.float64, types.int64,
 )  # fmt: skip
 
 
 @njit(_SIG, cache=True)
-def dop853(f, jac, dfdp, y0, p, T, rtol, atol, sens, t_samples, samples, h0, max_steps):  # pragma: no cover
+def dop853(f, jac, dfdp, y0, p, th, T, rtol, atol, sens, t_samples, samples, h0, max_steps):  # pragma: no cover
     """Integrate ``y' = F(y)`` (state, or state + ``[M | x_p]``) from 0 to ``T``; ``y0`` is overwritten.
 
     Returns ``(status, nfev, h_last)``; status 0 success, -1 step size too small, -2 too many steps,
@@ -70,7 +72,7 @@ def dop853(f, jac, dfdp, y0, p, T, rtol, atol, sens, t_samples, samples, h0, max
     yn = np.empty(N)
     tmp = np.empty(N)
     f0 = np.empty(N)
-    _rhs(f, jac, dfdp, y0, p, n, sens, xb, J, fp, f0)
+    _rhs(f, jac, dfdp, y0, p, th, n, sens, xb, J, fp, f0)
     nfev = 1
     ks = 0
     nsamp = t_samples.size
@@ -93,7 +95,7 @@ def dop853(f, jac, dfdp, y0, p, T, rtol, atol, sens, t_samples, samples, h0, max
         hh = min(hh, T)
         for i in range(N):
             tmp[i] = y0[i] + hh * f0[i]
-        _rhs(f, jac, dfdp, tmp, p, n, sens, xb, J, fp, yn)
+        _rhs(f, jac, dfdp, tmp, p, th, n, sens, xb, J, fp, yn)
         nfev += 1
         d2 = 0.0
         for i in range(N):
@@ -127,13 +129,13 @@ def dop853(f, jac, dfdp, y0, p, T, rtol, atol, sens, t_samples, samples, h0, max
                     for j in range(s):
                         acc += K[j, i] * _A[s, j]
                     tmp[i] = y0[i] + acc * hs
-                _rhs(f, jac, dfdp, tmp, p, n, sens, xb, J, fp, K[s])
+                _rhs(f, jac, dfdp, tmp, p, th, n, sens, xb, J, fp, K[s])
             for i in range(N):
                 acc = 0.0
                 for j in range(_NS):
                     acc += K[j, i] * _B[j]
                 yn[i] = y0[i] + hs * acc
-            _rhs(f, jac, dfdp, yn, p, n, sens, xb, J, fp, K[_NS])
+            _rhs(f, jac, dfdp, yn, p, th, n, sens, xb, J, fp, K[_NS])
             nfev += _NS
             e5 = 0.0
             e3 = 0.0

@@ -80,14 +80,14 @@ def _kernels() -> tuple[Any, Any, Any]:
     from ._dop853 import F_SIGNATURE, JAC_SIGNATURE
 
     @numba.njit(F_SIGNATURE, cache=True)
-    def f(x, p, out):  # pragma: no cover - compiled
+    def f(x, p, th, out):  # pragma: no cover - compiled
         out[0] = x[2]
         out[1] = x[3]
         out[2] = -(K1 * x[0] + p * x[1]) - C1 * x[2] - KN * x[0] ** 3 - DN * x[0] ** 2 * x[2]
         out[3] = -(-p * x[0] + K2 * x[1]) - C2 * x[3] - KN * x[1] ** 3 - DN * x[1] ** 2 * x[3]
 
     @numba.njit(JAC_SIGNATURE, cache=True)
-    def jac(x, p, out):  # pragma: no cover - compiled
+    def jac(x, p, th, out):  # pragma: no cover - compiled
         out[:, :] = 0.0
         out[0, 2] = 1.0
         out[1, 3] = 1.0
@@ -99,7 +99,7 @@ def _kernels() -> tuple[Any, Any, Any]:
         out[3, 3] = -C2 - DN * x[1] ** 2
 
     @numba.njit(F_SIGNATURE, cache=True)
-    def dfdp(x, p, out):  # pragma: no cover - compiled
+    def dfdp(x, p, th, out):  # pragma: no cover - compiled
         out[0] = 0.0
         out[1] = 0.0
         out[2] = -x[1]

@@ -3,9 +3,12 @@ r"""A compiled flow: numba DOP853 with variational equations, for systems given 
 The vector field is given as three numba functions with fixed signatures
 (compile them with ``numba.njit(F_SIGNATURE)`` / ``numba.njit(JAC_SIGNATURE)``):
 
-* ``f(x, p, out)``: ``out[:] = f(x, p)``;
-* ``jac(x, p, out)``: ``out[:, :] = f_x(x, p)`` (C-contiguous ``(n, n)``);
-* ``dfdp(x, p, out)``: ``out[:] = f_p(x, p)``.
+* ``f(x, p, theta, out)``: ``out[:] = f(x, p)``;
+* ``jac(x, p, theta, out)``: ``out[:, :] = f_x(x, p)`` (C-contiguous ``(n, n)``);
+* ``dfdp(x, p, theta, out)``: ``out[:] = f_p(x, p)``;
+
+``p`` is the continuation parameter and ``theta`` a fixed float64 vector of the other model
+parameters (e.g. the vector the simulation kernels take), given once to :func:`compiled_system`.
 
 The integrator kernel (:mod:`._dop853`, same coefficients, error norm and
 step-size control as SciPy's ``DOP853``) takes them as first-class functions,
@@ -34,7 +37,7 @@ from .system import SmoothSystem
 __all__ = ["CompiledFlow", "compiled_system", "F_SIGNATURE", "JAC_SIGNATURE"]
 
 
-def compiled_system(f: Any, jac: Any, dfdp: Any, n: int, **kwargs: Any) -> SmoothSystem:
+def compiled_system(f: Any, jac: Any, dfdp: Any, n: int, theta: Any = (), **kwargs: Any) -> SmoothSystem:
     """A :class:`~.system.SmoothSystem` whose Python callables call numba kernels.
 
     Parameters
@@ -43,6 +46,8 @@ def compiled_system(f: Any, jac: Any, dfdp: Any, n: int, **kwargs: Any) -> Smoot
         Kernels with the signatures of the module docstring.
     n : int
         State dimension.
+    theta : array_like
+        Fixed model parameters passed to every kernel call (default: empty).
     **kwargs
         Further :class:`~.system.SmoothSystem` fields (``B``, ``C``,
         ``jac_p``, ``state_names``, ``parameter_name``, ...).
@@ -52,24 +57,26 @@ def compiled_system(f: Any, jac: Any, dfdp: Any, n: int, **kwargs: Any) -> Smoot
     SmoothSystem
         With ``f``, ``jac`` and ``dfdp`` evaluating the kernels.
     """
+    th = np.ascontiguousarray(np.asarray(theta, dtype=float).ravel())
 
     def f_py(x: np.ndarray, p: float) -> np.ndarray:
         out = np.empty(n)
-        f(np.ascontiguousarray(x, dtype=float), float(p), out)
+        f(np.ascontiguousarray(x, dtype=float), float(p), th, out)
         return out
 
     def jac_py(x: np.ndarray, p: float) -> np.ndarray:
         out = np.empty((n, n))
-        jac(np.ascontiguousarray(x, dtype=float), float(p), out)
+        jac(np.ascontiguousarray(x, dtype=float), float(p), th, out)
         return out
 
     def dfdp_py(x: np.ndarray, p: float) -> np.ndarray:
         out = np.empty(n)
-        dfdp(np.ascontiguousarray(x, dtype=float), float(p), out)
+        dfdp(np.ascontiguousarray(x, dtype=float), float(p), th, out)
         return out
 
     system = SmoothSystem(f=f_py, jac=jac_py, n=n, dfdp=dfdp_py, **kwargs)
     object.__setattr__(system, "_kernels", (f, jac, dfdp))
+    object.__setattr__(system, "_theta", th)
     return system
 
 
@@ -84,6 +91,8 @@ class CompiledFlow:
         SmoothSystem when ``kernels`` is given.
     kernels : tuple, optional
         ``(f, jac, dfdp)`` numba kernels (default: those of ``system``).
+    theta : ndarray, optional
+        Fixed model parameters for the kernels (default: those given to :func:`compiled_system`).
     rtol : float
         Relative tolerance, in ``[1e-13, 1e-3]`` (default ``1e-11``).
     atol : float or ndarray, optional
@@ -94,6 +103,7 @@ class CompiledFlow:
 
     system: SmoothSystem
     kernels: tuple[Any, Any, Any] | None = None
+    theta: Any = None
     rtol: float = 1e-11
     atol: Any = None
     max_steps: int = 1_000_000
@@ -105,6 +115,8 @@ class CompiledFlow:
             self.kernels = getattr(self.system, "_kernels", None)
         if self.kernels is None or len(self.kernels) != 3:
             raise ParameterError("CompiledFlow: give kernels=(f, jac, dfdp) or a system from compiled_system()")
+        th = getattr(self.system, "_theta", np.empty(0)) if self.theta is None else self.theta
+        self.theta = np.ascontiguousarray(np.asarray(th, dtype=float).ravel())
         if not (isinstance(self.rtol, (int, float)) and 1e-13 <= self.rtol <= 1e-3):
             raise ParameterError(f"The option 'rtol' must be in [1e-13, 1e-3]; got {self.rtol!r}")
         self._kernel = dop853
@@ -156,8 +168,8 @@ class CompiledFlow:
         ts = T * np.arange(n_samples) / n_samples if n_samples else np.empty(0)
         S = np.empty((n_samples, n))
         f, jac, dfdp = self.kernels  # type: ignore[misc]
-        status, nfev, _h = self._kernel(f, jac, dfdp, y, float(p), float(T), float(self.rtol), atol, bool(sensitivities),
-                                        ts, S, 0.0, int(self.max_steps))  # fmt: skip
+        status, nfev, _h = self._kernel(f, jac, dfdp, y, float(p), self.theta, float(T), float(self.rtol), atol,
+                                        bool(sensitivities), ts, S, 0.0, int(self.max_steps))  # fmt: skip
         if status != 0:
             what = {-1: "step size too small", -2: "too many steps", -3: "non-finite state"}.get(int(status), "failure")
             raise FlowError(f"compiled DOP853 failed ({what}) at p = {p:.12g}")
