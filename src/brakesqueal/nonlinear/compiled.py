@@ -1,0 +1,183 @@
+r"""A compiled flow: numba DOP853 with variational equations, for systems given as numba kernels.
+
+The vector field is given as three numba functions with fixed signatures
+(compile them with ``numba.njit(F_SIGNATURE)`` / ``numba.njit(JAC_SIGNATURE)``):
+
+* ``f(x, p, theta, out)``: ``out[:] = f(x, p)``;
+* ``jac(x, p, theta, out)``: ``out[:, :] = f_x(x, p)`` (C-contiguous ``(n, n)``);
+* ``dfdp(x, p, theta, out)``: ``out[:] = f_p(x, p)``;
+
+``p`` is the continuation parameter and ``theta`` a fixed float64 vector of the other model
+parameters (e.g. the vector the simulation kernels take), given once to :func:`compiled_system`.
+
+The integrator kernel (:mod:`._dop853`, same coefficients, error norm and
+step-size control as SciPy's ``DOP853``) takes them as first-class functions,
+so it is compiled once per machine and cached by numba; each system only
+compiles its own three small functions.  :func:`compiled_system` wraps the
+kernels into a :class:`~.system.SmoothSystem` (Python callables, used by
+:func:`~.hopf.first_lyapunov`), and :class:`CompiledFlow` implements the
+:class:`~.flow.Flow` protocol for shooting and continuation.  Switching
+events are not supported here: use :class:`~.flow.ScipyFlow` for a
+:class:`~.system.PiecewiseSystem`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ._dop853 import F_SIGNATURE, JAC_SIGNATURE, dop853
+from .flow import FlowError, FlowResult
+from .system import SmoothSystem
+
+__all__ = ["CompiledFlow", "compiled_system", "F_SIGNATURE", "JAC_SIGNATURE"]
+
+
+def compiled_system(f: Any, jac: Any, dfdp: Any, n: int, theta: Any = (), **kwargs: Any) -> SmoothSystem:
+    """A :class:`~.system.SmoothSystem` whose Python callables call numba kernels.
+
+    Parameters
+    ----------
+    f, jac, dfdp : numba dispatchers
+        Kernels with the signatures of the module docstring.
+    n : int
+        State dimension.
+    theta : array_like
+        Fixed model parameters passed to every kernel call (default: empty).
+    **kwargs
+        Further :class:`~.system.SmoothSystem` fields (``B``, ``C``,
+        ``jac_p``, ``state_names``, ``parameter_name``, ...).
+
+    Returns
+    -------
+    SmoothSystem
+        With ``f``, ``jac`` and ``dfdp`` evaluating the kernels.
+    """
+    th = np.ascontiguousarray(np.asarray(theta, dtype=float).ravel())
+
+    def f_py(x: np.ndarray, p: float) -> np.ndarray:
+        out = np.empty(n)
+        f(np.ascontiguousarray(x, dtype=float), float(p), th, out)
+        return out
+
+    def jac_py(x: np.ndarray, p: float) -> np.ndarray:
+        out = np.empty((n, n))
+        jac(np.ascontiguousarray(x, dtype=float), float(p), th, out)
+        return out
+
+    def dfdp_py(x: np.ndarray, p: float) -> np.ndarray:
+        out = np.empty(n)
+        dfdp(np.ascontiguousarray(x, dtype=float), float(p), th, out)
+        return out
+
+    system = SmoothSystem(f=f_py, jac=jac_py, n=n, dfdp=dfdp_py, **kwargs)
+    object.__setattr__(system, "_kernels", (f, jac, dfdp))
+    object.__setattr__(system, "_theta", th)
+    return system
+
+
+@dataclass
+class CompiledFlow:
+    """Flow with sensitivities by the compiled DOP853 kernel (see the module docstring).
+
+    Parameters
+    ----------
+    system : SmoothSystem
+        A system from :func:`compiled_system` (its kernels are used), or any
+        SmoothSystem when ``kernels`` is given.
+    kernels : tuple, optional
+        ``(f, jac, dfdp)`` numba kernels (default: those of ``system``).
+    theta : ndarray, optional
+        Fixed model parameters for the kernels (default: those given to :func:`compiled_system`).
+    rtol : float
+        Relative tolerance, in ``[1e-13, 1e-3]`` (default ``1e-11``).
+    atol : float or ndarray, optional
+        Absolute tolerance of the state (default ``1e-3 rtol scale``).
+    max_steps : int
+        Maximum number of steps per call.
+    """
+
+    system: SmoothSystem
+    kernels: tuple[Any, Any, Any] | None = None
+    theta: Any = None
+    rtol: float = 1e-11
+    atol: Any = None
+    max_steps: int = 1_000_000
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.system, SmoothSystem):
+            raise ParameterError(f"CompiledFlow: 'system' must be a SmoothSystem (no events); got {type(self.system).__name__}")
+        if self.kernels is None:
+            self.kernels = getattr(self.system, "_kernels", None)
+        if self.kernels is None or len(self.kernels) != 3:
+            raise ParameterError("CompiledFlow: give kernels=(f, jac, dfdp) or a system from compiled_system()")
+        th = getattr(self.system, "_theta", np.empty(0)) if self.theta is None else self.theta
+        self.theta = np.ascontiguousarray(np.asarray(th, dtype=float).ravel())
+        if not (isinstance(self.rtol, (int, float)) and 1e-13 <= self.rtol <= 1e-3):
+            raise ParameterError(f"The option 'rtol' must be in [1e-13, 1e-3]; got {self.rtol!r}")
+        self._kernel = dop853
+
+    @property
+    def method(self) -> str:
+        """Integrator name (``"DOP853-jit"``)."""
+        return "DOP853-jit"
+
+    def __call__(self, x0: np.ndarray, T: float, p: float, *, sensitivities: bool = True, n_samples: int = 0,
+                 scale: np.ndarray | None = None) -> FlowResult:  # fmt: skip
+        """Integrate from ``x0`` over ``[0, T]`` (see :class:`~.flow.Flow`).
+
+        Parameters
+        ----------
+        x0 : ndarray
+            Initial state.
+        T : float
+            Duration (> 0).
+        p : float
+            Parameter.
+        sensitivities : bool
+            Also return the monodromy matrix and ``d phi / d p``.
+        n_samples : int
+            Number of uniform output samples over ``[0, T)``.
+        scale : ndarray, optional
+            Typical magnitude of each state component.
+
+        Returns
+        -------
+        FlowResult
+            End state and sensitivities.
+        """
+        n = self.system.n
+        x0 = np.asarray(x0, dtype=float)
+        if not (math.isfinite(T) and T > 0):
+            raise FlowError(f"flow duration must be positive and finite; got T = {T!r}")
+        if self.atol is not None:
+            ax = np.broadcast_to(np.asarray(self.atol, dtype=float), (n,)).copy()
+        else:
+            s = np.asarray(scale, dtype=float) if scale is not None else np.full(n, max(float(np.max(np.abs(x0))), 1e-300))
+            ax = 1e-3 * self.rtol * np.maximum(s, 1e-300)
+        if sensitivities:
+            y = np.concatenate([x0, np.hstack([np.eye(n), np.zeros((n, 1))]).ravel()])
+            atol = np.concatenate([ax, np.column_stack([np.full((n, n), 1e-3 * self.rtol), ax]).ravel()])
+        else:
+            y = x0.copy()
+            atol = ax
+        ts = T * np.arange(n_samples) / n_samples if n_samples else np.empty(0)
+        S = np.empty((n_samples, n))
+        f, jac, dfdp = self.kernels  # type: ignore[misc]
+        status, nfev, _h = self._kernel(f, jac, dfdp, y, float(p), self.theta, float(T), float(self.rtol), atol,
+                                        bool(sensitivities), ts, S, 0.0, int(self.max_steps))  # fmt: skip
+        if status != 0:
+            what = {-1: "step size too small", -2: "too many steps", -3: "non-finite state"}.get(int(status), "failure")
+            raise FlowError(f"compiled DOP853 failed ({what}) at p = {p:.12g}")
+        x = y[:n].copy()
+        Z = y[n:].reshape(n, n + 1) if sensitivities else None
+        return FlowResult(
+            x=x, f_end=self.system.rhs(x, p), monodromy=Z[:, :n].copy() if Z is not None else None,
+            dp=Z[:, n].copy() if Z is not None else None, t_samples=ts if n_samples else None,
+            x_samples=S if n_samples else None, events=[], modes=[], mode_end=0, nfev=int(nfev),
+            monodromy_method="variational" if sensitivities else "none",
+        )  # fmt: skip
