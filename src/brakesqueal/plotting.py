@@ -97,3 +97,41 @@ def save(fig: Any, path: str, dpi: int = 150) -> str:
     """Save a figure (format from the suffix: PNG, SVG, PDF) and return the path."""
     fig.savefig(path, dpi=dpi)
     return path
+
+
+def plot_modes(tracks: Any, fig: Any = None) -> Any:
+    """Mode-coupling diagram of :class:`~brakesqueal.analysis.modes.ModeTracks`: frequency and Re λ vs the parameter.
+
+    Coalescences are marked with circles on the frequency panel, stability
+    crossings with vertical dashed lines (red: destabilizing, green:
+    stabilizing).  Returns the figure.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    if fig is None:
+        fig = Figure(figsize=(6.4, 5.2), layout="constrained")
+        FigureCanvasAgg(fig)
+    ax_f, ax_r = fig.subplots(2, 1, sharex=True)
+    x = tracks.values
+    f, re = tracks.frequencies, tracks.eigenvalues.real
+    for k in range(f.shape[1]):
+        line, = ax_f.plot(x, f[:, k], lw=1.3, label=f"mode {k}")
+        ax_r.plot(x, re[:, k], lw=1.3, color=line.get_color())
+    for c in tracks.coalescences:
+        ax_f.plot([c["value"]], [c["frequency_hz"]], "o", mfc="none", mec="k", ms=7)
+    for c in tracks.crossings:
+        color = "tab:red" if c["direction"] == "destabilizing" else "tab:green"
+        for ax in (ax_f, ax_r):
+            ax.axvline(c["value"], color=color, ls="--", lw=0.8)
+    ax_r.axhline(0.0, color="0.4", lw=0.8)
+    if tracks.log:
+        ax_r.set_xscale("log")
+    unit = f" [{tracks.units}]" if tracks.units else ""
+    ax_r.set_xlabel(f"{tracks.parameter}{unit}")
+    ax_f.set_ylabel("frequency [Hz]")
+    ax_r.set_ylabel(r"Re $\lambda$ [1/s]")
+    ax_r.set_yscale("symlog", linthresh=max(1e-3, float(np.nanmax(np.abs(re))) * 1e-3))
+    ax_f.legend(fontsize=8, loc="best", ncols=2)
+    ax_f.set_title(f"mode coupling along {tracks.parameter} ({tracks.model})")
+    return fig

@@ -211,7 +211,7 @@ def _register_plugins() -> None:
     """Add the command groups that live in their own modules."""
     import importlib
 
-    for name in (".stability", ".sweep", ".cache", "..cli_simulate", "..cli_export"):
+    for name in (".stability", ".modes", ".sweep", ".cache", "..cli_simulate", "..cli_export"):
         mod = importlib.import_module(name, __package__)
         mod.register(app, bench_app)
 
