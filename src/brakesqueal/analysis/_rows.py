@@ -19,10 +19,12 @@ import numpy as np
 __all__ = ["rows_eval", "normalise_rows"]
 
 _U = 2.0 ** -53
+#: 2^-k for k = 0..1074 (exact), avoids a libm ldexp call per term
+_POW2 = np.ldexp(1.0, -np.arange(1075))
 
 
 @numba.njit(cache=True, error_model="numpy")
-def rows_eval(exps, slot, mant, e2, Um, Qe, nops, C, EC):  # type: ignore[no-untyped-def]
+def rows_eval(exps, slot, mant, e2, Um, Qe, nops, C, EC, pow2=_POW2):  # type: ignore[no-untyped-def]
     """Fill ``C[r, s]`` (values) and ``EC[r, s]`` (absolute error bounds) for every row ``r``.
 
     ``nops[s]`` bounds the number of rounded operations per term plus the
@@ -57,9 +59,9 @@ def rows_eval(exps, slot, mant, e2, Um, Qe, nops, C, EC):  # type: ignore[no-unt
             sh = ex[t] - mx
             s = slot[t]
             if sh < -1000:
-                EC[r, s] += math.ldexp(1.0, max(sh, -1074))
+                EC[r, s] += pow2[min(-sh, 1074)]
                 continue
-            v = math.ldexp(v, sh)
+            v *= pow2[-sh]
             C[r, s] += v
             A[s] += abs(v)
         for s in range(ncol):

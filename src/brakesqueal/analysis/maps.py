@@ -236,8 +236,8 @@ def _kernel_usable(kern: object, iv: np.ndarray) -> tuple[int, np.ndarray] | Non
     t = np.ldexp(np.asarray(iv, dtype=float), -e)
     deg = max(kern.degrees)  # type: ignore[attr-defined]
     tmax = float(np.max(np.abs(t))) if t.size else 0.0
-    if not (np.all(np.isfinite(t)) and (tmax <= 1 or deg * math.log2(tmax) < 900)):
-        return None
+    if not (np.all(np.isfinite(t)) and (tmax <= 1 or deg * math.log2(tmax) < 300)):
+        return None  # |a_k| < 2^300 keeps H3 finite in the kernel (no overflow, no NaN)
     return e, t
 
 

@@ -34,7 +34,8 @@ __all__ = ["MARKERS", "study_attrs", "variable_attrs", "create_store", "open_sto
            "remove_store", "checksum"]
 
 MARKERS = "_sweep_chunks"
-_STATUS_MEANINGS = "not_computed ok ok_nontrivial_silent_motion no_silent_motion pad_loses_contact invalid_parameters"
+_STATUS_MEANINGS = ("not_computed ok ok_nontrivial_silent_motion no_silent_motion pad_loses_contact invalid_parameters"
+                    " undecided")
 
 
 def _units(name: str) -> str:
@@ -84,7 +85,7 @@ def variable_attrs(study: Any) -> dict[str, dict[str, Any]]:
     """Attributes of every data variable."""
     extra = {"coordinates": " ".join(study.sample_names)} if study.kind == "samples" else {}
     out = {"stable": {"long_name": "silent motion asymptotically stable (Hurwitz)", **extra},
-           "status": {"flag_values": list(range(-1, 5)), "flag_meanings": _STATUS_MEANINGS, **extra}}
+           "status": {"flag_values": list(range(-1, 6)), "flag_meanings": _STATUS_MEANINGS, **extra}}
     for q, qa in FLOAT_QUANTITIES.items():
         if q in study.quantities:
             out[q] = {**qa, **extra}
