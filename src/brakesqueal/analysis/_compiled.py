@@ -446,14 +446,12 @@ def _illinois(c, rc, d, a, b, fa, fb, certified):  # type: ignore[no-untyped-def
 def _refine(c, rc, d, a, b, sa):  # type: ignore[no-untyped-def]
     """Shrink a bracket ``(a, b)`` holding one simple root (``sign p(a) = sa``, certified at both ends).
 
-    Returns ``(a, b, x)``: a bracket whose end signs are still certified
-    (Illinois regula falsi on certified signs), and an estimate ``x`` inside
-    it polished in plain floating point (regula falsi then Newton; ~1e-13
-    relative for well-conditioned roots; not certified beyond the bracket).
+    The root is located in plain floating point (log-bisection while the
+    bracket is wide, Illinois regula falsi, Newton); then the smallest
+    bracket ``x (1 ± δ)``, ``δ = 2^-44, 2^-36, ...``, whose end signs are
+    certified opposite is returned with the estimate: ``(a, b, x)``.  If no
+    such bracket is found the original ``(a, b)`` is kept (still certified).
     """
-    fa = horner_interval(c, rc, d, a)[0]
-    fb = horner_interval(c, rc, d, b)[0]
-    a, b = _illinois(c, rc, d, a, b, fa, fb, True)
     fa = _horner_d(c, d, a)[0]
     fb = _horner_d(c, d, b)[0]
     x = 0.5 * (a + b)
@@ -468,6 +466,18 @@ def _refine(c, rc, d, a, b, sa):  # type: ignore[no-untyped-def]
             if not (lo <= xn <= hi) or xn == x:
                 break
             x = xn
+    if not (a < x < b):
+        x = 0.5 * (a + b)
+    delta = 2.0 ** -44
+    scale = max(abs(x), 1e-300)
+    for _ in range(6):
+        xl = x - delta * scale
+        xh = x + delta * scale
+        if xl <= a or xh >= b:
+            break
+        if _sgn_at(c, rc, d, xl) == sa and _sgn_at(c, rc, d, xh) == -sa:
+            return xl, xh, x
+        delta *= 256.0
     return a, b, x
 
 
@@ -487,6 +497,35 @@ def isolate_roots(c, rc, d, lo, hi, out, w, rw, stack):  # type: ignore[no-untyp
         d -= 1  # exact zero leading coefficients: lower degree
     if d == 0:
         return 0
+    if lo >= 0.0:
+        # Descartes on (0, inf) with the raw coefficients: V = 0 -> no positive root; V = 1 -> exactly one
+        var = 0
+        last = 0
+        for k in range(d + 1):
+            if c[k] == 0.0 and rc[k] == 0.0:
+                continue
+            sg = _sign(c[k], rc[k])
+            if sg == 0:
+                var = 99
+                break
+            if last != 0 and sg != last:
+                var += 1
+            last = sg
+        if var == 0:
+            return 0
+        if var == 1:
+            sa = _sgn_at(c, rc, d, lo)
+            sb = _sgn_at(c, rc, d, hi)
+            if sa != 0 and sb != 0:
+                if sa == sb:
+                    return 0
+                if out.shape[0] < 1:
+                    return -1
+                ra, rb, rx = _refine(c, rc, d, lo, hi, sa)
+                out[0, 0] = ra
+                out[0, 1] = rb
+                out[0, 2] = rx
+                return 1
     top = 0
     stack[0, 0] = lo
     stack[0, 1] = hi
