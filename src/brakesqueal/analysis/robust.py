@@ -510,7 +510,10 @@ def _quartic_exact(e: Sequence[Fraction]) -> list[Fraction]:
 
 
 def _exact_point(p: Sequence[float], eigen: bool) -> tuple[int, float, float]:
-    q = _quartic_exact(exact_trivial_entries(p))
+    try:
+        q = _quartic_exact(exact_trivial_entries(p))
+    except (ZeroDivisionError, OverflowError, ValueError):  # singular closed form (invalid parameters)
+        return UNDECIDED, math.nan, math.nan
     code = routh_exact(q)
     if not eigen:
         return code, math.nan, math.nan

@@ -29,7 +29,6 @@ Everything here reuses the certified stability routes of :mod:`brakesqueal.analy
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
