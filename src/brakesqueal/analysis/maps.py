@@ -137,20 +137,22 @@ def _check_axes(space: ParameterSpace, axes: list[Axis], force: bool) -> None:
 def _valid(arr: dict[str, np.ndarray]) -> np.ndarray:
     """Points whose 17 model parameters satisfy the bounds of :class:`~brakesqueal.parameters.Parameters`."""
     ok = np.ones(np.shape(next(iter(arr.values()))), dtype=bool)
-    for name, vname in zip(PARAMETER_NAMES, VECTOR_NAMES):
-        v = arr[vname]
-        if vname != name:  # compliance in [0, inf)
-            ok &= (v >= 0) & np.isfinite(v)
-            continue
-        low, high, low_open, high_open = _BOUNDS[name]
-        ok &= (v > low if low_open else v >= low) & (v < high if high_open else v <= high)
-    ok &= arr["h10"] + arr["h20"] > 0
+    with np.errstate(all="ignore"):
+        for name, vname in zip(PARAMETER_NAMES, VECTOR_NAMES):
+            v = arr[vname]
+            if vname != name:  # compliance in [0, inf)
+                ok &= (v >= 0) & np.isfinite(v)
+                continue
+            low, high, low_open, high_open = _BOUNDS[name]
+            ok &= (v > low if low_open else v >= low) & (v < high if high_open else v <= high)
+        ok &= arr["h10"] + arr["h20"] > 0
     return ok
 
 
 def _trivial(arr: dict[str, np.ndarray]) -> np.ndarray:
-    a, b = arr["mu1"] * arr["h10"], arr["mu2"] * arr["h20"]
-    return np.abs(a - b) <= 1e-12 * np.maximum(np.abs(a), np.abs(b))
+    with np.errstate(all="ignore"):
+        a, b = arr["mu1"] * arr["h10"], arr["mu2"] * arr["h20"]
+        return np.abs(a - b) <= 1e-12 * np.maximum(np.abs(a), np.abs(b))
 
 
 def _roots_summary(a: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray]:

@@ -177,14 +177,15 @@ def _valid(arr: dict[str, np.ndarray]) -> np.ndarray:
         c = np.asarray(c)
         parts[c.shape] = parts[c.shape] & c if c.shape in parts else c
 
-    for name, vname in zip(PARAMETER_NAMES, VECTOR_NAMES):
-        v = arr[vname]
-        if vname != name:
-            add((v >= 0) & np.isfinite(v))
-            continue
-        low, high, low_open, high_open = _BOUNDS[name]
-        add((v > low if low_open else v >= low) & (v < high if high_open else v <= high))
-    add(arr["h10"] + arr["h20"] > 0)
+    with np.errstate(all="ignore"):
+        for name, vname in zip(PARAMETER_NAMES, VECTOR_NAMES):
+            v = arr[vname]
+            if vname != name:
+                add((v >= 0) & np.isfinite(v))
+                continue
+            low, high, low_open, high_open = _BOUNDS[name]
+            add((v > low if low_open else v >= low) & (v < high if high_open else v <= high))
+        add(arr["h10"] + arr["h20"] > 0)
     if all(bool(np.all(c)) for c in parts.values()):
         return np.ones((1,) * max(len(k) for k in parts), dtype=bool)
     ok: Any = np.True_
