@@ -111,26 +111,30 @@ def test_routh_classification_equals_eigenvalue_verdicts(model, x, y):
     space = ModelSpace(get_model(model))
     ref = model_stability_map(space, x, y, eigen=True).data
     fast = model_stability_map(space, x, y, eigen=False).data
-    assert "Routh" in fast.attrs["method"]
+    if model == "paper-2dof":  # the certified Routh test decides quartics; degree-2n ones of lightly damped
+        assert "Routh" in fast.attrs["method"]  # models with n > 2 fall back to eigenvalues (see fastmap)
     assert ref["stable"].values.any() and not ref["stable"].values.all(), "the map must contain a boundary"
-    differ = ref["stable"].values != fast["stable"].values
-    # only points where the eigenvalue verdict itself is within rounding of the boundary may differ
-    margin = np.abs(ref["max_real"].values)
-    assert not np.any(differ & (margin > 1e-6)), margin[differ]
-    assert np.array_equal(ref["status"].values, fast["status"].values)
+    both = (ref["status"].values <= 1) & (fast["status"].values <= 1)
+    # certified verdicts of both routes agree wherever both are decided
+    assert np.array_equal(ref["stable"].values[both], fast["stable"].values[both])
+    assert both.mean() > 0.99
+    assert np.array_equal(ref["status"].values >= 2, fast["status"].values >= 2) or \
+        set(np.unique(ref["status"].values[~both])) | set(np.unique(fast["status"].values[~both])) <= {5}
 
 
-def test_routh_classification_near_the_boundary():
-    """Points placed just off a boundary (found by bisection on eigenvalues) are classified correctly."""
+@pytest.mark.parametrize("model,xname,yname,yv,lo,hi", [("paper-2dof", "k_ip1", "k1", 6e6, 1e5, 1e10),
+                                                         ("eight-dof", "k_c", "k_cn", 5e7, 1e8, 1e10)])
+def test_routh_classification_near_the_boundary(model, xname, yname, yv, lo, hi):
+    """Points placed just off a boundary (found by bisection on eigenvalues): certified codes are never wrong."""
     from scipy.optimize import brentq
 
-    spec = get_model("eight-dof")
+    spec = get_model(model)
     space = ModelSpace(spec)
 
     def mr(kc):
-        return linearize_model(spec, {"k_c": kc, "k_cn": 5e7}).max_real
+        return linearize_model(spec, {xname: kc, yname: yv}).max_real
 
-    grid = np.geomspace(1e8, 1e10, 60)
+    grid = np.geomspace(lo, hi, 60)
     vals = np.array([mr(v) for v in grid])
     i = int(np.flatnonzero(np.sign(vals[:-1]) != np.sign(vals[1:]))[0])
     root = brentq(mr, grid[i], grid[i + 1], xtol=1e-6)
@@ -143,11 +147,14 @@ def test_routh_classification_near_the_boundary():
     vec = _vectorized(cm)
 
     def mats(xv, yv):
-        pp = _params(space, cm, {"k_c": xv, "k_cn": yv}, xv.size)
+        pp = _params(space, cm, {xname: xv, yname: yv}, xv.size)
         return _matrices_at_zero(space, cm, vec, pp, xv.size)[:3]
 
-    xs = np.concatenate([np.geomspace(1e8, 1e10, 9), pts])
+    xs = np.concatenate([np.geomspace(lo, hi, 9), pts])
     xs.sort()
-    verdict = classify(mats, xs, np.array([5e7, 5.1e7]), x_log=True, y_log=True)[0]
-    expect = np.array([mr(v) < 0 for v in xs])
-    assert np.array_equal(verdict, expect)
+    codes = classify(mats, xs, np.array([yv, yv * 1.02]), x_log=True, y_log=True)[0]
+    expect = np.array([mr(v) < 0 for v in xs]).astype(np.uint8)
+    decided = codes != 2
+    assert np.array_equal(codes[decided], expect[decided])
+    if model == "paper-2dof":
+        assert decided.all()

@@ -17,7 +17,7 @@ import numpy as np
 
 __all__ = ["StabilityMap", "CrossingResult", "CriticalSpeedResult", "open_map"]
 
-_STATUS_MEANINGS = "ok ok_nontrivial_silent_motion no_silent_motion pad_loses_contact invalid_parameters"
+_STATUS_MEANINGS = "ok ok_nontrivial_silent_motion no_silent_motion pad_loses_contact invalid_parameters undecided"
 
 
 def _units(name: str) -> str:
@@ -41,12 +41,14 @@ class StabilityMap:
         (``"linear"`` or ``"log"``) attributes.  Variables:
 
         * ``max_real``: largest real part of the eigenvalues of eq. (47) [1/s];
-        * ``stable``: bool, silent motion asymptotically stable (Hurwitz);
+        * ``stable``: bool, silent motion asymptotically stable (certified
+          Hurwitz test); for status 0/1 ``stable`` ⇔ ``max_real < 0``;
         * ``frequency``: frequency of the least-stable mode [Hz];
         * ``status``: int8 code, ``0`` ok, ``1`` ok with a non-trivial
           silent motion, ``2`` no silent motion, ``3`` a pad loses contact,
-          ``4`` invalid parameters (see its ``flag_meanings``); points with
-          ``status >= 2`` are never stable.
+          ``4`` invalid parameters, ``5`` undecided (the verdict could not be
+          certified, e.g. exactly on a stability boundary; see its
+          ``flag_meanings``); points with ``status >= 2`` are never stable.
 
         Dataset attributes: ``space`` (preset label), ``settings`` and
         ``tied`` (JSON), ``method`` and ``criterion``.
@@ -69,13 +71,13 @@ class StabilityMap:
                 "max_real": (dims, max_real, {"units": "1/s", "long_name": "largest real part of the eigenvalues"}),
                 "stable": (dims, stable, {"long_name": "silent motion asymptotically stable (Hurwitz)"}),
                 "frequency": (dims, frequency, {"units": "Hz", "long_name": "frequency of the least-stable mode"}),
-                "status": (dims, status, {"flag_values": np.arange(5, dtype=np.int8),
+                "status": (dims, status, {"flag_values": np.arange(6, dtype=np.int8),
                                           "flag_meanings": _STATUS_MEANINGS}),
             },
             coords=coords,
             attrs={"space": space.label, "settings": json.dumps({k: str(v) for k, v in space.definitions().items()}),
                    "tied": json.dumps(dict(space.tied)), "method": method,
-                   "criterion": "Lienard-Chipart on det(lambda^2 M + lambda D + K) (exact sign test)"},
+                   "criterion": "Lienard-Chipart on det(lambda^2 M + lambda D + K) (certified sign test)"},
         )
         return cls(ds)
 
@@ -166,6 +168,14 @@ class CrossingResult:
         The parameter space the path lies in (default ``None``); used by
         :meth:`plot` to evaluate the largest real part along the path.  Not
         part of :meth:`to_dict`, the repr or comparisons.
+    undecided_ranges : tuple of (float, float), optional
+        Sub-ranges where the verdict could not be decided (default none);
+        crossings inside them may be missing.
+    exhaustive : bool, optional
+        ``True`` (default) when every stability change outside
+        ``undecided_ranges`` is guaranteed to be listed (exact root
+        isolation); ``False`` for grid searches, which can miss two crossings
+        closer together than the grid spacing.
     """
 
     parameter: str
@@ -176,12 +186,20 @@ class CrossingResult:
     crossings: tuple[tuple[float, str], ...]
     method: str
     space: Any = field(default=None, repr=False, compare=False)
+    undecided_ranges: tuple[tuple[float, float], ...] = ()
+    exhaustive: bool = True
+
+    @property
+    def complete(self) -> bool:
+        """Whether the result is guaranteed on the whole range (exhaustive and nothing undecided)."""
+        return self.exhaustive and not self.undecided_ranges
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON schema of ``brakesqueal crossings --format json``."""
         return {"parameter": self.parameter, "stable_at_start": self.stable_at_start,
                 "crossings": [{"value": v, "direction": d} for v, d in self.crossings],
-                "range": [self.start, self.stop], "method": self.method}
+                "range": [self.start, self.stop], "method": self.method,
+                "undecided_ranges": [[a, b] for a, b in self.undecided_ranges], "exhaustive": self.exhaustive}
 
     def to_xarray(self) -> Any:
         """Dataset with dimension ``crossing``: ``value`` and ``direction`` (+1 stabilizing, -1 destabilizing)."""
@@ -196,7 +214,12 @@ class CrossingResult:
         """Human-readable summary."""
         lines = [f"{self.parameter} in [{self.start:g}, {self.stop:g}]: "
                  f"{'stable' if self.stable_at_start else 'unstable'} at start ({self.method})"]
-        lines += [f"  {self.parameter} = {v:.12g}: {d}" for v, d in self.crossings] or ["  no stability change"]
+        lines += [f"  {self.parameter} = {v:.12g}: {d}" for v, d in self.crossings] or (
+            ["  no stability change"] if self.complete else ["  no stability change found"])
+        lines += [f"  UNDECIDED for {self.parameter} in [{a:.6g}, {b:.6g}] (crossings there may be missing)"
+                  for a, b in self.undecided_ranges]
+        if not self.exhaustive:
+            lines.append("  note: grid search, crossings closer together than the grid spacing may be missing")
         return "\n".join(lines) + "\n"
 
     def plot(self, ax: Any = None, n: int = 400) -> Any:
@@ -231,21 +254,42 @@ class CriticalSpeedResult(CrossingResult):
         :func:`~brakesqueal.analysis.crossings.crossings`).
     space : ParameterSpace or None, optional
         The parameter space (default ``None``), used by :meth:`plot`.
+    undecided_ranges : tuple of (float, float), optional
+        Ω sub-ranges where the verdict could not be decided.
+    exhaustive : bool, optional
+        Whether every crossing outside ``undecided_ranges`` is guaranteed listed.
     """
 
     @property
     def Omega_crit(self) -> float | None:
-        """Smallest destabilizing Ω [rad/s] in the range, or None."""
+        """Smallest destabilizing Ω [rad/s] found in the range, or None (see :attr:`Omega_crit_certain`)."""
         onsets = [v for v, d in self.crossings if d == "destabilizing"]
         return onsets[0] if onsets else None
+
+    @property
+    def Omega_crit_certain(self) -> bool:
+        """``True`` when :attr:`Omega_crit` is established: no undecided range below it and an exhaustive search."""
+        oc = self.Omega_crit
+        if not self.exhaustive:
+            return False
+        return not any(a < (oc if oc is not None else math.inf) for a, _ in self.undecided_ranges)
 
     def to_dict(self) -> dict[str, Any]:
         d = super().to_dict()
         d["Omega_crit"] = self.Omega_crit
+        d["Omega_crit_certain"] = self.Omega_crit_certain
         return d
 
     def text(self) -> str:
         oc = self.Omega_crit
-        head = (f"Omega_crit = {oc:.12g} rad/s ({oc / (2 * math.pi):.6g} rev/s)" if oc is not None
-                else "Omega_crit = none (no destabilizing crossing in the range)")
+        if oc is not None:
+            head = f"Omega_crit = {oc:.12g} rad/s ({oc / (2 * math.pi):.6g} rev/s)"
+            if not self.Omega_crit_certain:
+                head += " (NOT certain: a smaller onset may lie in an undecided range or between grid points)"
+        elif not self.stable_at_start and self.complete:
+            head = "Omega_crit = none in the range: unstable already at the start of the range"
+        elif self.complete:
+            head = "Omega_crit = none (no destabilizing crossing in the range)"
+        else:
+            head = "Omega_crit = UNKNOWN (no destabilizing crossing found, but the range was not fully decided)"
         return head + "\n" + super().text()

@@ -35,7 +35,7 @@ def _naive_eigvals_rate(space, kip: np.ndarray, mu: np.ndarray, n: int) -> float
 def bench_map(*, size: int = 4000, large: bool = False) -> list[BenchResult]:
     """Stability-map throughput: compiled Hurwitz kernel, NumPy path, Dataset path, naive baseline."""
     from ..numeric.compiled import compiled_model
-    from .kernels import hurwitz_stable, map_kernel, quartic_coefficients
+    from .kernels import hurwitz_stable, inner_exponent, kernel_segments, map_kernel, quartic_coefficients
     from .maps import Axis, stability_map
     from .space import VECTOR_NAMES, ParameterSpace
 
@@ -49,10 +49,13 @@ def bench_map(*, size: int = 4000, large: bool = False) -> list[BenchResult]:
     outer, inner = ax[kern.outer], ax[kern.inner]
     ov, iv = outer.values(), inner.values()
     out = np.empty((ov.size, iv.size), dtype=np.uint8)
+    e = inner_exponent(iv)
+    t_in = np.ldexp(iv, -e)
 
     def run() -> None:
-        C, _ = kern.row_coefficients(ov, inner.ref)  # matrices' coefficients built from the axes each time
-        kern.classify(C, iv / inner.ref, out)
+        C, EC = kern.row_coefficients(ov, e)  # coefficient tables (with error bounds) built from the axes each time
+        seg, T = kernel_segments(t_in)
+        kern.classify(C, EC, t_in, seg, T, out)  # certified codes: 0 unstable, 1 stable, 2 uncertain
 
     run()
     t_kernel = best_time(run, repeat=5)
@@ -75,17 +78,18 @@ def bench_map(*, size: int = 4000, large: bool = False) -> list[BenchResult]:
     rate_np_generic = sub_o.size * sub_i.size / t_np
     from .kernels import classify_numpy
 
-    C_sub, _ = kern.row_coefficients(ov[:250], inner.ref)
-    t_sub = iv / inner.ref
-    t_np = best_time(lambda: classify_numpy(kern, C_sub, t_sub), repeat=3)
+    C_sub, EC_sub = kern.row_coefficients(ov[:250], e)
+    t_np = best_time(lambda: classify_numpy(kern, C_sub, EC_sub, t_in), repeat=3)
     rate_np = 250 * iv.size / t_np
     small = (Axis("k_ip", 1e5, 1e10, 300, True), Axis("mu", 0.05, 1.0, 200))
     stability_map(space, *small)
     t_ds = best_time(lambda: stability_map(space, *small), repeat=3)
     rate_ds = 300 * 200 / t_ds
     res = [
-        BenchResult("map: compiled Hurwitz kernel (paper-fig2, k_ip x mu)", rate, "points/s", base, rate / base,
+        BenchResult("map: certified compiled Hurwitz kernel (paper-fig2, k_ip x mu)", rate, "points/s", base,
+                    rate / base,
                     {"grid": f"{size}x{size}", "best_time_s": round(t_kernel, 5),
+                     "uncertain_points": int(np.count_nonzero(out == 2)),
                      "kernel_build_s_incl_sympy_and_load": round(build, 3),
                      "baseline": "naive per-point loop: closed-form matrices + scipy.linalg.eigvals",
                      "target": ">= 3e8 points/s and >= 1e4 x baseline"}),

@@ -1,7 +1,19 @@
-"""Compiled (numba) polynomial root isolation and the batched critical-speed kernel.
+"""Compiled (numba) kernels: certified sign tests, root isolation and the batched critical-speed kernel.
 
 Imported lazily (numba start-up costs about a second); every function is
 cached on disk by numba.
+
+Certified arithmetic
+--------------------
+Numbers are carried as *midpoint-radius intervals* ``(m, r)``: the exact value
+lies in ``[m - r, m + r]``.  Every operation adds the rounding error of its
+midpoint (``u |m|``, ``u = 2^-53``) and inflates the radius by ``1 + 16u`` to
+cover the rounding of the radius computation itself (Rump's midpoint-radius
+arithmetic with a safety factor; an absolute ``2^-1020`` covers underflow).
+A sign is *certified* when the interval excludes zero.  These intervals are
+used by the Routh test (:func:`routh_interval`), by interval Horner
+(:func:`horner_interval`), by Descartes' rule of signs on an interval
+(:func:`descartes`), and by the critical-speed kernel (:func:`critical_batch`).
 """
 
 from __future__ import annotations
@@ -11,11 +23,18 @@ import math
 import numba
 import numpy as np
 
-__all__ = ["peval", "real_roots", "critical_batch"]
+__all__ = ["peval", "real_roots", "routh_interval", "routh_batch", "quartic_interval_batch", "horner_interval",
+           "descartes", "isolate_roots", "critical_batch", "UNSTABLE", "STABLE", "UNDECIDED"]
 
 _JIT = dict(cache=True, error_model="numpy")
 
+UNSTABLE, STABLE, UNDECIDED = 0, 1, 2
+_U = 2.0 ** -53
+_KR = 1.0 + 16.0 * _U
+_ETA = 2.0 ** -1020  # smallest normal range: subnormal operands are very slow on x86
 
+
+# ---------------------------------------------------------------- plain float helpers (kept for callers)
 @numba.njit(**_JIT)
 def peval(c, deg, x):  # type: ignore[no-untyped-def]
     """Horner evaluation of ``Σ_{k<=deg} c[k] x^k``."""
@@ -52,12 +71,12 @@ def _solve(c, dc, deg, lo, hi, flo):  # type: ignore[no-untyped-def]
 
 @numba.njit(**_JIT)
 def real_roots(c, lo, hi, out):  # type: ignore[no-untyped-def]
-    """Real roots of ``Σ c[k] x^k`` in ``(lo, hi)``, ascending, written to ``out``; returns the count.
+    """Real roots of ``Σ c[k] x^k`` in ``(lo, hi)`` in floating point (not certified), ascending; returns the count.
 
     Derivative cascade: the real roots of ``p^(m+1)`` split the interval into
     pieces where ``p^(m)`` is monotone, so each piece holds at most one root,
-    found by bracketing.  Roots of even multiplicity at a critical point are
-    reported once.
+    found by bracketing.  Kept as a fast helper; the certified isolation is
+    :func:`isolate_roots`.
     """
     deg = c.shape[0] - 1
     while deg > 0 and c[deg] == 0.0:
@@ -101,96 +120,689 @@ def real_roots(c, lo, hi, out):  # type: ignore[no-untyped-def]
     return npts
 
 
-@numba.njit(**_JIT)
-def _pmul(a, b):  # type: ignore[no-untyped-def]
-    out = np.zeros(a.shape[0] + b.shape[0] - 1)
-    for i in range(a.shape[0]):
-        for j in range(b.shape[0]):
-            out[i + j] += a[i] * b[j]
-    return out
+# ---------------------------------------------------------------- midpoint-radius interval arithmetic
+@numba.njit(inline="always", **_JIT)
+def _imul(a, ra, b, rb):  # type: ignore[no-untyped-def]
+    if (a == 0.0 and ra == 0.0) or (b == 0.0 and rb == 0.0):
+        return 0.0, 0.0  # exact zeros stay exact (and no tiny radii that would become subnormal)
+    m = a * b
+    return m, ((abs(a) * rb + ra * abs(b)) + ra * rb + _U * abs(m)) * _KR + _ETA
+
+
+@numba.njit(inline="always", **_JIT)
+def _iadd(a, ra, b, rb):  # type: ignore[no-untyped-def]
+    m = a + b
+    return m, (ra + rb + _U * abs(m)) * _KR
+
+
+@numba.njit(inline="always", **_JIT)
+def _isub(a, ra, b, rb):  # type: ignore[no-untyped-def]
+    m = a - b
+    return m, (ra + rb + _U * abs(m)) * _KR
+
+
+@numba.njit(inline="always", **_JIT)
+def _idiv(a, ra, b, rb):  # type: ignore[no-untyped-def]
+    """Interval quotient; the caller guarantees ``|b| > rb``."""
+    m = a / b
+    return m, ((ra + abs(m) * rb) / (abs(b) - rb) + _U * abs(m)) * _KR + _ETA
+
+
+@numba.njit(inline="always", **_JIT)
+def _sign(m, r):  # type: ignore[no-untyped-def]
+    """+1 / -1 if the interval is certified positive / negative, 0 otherwise (NaN: 0)."""
+    if m - r > 0.0:
+        return 1
+    if m + r < 0.0:
+        return -1
+    return 0
 
 
 @numba.njit(**_JIT)
-def _stable_at(A, P, w):  # type: ignore[no-untyped-def]
-    for i in range(5):
-        if not peval(A[i], A.shape[1] - 1, w) > 0.0:
-            return False
-    return peval(P, P.shape[0] - 1, w) > 0.0
+def horner_interval(c, rc, deg, x):  # type: ignore[no-untyped-def]
+    """Enclosure ``(value, radius)`` of ``Σ_{k<=deg} c_k x^k`` for ``c_k ∈ [c[k] ± rc[k]]``, ``x`` exact."""
+    v, rv = c[deg], rc[deg]
+    ax = abs(x)
+    for k in range(deg - 1, -1, -1):
+        m = v * x
+        rm = (ax * rv + _U * abs(m)) * _KR
+        if rm != 0.0 or m != 0.0:
+            rm += _ETA
+        v, rv = _iadd(m, rm, c[k], rc[k])
+    return v, rv
 
 
 @numba.njit(**_JIT)
-def critical_batch(E_all, lo, hi, roots_out, dirs_out, counts, start_stable):  # type: ignore[no-untyped-def]
-    """Stability changes along Ω in ``(lo, hi)`` for each row of Laurent entry tables.
+def _sgn_at(c, rc, d, x):  # type: ignore[no-untyped-def]
+    v, r = horner_interval(c, rc, d, x)
+    return _sign(v, r)
+
+
+# ---------------------------------------------------------------- certified Routh test
+@numba.njit(**_JIT)
+def _normalise(row, rrow, n):  # type: ignore[no-untyped-def]
+    big = 0.0
+    for k in range(n):
+        v = abs(row[k]) + rrow[k]
+        if v > big:
+            big = v
+    if big > 0.0 and math.isfinite(big):
+        e = math.frexp(big)[1]
+        for k in range(n):
+            row[k] = math.ldexp(row[k], -e)
+            rrow[k] = math.ldexp(rrow[k], -e)
+
+
+@numba.njit(**_JIT)
+def _routh_core(a, r, m, row0, r0, row1, r1, new, rnew):  # type: ignore[no-untyped-def]
+    for k in range(m + 1):
+        if not (math.isfinite(a[k]) and math.isfinite(r[k])):
+            return UNDECIDED
+    if m == 0:
+        return STABLE if abs(a[0]) > r[0] else UNDECIDED
+    lead = a[m]
+    if not abs(lead) > r[m]:
+        return UNDECIDED
+    s = 1.0 if lead > 0.0 else -1.0
+    # λ -> 2^e λ: a_k -> a_k 2^(e k), exact; balances |a_0| and |a_m|
+    e = 0
+    if a[0] != 0.0:
+        e = int(round((math.log2(abs(a[0])) - math.log2(abs(lead))) / m))
+    n0 = m // 2 + 1
+    for k in range(n0 + 1):
+        row0[k] = 0.0
+        r0[k] = 0.0
+        row1[k] = 0.0
+        r1[k] = 0.0
+    for k in range(n0):
+        i = m - 2 * k
+        if i >= 0:
+            row0[k] = s * math.ldexp(a[i], e * i)
+            r0[k] = math.ldexp(r[i], e * i)
+        i = m - 1 - 2 * k
+        if i >= 0:
+            row1[k] = s * math.ldexp(a[i], e * i)
+            r1[k] = math.ldexp(r[i], e * i)
+    _normalise(row0, r0, n0)
+    _normalise(row1, r1, n0)
+    if not row0[0] - r0[0] > 0.0:
+        return UNDECIDED  # cannot happen after the sign fold unless overflow
+    for j in range(2, m + 1):
+        sg = _sign(row1[0], r1[0])
+        if sg == -1 or (row1[0] + r1[0] <= 0.0):
+            return UNSTABLE
+        if sg == 0:
+            return UNDECIDED
+        q, rq = _idiv(row0[0], r0[0], row1[0], r1[0])
+        for k in range(n0):
+            pm, pr = _imul(q, rq, row1[k + 1], r1[k + 1])
+            new[k], rnew[k] = _isub(row0[k + 1], r0[k + 1], pm, pr)
+        new[n0] = 0.0
+        rnew[n0] = 0.0
+        for k in range(n0 + 1):
+            row0[k] = row1[k]
+            r0[k] = r1[k]
+            row1[k] = new[k]
+            r1[k] = rnew[k]
+        _normalise(row1, r1, n0)
+        if not (math.isfinite(row1[0]) and math.isfinite(r1[0])):
+            return UNDECIDED
+    sg = _sign(row1[0], r1[0])
+    if sg == 1:
+        return STABLE
+    if sg == -1 or row1[0] + r1[0] <= 0.0:
+        return UNSTABLE
+    return UNDECIDED
+
+
+@numba.njit(**_JIT)
+def routh_interval(a, r):  # type: ignore[no-untyped-def]
+    """Certified Routh–Hurwitz verdict of ``Σ a_k λ^k`` with ``|error of a_k| <= r[k]``.
+
+    Returns ``STABLE`` (1) if every polynomial in the coefficient box has all
+    roots in the open left half-plane, ``UNSTABLE`` (0) if none has, and
+    ``UNDECIDED`` (2) otherwise (or when a value is not finite).
+    """
+    m = a.shape[0] - 1
+    n0 = m // 2 + 2
+    w = np.zeros((6, n0 + 1))
+    return _routh_core(a, r, m, w[0], w[1], w[2], w[3], w[4], w[5])
+
+
+@numba.njit(**_JIT)
+def routh_batch(A, R, out):  # type: ignore[no-untyped-def]
+    """:func:`routh_interval` for every row of ``A`` / ``R`` (ascending coefficients); verdicts to ``out``."""
+    m = A.shape[1] - 1
+    n0 = m // 2 + 2
+    w = np.zeros((6, n0 + 1))
+    for i in range(A.shape[0]):
+        out[i] = _routh_core(A[i], R[i], m, w[0], w[1], w[2], w[3], w[4], w[5])
+
+
+@numba.njit(**_JIT)
+def quartic_interval_batch(E, RE, A, RA):  # type: ignore[no-untyped-def]
+    """Interval coefficients ``a0..a4`` of ``det(λ²M + λD + K)`` for 2×2 matrices given entry-wise.
+
+    ``E[n, 12]`` holds ``M, D, K`` row-major, ``RE`` their radii; writes ``A[n, 5]``, ``RA[n, 5]``.
+    """
+    for n in range(E.shape[0]):
+        e = E[n]
+        re = RE[n]
+        # a4 = m11 m22 - m12 m21
+        x, rx = _imul(e[0], re[0], e[3], re[3])
+        y, ry = _imul(e[1], re[1], e[2], re[2])
+        A[n, 4], RA[n, 4] = _isub(x, rx, y, ry)
+        # a3 = m11 d22 + d11 m22 - m12 d21 - d12 m21
+        s, rs = _imul(e[0], re[0], e[7], re[7])
+        x, rx = _imul(e[4], re[4], e[3], re[3])
+        s, rs = _iadd(s, rs, x, rx)
+        x, rx = _imul(e[1], re[1], e[6], re[6])
+        s, rs = _isub(s, rs, x, rx)
+        x, rx = _imul(e[5], re[5], e[2], re[2])
+        A[n, 3], RA[n, 3] = _isub(s, rs, x, rx)
+        # a2 = m11 k22 + d11 d22 + k11 m22 - m12 k21 - d12 d21 - k12 m21
+        s, rs = _imul(e[0], re[0], e[11], re[11])
+        x, rx = _imul(e[4], re[4], e[7], re[7])
+        s, rs = _iadd(s, rs, x, rx)
+        x, rx = _imul(e[8], re[8], e[3], re[3])
+        s, rs = _iadd(s, rs, x, rx)
+        x, rx = _imul(e[1], re[1], e[10], re[10])
+        s, rs = _isub(s, rs, x, rx)
+        x, rx = _imul(e[5], re[5], e[6], re[6])
+        s, rs = _isub(s, rs, x, rx)
+        x, rx = _imul(e[9], re[9], e[2], re[2])
+        A[n, 2], RA[n, 2] = _isub(s, rs, x, rx)
+        # a1 = d11 k22 + k11 d22 - d12 k21 - k12 d21
+        s, rs = _imul(e[4], re[4], e[11], re[11])
+        x, rx = _imul(e[8], re[8], e[7], re[7])
+        s, rs = _iadd(s, rs, x, rx)
+        x, rx = _imul(e[5], re[5], e[10], re[10])
+        s, rs = _isub(s, rs, x, rx)
+        x, rx = _imul(e[9], re[9], e[6], re[6])
+        A[n, 1], RA[n, 1] = _isub(s, rs, x, rx)
+        # a0 = k11 k22 - k12 k21
+        x, rx = _imul(e[8], re[8], e[11], re[11])
+        y, ry = _imul(e[9], re[9], e[10], re[10])
+        A[n, 0], RA[n, 0] = _isub(x, rx, y, ry)
+
+
+# ---------------------------------------------------------------- certified real-root isolation (Descartes)
+@numba.njit(**_JIT)
+def _transform(w, d, a, h):  # type: ignore[no-untyped-def]
+    """In place: ``w <- (1+t)^d p(a + h/(1+t))`` coefficients (Taylor shift by a, scale by h, reverse, shift by 1)."""
+    for i in range(d):
+        for j in range(d - 1, i - 1, -1):
+            w[j] += a * w[j + 1]
+    hk = 1.0
+    for k in range(1, d + 1):
+        hk *= h
+        w[k] *= hk
+    for k in range((d + 1) // 2):
+        t = w[k]
+        w[k] = w[d - k]
+        w[d - k] = t
+    for i in range(d):
+        for j in range(d - 1, i - 1, -1):
+            w[j] += w[j + 1]
+
+
+@numba.njit(**_JIT)
+def descartes(c, rc, d, a, b, w, rw):  # type: ignore[no-untyped-def]
+    """Certified Descartes bound for the roots of ``Σ c_k x^k`` (interval coefficients) in ``(a, b)``.
+
+    The polynomial is transformed to ``q(t) = (1+t)^d p((a + b t)/(1+t))``
+    (Taylor shift by ``a``, scaling by ``h = fl(b - a)``, reversal, shift by
+    1) in plain floating point; the same linear map with all entries made
+    non-negative, applied to ``rc + γ|c|`` (``γ = (6d + 4) u``, covering the
+    rounding of every operation and of ``h``), bounds the error of every
+    coefficient of ``q``.  ``w``, ``rw`` are workspaces of length ``d + 1``.
+    Returns 0 (no root for any member of the coefficient box), 1 (exactly one
+    simple root for every member) or 2 (undetermined: two or more sign
+    variations, or an uncertain sign).
+    """
+    g = (6.0 * d + 4.0) * _U
+    for k in range(d + 1):
+        w[k] = c[k]
+        rw[k] = rc[k] + g * abs(c[k])
+    h = b - a
+    _transform(w, d, a, h)
+    _transform(rw, d, abs(a), abs(h))
+    last = 0
+    var = 0
+    for k in range(d + 1):
+        r = rw[k] * (1.0 + g) + (_ETA if rw[k] != 0.0 else 0.0)
+        if w[k] == 0.0 and r == 0.0:
+            continue
+        sg = _sign(w[k], r)
+        if sg == 0:
+            return 2
+        if last != 0 and sg != last:
+            var += 1
+            if var >= 2:
+                return 2
+        last = sg
+    return var
+
+
+@numba.njit(**_JIT)
+def _horner_d(c, d, x):  # type: ignore[no-untyped-def]
+    """Plain floating-point ``p(x)`` and ``p'(x)``."""
+    p = c[d]
+    dp = 0.0
+    for k in range(d - 1, -1, -1):
+        dp = dp * x + p
+        p = p * x + c[k]
+    return p, dp
+
+
+@numba.njit(**_JIT)
+def _illinois(c, rc, d, a, b, fa, fb, certified):  # type: ignore[no-untyped-def]
+    """Illinois regula falsi on ``(a, b)`` (``fa``, ``fb`` of opposite signs); returns the final ``(a, b)``.
+
+    ``certified``: use a sign only when certified by interval Horner (stop at
+    the rounding band); otherwise plain floating-point signs.
+    """
+    sa = 1.0 if fa > 0.0 else -1.0
+    side = 0
+    for _ in range(100):
+        if b - a <= 2.0 ** -51 * max(abs(a), abs(b)):
+            break
+        if a > 0.0 and b > 2.0 * a:
+            x = math.sqrt(a) * math.sqrt(b)  # wide positive bracket: bisect in log scale first
+        elif b < 0.0 and a < 2.0 * b:
+            x = -math.sqrt(-a) * math.sqrt(-b)
+        else:
+            x = 0.5 * (a + b)
+            if fa != fb:
+                xs = a - fa * (b - a) / (fb - fa)
+                if a < xs < b:
+                    x = xs
+        if not (a < x < b):
+            break
+        if certified:
+            v, rv = horner_interval(c, rc, d, x)
+            sg = _sign(v, rv)
+            if sg == 0:
+                break
+        else:
+            v = _horner_d(c, d, x)[0]
+            if v == 0.0:
+                return x, x
+            sg = 1 if v > 0.0 else -1
+        if sg == sa:
+            a, fa = x, v
+            if side == -1:
+                fb *= 0.5
+            side = -1
+        else:
+            b, fb = x, v
+            if side == 1:
+                fa *= 0.5
+            side = 1
+    return a, b
+
+
+@numba.njit(**_JIT)
+def _refine(c, rc, d, a, b, sa):  # type: ignore[no-untyped-def]
+    """Shrink a bracket ``(a, b)`` holding one simple root (``sign p(a) = sa``, certified at both ends).
+
+    The root is located in plain floating point (log-bisection while the
+    bracket is wide, Illinois regula falsi, Newton); then the smallest
+    bracket ``x (1 ± δ)``, ``δ = 2^-44, 2^-36, ...``, whose end signs are
+    certified opposite is returned with the estimate: ``(a, b, x)``.  If no
+    such bracket is found the original ``(a, b)`` is kept (still certified).
+    """
+    fa = _horner_d(c, d, a)[0]
+    fb = _horner_d(c, d, b)[0]
+    x = 0.5 * (a + b)
+    if fa != 0.0 and fb != 0.0 and (fa > 0.0) != (fb > 0.0):
+        lo, hi = _illinois(c, rc, d, a, b, fa, fb, False)
+        x = 0.5 * (lo + hi)
+        for _ in range(3):
+            p, dp = _horner_d(c, d, x)
+            if p == 0.0 or dp == 0.0:
+                break
+            xn = x - p / dp
+            if not (lo <= xn <= hi) or xn == x:
+                break
+            x = xn
+    if not (a < x < b):
+        x = 0.5 * (a + b)
+    delta = 2.0 ** -44
+    scale = max(abs(x), 1e-300)
+    for _ in range(6):
+        xl = x - delta * scale
+        xh = x + delta * scale
+        if xl <= a or xh >= b:
+            break
+        if _sgn_at(c, rc, d, xl) == sa and _sgn_at(c, rc, d, xh) == -sa:
+            return xl, xh, x
+        delta *= 256.0
+    return a, b, x
+
+
+@numba.njit(**_JIT)
+def isolate_roots(c, rc, d, lo, hi, out, w, rw, stack):  # type: ignore[no-untyped-def]
+    """Certified isolation of the real roots of an interval polynomial in ``(lo, hi)``.
+
+    Vincent–Collins–Akritas bisection with :func:`descartes`; every root is
+    returned as a bracket ``out[k, :2] = (a, b)`` with certified opposite signs
+    of ``p`` at ``a`` and ``b`` (exactly one simple root inside), ascending, and
+    a floating-point estimate ``out[k, 2]`` inside the bracket.
+    Returns the number of roots, or ``-1`` if the roots could not be isolated
+    (a cluster narrower than ``2^-40`` relative, a root at ``lo`` or ``hi``,
+    or more than ``out.shape[0]`` roots).
+    """
+    while d > 0 and c[d] == 0.0 and rc[d] == 0.0:
+        d -= 1  # exact zero leading coefficients: lower degree
+    if d == 0:
+        return 0
+    if lo >= 0.0:
+        # Descartes on (0, inf) with the raw coefficients: V = 0 -> no positive root; V = 1 -> exactly one
+        var = 0
+        last = 0
+        for k in range(d + 1):
+            if c[k] == 0.0 and rc[k] == 0.0:
+                continue
+            sg = _sign(c[k], rc[k])
+            if sg == 0:
+                var = 99
+                break
+            if last != 0 and sg != last:
+                var += 1
+            last = sg
+        if var == 0:
+            return 0
+        if var == 1:
+            sa = _sgn_at(c, rc, d, lo)
+            sb = _sgn_at(c, rc, d, hi)
+            if sa != 0 and sb != 0:
+                if sa == sb:
+                    return 0
+                if out.shape[0] < 1:
+                    return -1
+                ra, rb, rx = _refine(c, rc, d, lo, hi, sa)
+                out[0, 0] = ra
+                out[0, 1] = rb
+                out[0, 2] = rx
+                return 1
+    top = 0
+    stack[0, 0] = lo
+    stack[0, 1] = hi
+    top = 1
+    nout = 0
+    while top > 0:
+        top -= 1
+        a = stack[top, 0]
+        b = stack[top, 1]
+        v = descartes(c, rc, d, a, b, w, rw)
+        if v == 0:
+            continue
+        if v == 1:
+            sa = _sgn_at(c, rc, d, a)
+            sb = _sgn_at(c, rc, d, b)
+            if sa == 0 or sb == 0 or sa == sb:
+                return -1
+            if nout >= out.shape[0]:
+                return -1
+            ra, rb, rx = _refine(c, rc, d, a, b, sa)
+            out[nout, 0] = ra
+            out[nout, 1] = rb
+            out[nout, 2] = rx
+            nout += 1
+            continue
+        if b - a <= 2.0 ** -40 * max(abs(a), abs(b)):
+            return -1
+        if top + 2 > stack.shape[0]:
+            return -1
+        if a > 0.0 and b > 4.0 * a:
+            mid = math.sqrt(a) * math.sqrt(b)
+        else:
+            mid = 0.5 * (a + b)
+        ok = False
+        for t in range(8):
+            frac = (0.5, 0.4375, 0.5625, 0.375, 0.625, 0.3125, 0.6875, 0.25)[t]
+            m = mid if t == 0 else a + frac * (b - a)
+            if a < m < b and _sgn_at(c, rc, d, m) != 0:
+                ok = True
+                mid = m
+                break
+        if not ok:
+            return -1
+        stack[top, 0] = mid
+        stack[top, 1] = b
+        stack[top + 1, 0] = a
+        stack[top + 1, 1] = mid
+        top += 2
+    return nout
+
+
+# ---------------------------------------------------------------- critical speeds (certified)
+@numba.njit(**_JIT)
+def _ipoly_mul_acc(a, ra, b, rb, na, nb, sgn, out, rout):  # type: ignore[no-untyped-def]
+    """``out += sgn * a * b`` for interval polynomials (lengths ``na``, ``nb``)."""
+    for i in range(na):
+        if a[i] == 0.0 and ra[i] == 0.0:
+            continue
+        for j in range(nb):
+            if b[j] == 0.0 and rb[j] == 0.0:
+                continue
+            m, r = _imul(a[i], ra[i], b[j], rb[j])
+            out[i + j], rout[i + j] = _iadd(out[i + j], rout[i + j], sgn * m, r)
+
+
+@numba.njit(**_JIT)
+def _verdict_at(A, RA, P, RP, w, dA, dP):  # type: ignore[no-untyped-def]
+    """Certified quartic verdict at ``w`` from ``A_i(w) = w² a_i`` and ``P(w) = w^6 H3`` (w > 0).
+
+    ``dA[i]``, ``dP`` are the effective degrees (higher coefficients exactly zero).
+    """
+    v4, r4 = horner_interval(A[4], RA[4], dA[4], w)
+    s4 = _sign(v4, r4)
+    if s4 == 0:
+        return UNDECIDED
+    allpos = True
+    for i in range(4):
+        v, r = horner_interval(A[i], RA[i], dA[i], w)
+        sg = _sign(v, r) * s4
+        if sg < 0:
+            return UNSTABLE
+        if sg == 0:
+            allpos = False
+    vp, rp = horner_interval(P, RP, dP, w)
+    sp = _sign(vp, rp) * s4
+    if sp < 0:
+        return UNSTABLE
+    if sp > 0 and allpos:
+        return STABLE
+    return UNDECIDED
+
+
+@numba.njit(**_JIT)
+def _piece_verdict(A, RA, P, RP, x0, x1, dA, dP):  # type: ignore[no-untyped-def]
+    """Verdict somewhere inside ``(x0, x1)`` (a few trial points)."""
+    for t in range(7):
+        frac = (0.5, 0.25, 0.75, 0.125, 0.875, 0.375, 0.625)[t]
+        if x0 > 0.0 and x1 > 4.0 * x0:
+            x = math.exp(math.log(x0) + frac * (math.log(x1) - math.log(x0)))
+        else:
+            x = x0 + frac * (x1 - x0)
+        if not (x0 < x < x1):
+            continue
+        v = _verdict_at(A, RA, P, RP, x, dA, dP)
+        if v != UNDECIDED:
+            return v
+    return UNDECIDED
+
+
+@numba.njit(**_JIT)
+def critical_batch(E_all, R_all, bounds, roots_out, dirs_out, counts, start_stable, flags):  # type: ignore[no-untyped-def]
+    """Certified stability changes along Ω for each row of Laurent entry tables.
 
     ``E_all[n, e, k]`` is the coefficient of ``Ω^(k-1)`` of entry ``e`` of
-    ``(Mbar, Dbar, Kbar)`` (row-major).  With ``w = Ω/s``, ``s = sqrt(lo hi)``,
-    ``A_i(w) = w² a_i`` and ``P(w) = w^6 H3`` are polynomials; candidates are
-    the real roots of ``P`` and of the ``A_i``, stability is decided between
-    consecutive candidates by Liénard–Chipart.
+    ``(Mbar, Dbar, Kbar)`` (row-major), ``R_all`` its error radius.
+    ``bounds`` are the sub-range limits ``lo = b_0 < b_1 < ... < b_J = hi``
+    (internal ones powers of two).  On each sub-range, with ``Ω = s w``
+    (``s`` a power of two near the geometric mean), ``A_i(w) = w² a_i`` and
+    ``P(w) = w^6 H3`` are interval polynomials; the roots of ``A_0``, ``A_4``
+    and ``P`` (the only places where the Liénard–Chipart verdict can change,
+    by Orlando's formula) are isolated with :func:`isolate_roots` and the
+    verdict is certified on every piece in between.  ``flags[n] = 1`` marks a
+    row where something could not be certified (the caller recomputes it
+    exactly); otherwise the results are complete for ``(lo, hi)``.
     """
-    s = math.sqrt(lo * hi)
-    wl, wh = lo / s, hi / s
-    cand = np.empty(64)
-    r = np.empty(32)
+    cand = np.empty((64, 3))
+    brk = np.empty((32, 3))
+    w = np.empty(19)
+    rw = np.empty(19)
+    stack = np.empty((256, 2))
+    A = np.zeros((5, 7))
+    RA = np.zeros((5, 7))
+    P = np.zeros(19)
+    RP = np.zeros(19)
+    T1 = np.zeros(13)
+    R1 = np.zeros(13)
+    T2 = np.zeros(13)
+    R2 = np.zeros(13)
+    Es = np.zeros((12, 4))
+    Rs = np.zeros((12, 4))
+    dA = np.zeros(5, dtype=np.int64)
+    maxc = roots_out.shape[1]
+    nsub = bounds.shape[0] - 1
     for n in range(E_all.shape[0]):
-        E = E_all[n].copy()
-        for e in range(12):
-            f = 1.0 / s
-            for k in range(4):
-                E[e, k] *= f
-                f *= s
-        m11, m12, m21, m22 = E[0], E[1], E[2], E[3]
-        d11, d12, d21, d22 = E[4], E[5], E[6], E[7]
-        k11, k12, k21, k22 = E[8], E[9], E[10], E[11]
-        A = np.zeros((5, 7))
-        A[4] = _pmul(m11, m22) - _pmul(m12, m21)
-        A[3] = _pmul(m11, d22) + _pmul(d11, m22) - _pmul(m12, d21) - _pmul(d12, m21)
-        A[2] = (_pmul(m11, k22) + _pmul(d11, d22) + _pmul(k11, m22) - _pmul(m12, k21)
-                - _pmul(d12, d21) - _pmul(k12, m21))
-        A[1] = _pmul(d11, k22) + _pmul(k11, d22) - _pmul(d12, k21) - _pmul(k12, d21)
-        A[0] = _pmul(k11, k22) - _pmul(k12, k21)
-        mx = np.max(np.abs(A))
-        if mx > 0.0:
-            A /= mx
-        if peval(A[4], 6, 1.0) < 0.0:
-            A *= -1.0
-        P = _pmul(A[1], _pmul(A[3], A[2]) - _pmul(A[4], A[1])) - _pmul(_pmul(A[3], A[3]), A[0])
-        mx = np.max(np.abs(P))
-        if mx > 0.0:
-            P /= mx
-        nc = 0
-        lz = 0
-        while lz < P.shape[0] - 1 and P[lz] == 0.0:
-            lz += 1
-        k = real_roots(P[lz:].copy(), wl, wh, r)
-        for q in range(k):
-            cand[nc] = r[q]
-            nc += 1
-        for i in range(5):
-            lz = 0
-            while lz < 6 and A[i, lz] == 0.0:
-                lz += 1
-            k = real_roots(A[i, lz:].copy(), wl, wh, r)
-            for q in range(k):
-                if nc < cand.shape[0]:
-                    cand[nc] = r[q]
-                    nc += 1
-        c = np.sort(cand[:nc])
-        prev = _stable_at(A, P, wl)
-        start_stable[n] = prev
+        flag = 0
         m = 0
-        for q in range(nc):
-            b = c[q + 1] if q + 1 < nc else wh
-            if b <= c[q]:
-                continue
-            st = _stable_at(A, P, math.sqrt(c[q] * b))
-            if st != prev:
-                if m < roots_out.shape[1]:
-                    roots_out[n, m] = c[q] * s
-                    dirs_out[n, m] = 1 if st else -1
-                m += 1
-                prev = st
+        prev = -1
+        for j in range(nsub):
+            lo = bounds[j]
+            hi = bounds[j + 1]
+            ks = int(round(0.5 * (math.log2(lo) + math.log2(hi))))
+            wl = math.ldexp(lo, -ks)
+            wh = math.ldexp(hi, -ks)
+            for e in range(12):
+                for k in range(4):
+                    Es[e, k] = math.ldexp(E_all[n, e, k], ks * (k - 1))
+                    Rs[e, k] = math.ldexp(R_all[n, e, k], ks * (k - 1))
+            A[:, :] = 0.0
+            RA[:, :] = 0.0
+            # a4 = m11 m22 - m12 m21
+            _ipoly_mul_acc(Es[0], Rs[0], Es[3], Rs[3], 4, 4, 1.0, A[4], RA[4])
+            _ipoly_mul_acc(Es[1], Rs[1], Es[2], Rs[2], 4, 4, -1.0, A[4], RA[4])
+            # a3 = m11 d22 + d11 m22 - m12 d21 - d12 m21
+            _ipoly_mul_acc(Es[0], Rs[0], Es[7], Rs[7], 4, 4, 1.0, A[3], RA[3])
+            _ipoly_mul_acc(Es[4], Rs[4], Es[3], Rs[3], 4, 4, 1.0, A[3], RA[3])
+            _ipoly_mul_acc(Es[1], Rs[1], Es[6], Rs[6], 4, 4, -1.0, A[3], RA[3])
+            _ipoly_mul_acc(Es[5], Rs[5], Es[2], Rs[2], 4, 4, -1.0, A[3], RA[3])
+            # a2 = m11 k22 + d11 d22 + k11 m22 - m12 k21 - d12 d21 - k12 m21
+            _ipoly_mul_acc(Es[0], Rs[0], Es[11], Rs[11], 4, 4, 1.0, A[2], RA[2])
+            _ipoly_mul_acc(Es[4], Rs[4], Es[7], Rs[7], 4, 4, 1.0, A[2], RA[2])
+            _ipoly_mul_acc(Es[8], Rs[8], Es[3], Rs[3], 4, 4, 1.0, A[2], RA[2])
+            _ipoly_mul_acc(Es[1], Rs[1], Es[10], Rs[10], 4, 4, -1.0, A[2], RA[2])
+            _ipoly_mul_acc(Es[5], Rs[5], Es[6], Rs[6], 4, 4, -1.0, A[2], RA[2])
+            _ipoly_mul_acc(Es[9], Rs[9], Es[2], Rs[2], 4, 4, -1.0, A[2], RA[2])
+            # a1 = d11 k22 + k11 d22 - d12 k21 - k12 d21
+            _ipoly_mul_acc(Es[4], Rs[4], Es[11], Rs[11], 4, 4, 1.0, A[1], RA[1])
+            _ipoly_mul_acc(Es[8], Rs[8], Es[7], Rs[7], 4, 4, 1.0, A[1], RA[1])
+            _ipoly_mul_acc(Es[5], Rs[5], Es[10], Rs[10], 4, 4, -1.0, A[1], RA[1])
+            _ipoly_mul_acc(Es[9], Rs[9], Es[6], Rs[6], 4, 4, -1.0, A[1], RA[1])
+            # a0 = k11 k22 - k12 k21
+            _ipoly_mul_acc(Es[8], Rs[8], Es[11], Rs[11], 4, 4, 1.0, A[0], RA[0])
+            _ipoly_mul_acc(Es[9], Rs[9], Es[10], Rs[10], 4, 4, -1.0, A[0], RA[0])
+            _normalise(A.reshape(-1), RA.reshape(-1), 35)
+            # P = A1 (A3 A2 - A4 A1) - A3^2 A0
+            T1[:] = 0.0
+            R1[:] = 0.0
+            _ipoly_mul_acc(A[3], RA[3], A[2], RA[2], 7, 7, 1.0, T1, R1)
+            _ipoly_mul_acc(A[4], RA[4], A[1], RA[1], 7, 7, -1.0, T1, R1)
+            T2[:] = 0.0
+            R2[:] = 0.0
+            _ipoly_mul_acc(A[3], RA[3], A[3], RA[3], 7, 7, 1.0, T2, R2)
+            P[:] = 0.0
+            RP[:] = 0.0
+            _ipoly_mul_acc(A[1], RA[1], T1, R1, 7, 13, 1.0, P, RP)
+            _ipoly_mul_acc(T2, R2, A[0], RA[0], 13, 7, -1.0, P, RP)
+            _normalise(P, RP, 19)
+            ok = True
+            for k in range(19):
+                if not (math.isfinite(P[k]) and math.isfinite(RP[k])):
+                    ok = False
+            for i in range(5):
+                for k in range(7):
+                    if not (math.isfinite(A[i, k]) and math.isfinite(RA[i, k])):
+                        ok = False
+            if not ok:
+                flag = 1
+                break
+            for i in range(5):
+                dA[i] = 6
+                while dA[i] > 0 and A[i, dA[i]] == 0.0 and RA[i, dA[i]] == 0.0:
+                    dA[i] -= 1
+            dP = 18
+            while dP > 0 and P[dP] == 0.0 and RP[dP] == 0.0:
+                dP -= 1
+            # isolate the roots of A0, A4, P
+            nc = 0
+            for which in range(3):
+                if which == 0:
+                    cnt = isolate_roots(P, RP, 18, wl, wh, brk, w, rw, stack)
+                elif which == 1:
+                    cnt = isolate_roots(A[0], RA[0], 6, wl, wh, brk, w, rw, stack)
+                else:
+                    cnt = isolate_roots(A[4], RA[4], 6, wl, wh, brk, w, rw, stack)
+                if cnt < 0 or nc + cnt > cand.shape[0]:
+                    flag = 1
+                    break
+                for q in range(cnt):
+                    cand[nc, 0] = brk[q, 0]
+                    cand[nc, 1] = brk[q, 1]
+                    cand[nc, 2] = brk[q, 2]
+                    nc += 1
+            if flag:
+                break
+            # sort brackets, require them disjoint
+            for q in range(1, nc):
+                x0 = cand[q, 0]
+                x1 = cand[q, 1]
+                x2 = cand[q, 2]
+                p = q - 1
+                while p >= 0 and cand[p, 0] > x0:
+                    cand[p + 1, 0] = cand[p, 0]
+                    cand[p + 1, 1] = cand[p, 1]
+                    cand[p + 1, 2] = cand[p, 2]
+                    p -= 1
+                cand[p + 1, 0] = x0
+                cand[p + 1, 1] = x1
+                cand[p + 1, 2] = x2
+            for q in range(1, nc):
+                if cand[q, 0] <= cand[q - 1, 1]:
+                    flag = 1
+            if flag:
+                break
+            x0 = wl
+            for q in range(nc + 1):
+                x1 = cand[q, 0] if q < nc else wh
+                v = _piece_verdict(A, RA, P, RP, x0, x1, dA, dP)
+                if v == UNDECIDED:
+                    flag = 1
+                    break
+                if prev == -1:
+                    start_stable[n] = v == STABLE
+                elif v != prev:
+                    if q == 0:
+                        val = lo  # change exactly at the sub-range boundary
+                    else:
+                        val = math.ldexp(cand[q - 1, 2], ks)
+                    if m < maxc:
+                        roots_out[n, m] = val
+                        dirs_out[n, m] = 1 if v == STABLE else -1
+                    m += 1
+                prev = v
+                if q < nc:
+                    x0 = cand[q, 1]
+            if flag:
+                break
         counts[n] = m
+        flags[n] = flag
 
 
 def _guard() -> None:

@@ -1,96 +1,274 @@
 r"""Exact stability changes along a 1-D path and critical speeds.
 
 Stability changes only where the characteristic quartic has a root at 0
-(``a0 = 0``) or a pair on the imaginary axis (``H3 = 0``); both are rational
-in the path parameter for the closed forms, so the candidates are the real
-roots of polynomials, isolated exactly (:func:`~.kernels.real_roots`), and
-stability is decided between consecutive candidates by Liénard–Chipart.
-Reading a grid is never used for the closed-form path; the numeric fallback
-(non-trivial silent motion) brackets sign changes of the verdict on a fine
-grid and polishes with Brent's method on the largest real part.
+(``a0 = 0``), a pair on the imaginary axis (``H3 = 0``) or its degree drops
+(``a4 = 0``, Orlando's formula); with ``a_i = N_i / Den`` these are real roots
+of the exact polynomials ``N_0``, ``N_4``, ``H3(N)`` and ``Den`` in the path
+parameter (:func:`~.kernels.quartic_numerators`, rational arithmetic).  Their
+roots are isolated *exactly* on the requested range, whatever its width
+(:func:`~.robust.isolate_real_roots`: continued fractions over QQ; constants
+such as π carried with 80 significant digits), and the verdict is evaluated
+exactly between consecutive roots.  Nothing is read from a grid and nothing
+overflows, so ``--along k_ip=1e-100:1e100:log`` is as exact as ``1e5:1e10``.
+
+The numeric fallback (non-trivial silent motion, non-rational ties) brackets
+sign changes of the certified per-point verdict on a grid and polishes with
+Brent's method; it is marked ``exhaustive=False`` (two crossings closer than
+the grid spacing can be missed) and points it cannot decide are reported in
+``undecided_ranges``.
 """
 
 from __future__ import annotations
 
 import math
+from fractions import Fraction
+from typing import Any
 
 import numpy as np
-from numpy.polynomial import polynomial as npoly
 
-from ..errors import ParameterError
+from ..errors import ParameterError, SilentMotionError
 from ..expressions import names_in
-from .kernels import critical_speeds_batch, hurwitz_stable, path_polynomials, real_roots
+from .kernels import QuarticNumerators, critical_speeds_batch, quartic_numerators
 from .maps import Axis
+from .robust import isolate_real_roots
 from .space import ParameterSpace
 
-__all__ = ["crossings", "critical_speeds", "critical_speeds_many"]
+__all__ = ["crossings", "critical_speeds", "critical_speeds_many", "exact_crossings", "exact_omega_crossings"]
+
+_DIGITS = 80
 
 
-def _hurwitz_poly(A: list[np.ndarray]) -> np.ndarray:
-    a0, a1, a2, a3, a4 = A
-    return npoly.polysub(npoly.polymul(a1, npoly.polysub(npoly.polymul(a3, a2), npoly.polymul(a4, a1))),
-                         npoly.polymul(npoly.polymul(a3, a3), a0))
+def _mpf_fraction(v: Any) -> Fraction:
+    import mpmath
+
+    sign, man, exp, _ = mpmath.mpf(v)._mpf_
+    man = -int(man) if sign else int(man)
+    return Fraction(man * 2 ** exp) if exp >= 0 else Fraction(man, 2 ** (-exp))
 
 
-def _stable_poly(A: list[np.ndarray], P: np.ndarray, t: float) -> bool:
-    vals = [npoly.polyval(t, a) for a in A]
-    return bool(hurwitz_stable(*vals)) and bool(np.sign(vals[4]) * npoly.polyval(t, P) > 0)
+def _univariate(poly: Any, consts: tuple[Any, ...]) -> tuple[list[Fraction], bool]:
+    """Ascending Fraction coefficients in the first generator; ``exact`` False when constants were rounded."""
+    import mpmath
+    import sympy as sp
+
+    if not consts:
+        deg = max((m[0] for m in poly.monoms()), default=0)
+        out = [Fraction(0)] * (deg + 1)
+        for mon, c in poly.terms():
+            out[mon[0]] += Fraction(int(c.numerator), int(c.denominator))
+        return out, True
+    with mpmath.workdps(_DIGITS + 20):
+        cv = [mpmath.mpf(sp.N(c, _DIGITS + 30)) for c in consts]
+        acc: dict[int, Any] = {}
+        for mon, c in poly.terms():
+            v = mpmath.mpf(int(c.numerator)) / int(c.denominator)
+            for g, k in zip(cv, mon[1:]):
+                v *= g ** k
+            acc[mon[0]] = acc.get(mon[0], 0) + v
+        deg = max(acc, default=0)
+        out = [Fraction(0)] * (deg + 1)
+        for k, v in acc.items():
+            with mpmath.workdps(_DIGITS):
+                out[k] = _mpf_fraction(+v)
+    return out, False
 
 
-def _exact(space: ParameterSpace, axis: Axis) -> tuple[bool, list[tuple[float, str]]] | None:
-    res = path_polynomials(space, axis.name, axis.start > 0)
-    if res is None:
+def _peval(c: list[Fraction], x: Fraction) -> tuple[Fraction, Fraction]:
+    v = Fraction(0)
+    a = Fraction(0)
+    ax = abs(x)
+    for k in range(len(c) - 1, -1, -1):
+        v = v * x + c[k]
+        a = a * ax + abs(c[k])
+    return v, a
+
+
+def _verdict(N: list[list[Fraction]], x: Fraction, exact: bool) -> int | None:
+    """Exact quartic verdict (1 stable, 0 unstable) at ``x``; ``None`` if a sign is not reliable."""
+    vals = []
+    for c in N:
+        v, a = _peval(c, x)
+        if not exact and v != 0 and abs(v) < Fraction(1, 10 ** (_DIGITS - 15)) * a:
+            return None
+        vals.append(v)
+    n0, n1, n2, n3, n4 = vals
+    if n4 == 0:
         return None
-    polys, _ = res
-    ref = axis.ref
-    A = [np.asarray(a, dtype=float) * ref ** np.arange(a.size) for a in polys]
-    mx = max(float(np.max(np.abs(a))) for a in A)
-    A = [a / mx for a in A]
-    P = _hurwitz_poly(A)
-    P = P / max(float(np.max(np.abs(P))), 1e-300)
-    lo, hi = axis.start / ref, axis.stop / ref
-    cand = list(real_roots(P, lo, hi))
-    for a in A:
-        cand.extend(real_roots(a, lo, hi))
-    cand = sorted(set(cand))
-    out: list[tuple[float, str]] = []
-    prev = _stable_poly(A, P, lo)
-    start = prev
-    for q, c in enumerate(cand):
-        b = cand[q + 1] if q + 1 < len(cand) else hi
-        if b <= c:
-            continue
-        mid = math.sqrt(c * b) if axis.log else 0.5 * (c + b)
-        st = _stable_poly(A, P, mid)
-        if st != prev:
-            out.append((c * ref, "stabilizing" if st else "destabilizing"))
-            prev = st
-    return start, out
+    s = 1 if n4 > 0 else -1
+    h = n1 * (n3 * n2 - n4 * n1) - n3 * n3 * n0
+    if not exact:
+        scale = abs(n1) * (abs(n3 * n2) + abs(n4 * n1)) + n3 * n3 * abs(n0)
+        if h != 0 and abs(h) < Fraction(1, 10 ** (_DIGITS - 20)) * scale:
+            return None
+    if all(s * v > 0 for v in (n0, n1, n2, n3)) and s * h > 0:
+        return 1
+    return 0
 
 
-def _numeric(space: ParameterSpace, axis: Axis, n: int = 801) -> tuple[bool, list[tuple[float, str]]]:
+def _split_point(a: Fraction, b: Fraction, log: bool, frac: float = 0.5) -> Fraction:
+    if log and a > 0 and b > 4 * a:
+        try:
+            la, lb = math.log(a), math.log(b)
+            x = Fraction(math.exp(la + frac * (lb - la)))
+        except (OverflowError, ValueError):
+            x = a
+        if a < x < b:
+            return x
+    return a + (b - a) * Fraction(frac).limit_denominator(64)
+
+
+def exact_crossings(qn: QuarticNumerators, lo: float, hi: float, log: bool = True,
+                    valid: Any = None) -> tuple[bool, list[tuple[float, str]], list[tuple[float, float]]]:
+    """All stability changes in ``(lo, hi)`` of a one-variable :class:`~.kernels.QuarticNumerators`.
+
+    Parameters
+    ----------
+    qn : QuarticNumerators
+        Numerators in one axis variable.
+    lo, hi : float
+        The range (taken exactly; any magnitudes).
+    log : bool
+        Place test points geometrically (only where the verdict is sampled).
+    valid : callable, optional
+        ``valid(x: float) -> bool``; pieces whose test point is invalid are
+        reported as undecided.
+
+    Returns
+    -------
+    stable_at_start : bool
+        Verdict just above ``lo``.
+    crossings : list of (float, str)
+        Values and directions, ascending.
+    undecided : list of (float, float)
+        Ranges where no verdict could be established (empty in all but
+        pathological cases).
+    """
+    exact = True
+    polys = []
+    for p in (*qn.N, qn.hurwitz(), qn.den):
+        c, ex = _univariate(p, qn.constants)
+        exact &= ex
+        polys.append(c)
+    N = polys[:5]
+    lo_q, hi_q = Fraction(lo), Fraction(hi)
+    roots = isolate_real_roots([N[0], N[4], polys[5], polys[6]], lo_q, hi_q)
+    iv = [(a, b) for a, b, _ in roots if b > lo_q and a < hi_q and not (a == b == lo_q) and not (a == b == hi_q)]
+    # merge isolating intervals closer than 1e-30 relative (a multiple root split by rounded constants)
+    merged: list[list[Fraction]] = []
+    for a, b in iv:
+        if merged and a - merged[-1][1] <= Fraction(1, 10 ** 30) * max(abs(a), abs(merged[-1][1]), Fraction(1, 10 ** 300)):
+            merged[-1][1] = max(merged[-1][1], b)
+        else:
+            merged.append([a, b])
+    edges = [lo_q] + [x for a, b in merged for x in (a, b)] + [hi_q]
+    pieces = [(edges[2 * k], edges[2 * k + 1]) for k in range(len(merged) + 1)]
+    verdicts: list[int | None] = []
+    for a, b in pieces:
+        v = None
+        if b > a:
+            for frac in (0.5, 0.25, 0.75, 0.125, 0.875):
+                x = _split_point(a, b, log, frac)
+                if valid is not None and not valid(float(x)):
+                    break
+                v = _verdict(N, x, exact)
+                if v is not None:
+                    break
+        verdicts.append(v)
+    found: list[tuple[float, str]] = []
+    undecided: list[tuple[float, float]] = []
+    prev: int | None = verdicts[0]
+    start = bool(verdicts[0]) if verdicts[0] is not None else False
+    if verdicts[0] is None:
+        undecided.append((float(pieces[0][0]), float(pieces[0][1])))
+    for k in range(1, len(pieces)):
+        v = verdicts[k]
+        a, b = merged[k - 1]
+        if v is None:
+            undecided.append((float(a), float(pieces[k][1])))
+        elif prev is None:
+            undecided.append((float(pieces[k - 1][1]), float(b)))
+        elif v != prev:
+            found.append((float((a + b) / 2), "stabilizing" if v == 1 else "destabilizing"))
+        if v is not None:
+            prev = v
+        else:
+            prev = None
+    return start, found, _merge_ranges(undecided)
+
+
+def _merge_ranges(r: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    out: list[tuple[float, float]] = []
+    for a, b in sorted(r):
+        if out and a <= out[-1][1]:
+            out[-1] = (out[-1][0], max(out[-1][1], b))
+        else:
+            out.append((a, b))
+    return out
+
+
+def exact_omega_crossings(p: np.ndarray, lo: float, hi: float
+                          ) -> tuple[bool, list[tuple[float, str]], list[tuple[float, float]]]:
+    """Exact stability changes along Ω in ``(lo, hi)`` for one parameter vector (trivial silent motion).
+
+    The closed-form matrices are evaluated with the (exact rational) parameter
+    values and Ω symbolic; see :func:`exact_crossings`.
+    """
+    import sympy as sp
+
+    from .kernels import QuarticNumerators, _closed_form_compliance, _quartic_field
+    from .space import VECTOR_NAMES
+
+    M, D, K, syms = _closed_form_compliance()
+    W = sp.Symbol("X0", positive=True)
+    sub = {syms[n]: (W if n == "Omega" else sp.Rational(float(v))) for n, v in zip(VECTOR_NAMES, p)}
+    entries = [e.xreplace(sub) for X in (M, D, K) for e in X]
+    res = _quartic_field(entries, [W])
+    if res is None:  # cannot happen for the closed form
+        return False, [], [(lo, hi)]
+    Nn, den, consts = res
+    return exact_crossings(QuarticNumerators(("Omega",), consts, Nn, den), lo, hi, True)
+
+
+def _numeric(space: ParameterSpace, axis: Axis, n: int = 801
+             ) -> tuple[bool, list[tuple[float, str]], list[tuple[float, float]]]:
     from scipy.optimize import brentq
 
-    from .maps import _numeric_point, _roots_summary
+    from .maps import numeric_point_verdict
 
     grid = Axis(axis.name, axis.start, axis.stop, n, axis.log).values()
 
-    def verdict(v: float) -> tuple[bool, float]:
-        code, c = _numeric_point(space, {axis.name: float(v)})
-        if c is None:
-            return False, math.nan
-        return bool(hurwitz_stable(*c)), float(_roots_summary(c)[0][0])
+    def verdict(v: float) -> tuple[int, bool, float]:
+        code, st, mr, _ = numeric_point_verdict(space, {axis.name: float(v)})
+        return code, st, mr
 
     vs = [verdict(v) for v in grid]
     out: list[tuple[float, str]] = []
-    for (a, (sa, ma)), (b, (sb, mb)) in zip(zip(grid, vs), zip(grid[1:], vs[1:])):
-        if sa == sb:
+    undecided: list[tuple[float, float]] = []
+    ok = [c <= 1 for c, _, _ in vs]
+    for k in range(n):
+        if not ok[k]:
+            undecided.append((float(grid[max(k - 1, 0)]), float(grid[min(k + 1, n - 1)])))
+    for k in range(n - 1):
+        (ca, sa, ma), (cb, sb, mb) = vs[k], vs[k + 1]
+        if not (ok[k] and ok[k + 1]) or sa == sb:
             continue
+        a, b = grid[k], grid[k + 1]
         x = a
         if math.isfinite(ma) and math.isfinite(mb) and ma * mb < 0:
-            x = brentq(lambda v: verdict(v)[1], a, b, xtol=1e-300, rtol=1e-15, maxiter=200)
-        out.append((x, "stabilizing" if sb else "destabilizing"))
-    return vs[0][0], out
+            x = brentq(lambda v: verdict(v)[2], a, b, xtol=1e-300, rtol=1e-15, maxiter=200)
+        out.append((float(x), "stabilizing" if sb else "destabilizing"))
+    return bool(vs[0][1]), out, _merge_ranges(undecided)
+
+
+def _valid_fn(space: ParameterSpace, name: str) -> Any:
+    def valid(x: float) -> bool:
+        try:
+            space.resolve({name: x})
+        except (ParameterError, SilentMotionError, ValueError, ZeroDivisionError, OverflowError):
+            return False
+        return True
+
+    return valid
 
 
 def crossings(space: ParameterSpace, axis: Axis) -> object:
@@ -107,17 +285,19 @@ def crossings(space: ParameterSpace, axis: Axis) -> object:
         settable name keeps its value in ``space`` and tied names follow.
     axis : Axis
         The path: ``axis.name`` must be a settable name of ``space``;
-        ``start`` and ``stop`` bound it (SI unit of the parameter).  ``log``
-        only selects where stability is sampled between candidates (geometric
-        instead of arithmetic midpoints) and the spacing of the numeric
-        fallback's grid; ``num`` is ignored.
+        ``start`` and ``stop`` bound it (SI unit of the parameter; any width,
+        e.g. ``1e-100`` to ``1e100``).  ``log`` only selects where stability is
+        sampled between candidates (geometric instead of arithmetic
+        midpoints) and the spacing of the numeric fallback's grid; ``num`` is
+        ignored.
 
     Returns
     -------
     CrossingResult
-        ``stable_at_start`` (verdict at ``start``) and the crossings with their
-        direction (``"destabilizing"``: stable before, unstable after, in the
-        direction of increasing parameter), in increasing order, and ``method``.
+        ``stable_at_start`` (verdict just above ``start``) and the crossings
+        with their direction (``"destabilizing"``: stable before, unstable
+        after, in the direction of increasing parameter), in increasing order,
+        ``method``, ``undecided_ranges`` and ``exhaustive``.
 
     Raises
     ------
@@ -129,26 +309,30 @@ def crossings(space: ParameterSpace, axis: Axis) -> object:
     -----
     When the closed-form quartic is rational in the parameter and the silent
     motion is trivial along the whole path (eq. 49), the candidates are the
-    real roots of ``a0`` (a root ``λ = 0``) and of the Hurwitz determinant
-    ``H3 = a1 (a2 a3 - a1 a4) - a0 a3²`` (a pair ``λ = ±iω``), isolated
-    exactly; the result is then exact to rounding.  Otherwise the numeric
-    linearization is evaluated on an 801-point grid along the path, sign
-    changes of the verdict are bracketed and the crossing is polished with
-    Brent's method on the largest real part; two crossings closer together
-    than the grid spacing may then be missed.
+    real roots of the exact numerators of ``a0``, ``a4``, of the Hurwitz
+    determinant ``H3 = a1 (a2 a3 - a1 a4) - a0 a3²`` and of the common
+    denominator, isolated exactly on the whole range; the result is complete
+    and exact (crossing values to ~1e-15 relative).  Sub-ranges whose
+    parameters are invalid are reported in ``undecided_ranges``.  Otherwise
+    the numeric linearization is evaluated on an 801-point grid along the
+    path, sign changes of the certified verdict are bracketed and the
+    crossing is polished with Brent's method on the largest real part
+    (``exhaustive=False``).
     """
     from ..results import CrossingResult
 
     space.check_axis(axis.name)
     space.resolve({axis.name: axis.start})
-    res = _exact(space, axis)
-    method = "exact (roots of the Hurwitz polynomials of the closed form)"
-    if res is None:
-        res = _numeric(space, axis)
-        method = "numeric linearization (grid bracketing + Brent on max Re λ)"
-    start, found = res
+    qn = quartic_numerators(space, (axis.name,))
+    if qn is not None:
+        start, found, undecided = exact_crossings(qn, axis.start, axis.stop, axis.log, _valid_fn(space, axis.name))
+        method, exhaustive = "exact (isolated real roots of the Hurwitz polynomials of the closed form)", True
+    else:
+        start, found, undecided = _numeric(space, axis)
+        method, exhaustive = "numeric linearization (certified verdicts on an 801-point grid + Brent)", False
     return CrossingResult(parameter=axis.name, start=axis.start, stop=axis.stop, log=axis.log,
-                          stable_at_start=start, crossings=tuple(found), method=method, space=space)
+                          stable_at_start=start, crossings=tuple(found), method=method, space=space,
+                          undecided_ranges=tuple(undecided), exhaustive=exhaustive)
 
 
 def _omega_batchable(space: ParameterSpace) -> bool:
@@ -160,11 +344,13 @@ def _omega_batchable(space: ParameterSpace) -> bool:
 def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5) -> object:
     """All onsets and re-stabilisations of squeal along the spin rate Ω in ``(lo, hi)`` [rad/s].
 
-    Uses the compiled Laurent-polynomial kernel when the silent motion is
-    trivial (eq. 49) and no tied name depends on ``Omega`` (relative accuracy
-    ~1e-12, at most 16 crossings reported), otherwise :func:`crossings` along
-    a logarithmic Ω axis.  The smallest destabilizing Ω is the critical speed
-    ``Omega_crit`` of the paper's Fig. 3.
+    Uses the certified compiled Laurent-polynomial kernel when the silent
+    motion is trivial (eq. 49) and no tied name depends on ``Omega`` (sets it
+    cannot certify are recomputed by exact root isolation; at most 16
+    crossings reported), otherwise :func:`crossings` along a logarithmic Ω
+    axis.  The smallest destabilizing Ω is the critical speed ``Omega_crit``
+    of the paper's Fig. 3.  Any range ``0 < lo < hi`` is handled (split into
+    sub-ranges internally).
 
     Parameters
     ----------
@@ -178,7 +364,8 @@ def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5) -> 
     -------
     CriticalSpeedResult
         Crossings along ``Omega`` (``log=True``); its ``Omega_crit`` is the
-        first destabilizing one, or ``None``.
+        first destabilizing one, or ``None``; ``Omega_crit_certain`` and
+        ``undecided_ranges`` state what is established.
 
     Raises
     ------
@@ -194,15 +381,20 @@ def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5) -> 
         from .equilibrium import parameter_vector
 
         p = np.array([parameter_vector(space.resolve({}))])
-        roots, dirs, counts, start = critical_speeds_batch(p, lo, hi, max_crossings=16)
+        roots, dirs, counts, start, status = critical_speeds_batch(p, lo, hi, max_crossings=16, return_status=True)
         found = tuple((float(roots[0, k]), "stabilizing" if dirs[0, k] > 0 else "destabilizing")
                       for k in range(min(int(counts[0]), 16)))
+        undecided: tuple[tuple[float, float], ...] = ()
+        if status[0] != 0:
+            _, _, und = exact_omega_crossings(p[0], lo, hi)
+            undecided = tuple(und) or ((lo, hi),)
         return CriticalSpeedResult(parameter="Omega", start=lo, stop=hi, log=True, stable_at_start=bool(start[0]),
-                                   crossings=found, method="exact (compiled Laurent-polynomial Hurwitz kernel)",
-                                   space=space)
+                                   crossings=found, method="exact (certified compiled Laurent-polynomial Hurwitz "
+                                   "kernel, exact rational fallback)", space=space, undecided_ranges=undecided)
     r = crossings(space, axis)
     return CriticalSpeedResult(parameter="Omega", start=lo, stop=hi, log=True, stable_at_start=r.stable_at_start,
-                               crossings=r.crossings, method=r.method, space=space)
+                               crossings=r.crossings, method=r.method, space=space,
+                               undecided_ranges=r.undecided_ranges, exhaustive=r.exhaustive)
 
 
 def critical_speeds_many(space: ParameterSpace, changes: dict[str, np.ndarray], lo: float = 1.0, hi: float = 1e5,
@@ -210,11 +402,11 @@ def critical_speeds_many(space: ParameterSpace, changes: dict[str, np.ndarray], 
     """Batched critical speeds over arrays of settable values (trivial silent motion required).
 
     Each of the ``n`` points resolves ``space`` with the values of
-    ``changes`` at that index, then the compiled kernel of
+    ``changes`` at that index, then the certified compiled kernel of
     :func:`~brakesqueal.analysis.kernels.critical_speeds_batch` finds every
-    stability change along Ω in ``(lo, hi)``.  Tied names are evaluated with
-    the space's own value of ``Omega`` (use :func:`critical_speeds` when one
-    depends on ``Omega``).
+    stability change along Ω in ``(lo, hi)`` (exact fallback per set).  Tied
+    names are evaluated with the space's own value of ``Omega`` (use
+    :func:`critical_speeds` when one depends on ``Omega``).
 
     Parameters
     ----------
@@ -249,6 +441,7 @@ def critical_speeds_many(space: ParameterSpace, changes: dict[str, np.ndarray], 
     """
     from .equilibrium import parameter_vector
 
+    Axis("Omega", lo, hi, 2, True)
     names = list(changes)
     for n in names:
         space.check_axis(n)
@@ -260,5 +453,4 @@ def critical_speeds_many(space: ParameterSpace, changes: dict[str, np.ndarray], 
         if not prm.trivial_silent_motion():
             raise ParameterError("critical_speeds_many needs a trivial silent motion (mu1*h10 = mu2*h20, eq. 49)")
         P[i] = parameter_vector(prm)
-    return critical_speeds_batch(P, lo, hi, max_crossings)
-
+    return critical_speeds_batch(P, lo, hi, max_crossings)  # type: ignore[return-value]

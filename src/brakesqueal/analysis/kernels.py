@@ -1,31 +1,44 @@
-r"""Exact stability criteria of 2-DOF models, generated from the closed forms and compiled.
+r"""Certified stability criteria of 2-DOF models, generated from the closed forms and compiled.
 
 The characteristic polynomial of eq. (47) for a 2-DOF model is the quartic
 
 .. math:: \det(\lambda^2 \bar M + \lambda \bar D + \bar K)
           = a_4 \lambda^4 + a_3 \lambda^3 + a_2 \lambda^2 + a_1 \lambda + a_0 .
 
-With ``a4 > 0`` all roots have negative real parts iff (Liénard–Chipart)
-``a0, a1, a2, a3 > 0`` and ``H3 = a3 a2 a1 - a4 a1^2 - a3^2 a0 > 0``; on the
-boundary of the stable set either ``a0 = 0`` (a real root at 0) or ``H3 = 0``
-(a pair ``±iω``).  The criterion is invariant under multiplying all ``ai``
-by one positive number, and under ``λ -> σλ`` (``ai -> ai σ^i``), which the
-kernels use to keep numbers of order one.
+All roots have negative real parts iff (Liénard–Chipart / Hurwitz) every
+``s a_i > 0`` and ``s H3 > 0`` with ``s = sign(a4)`` and
+``H3 = a3 a2 a1 - a4 a1^2 - a3^2 a0`` (the third Hurwitz determinant).  The
+test is invariant under multiplying all ``a_i`` by one non-zero number — so
+a common denominator of any sign may be dropped *per point* — and under
+``λ -> σλ`` (``a_i -> a_i σ^i``).  Stability can only change where ``a0 = 0``,
+``H3 = 0`` or ``a4 = 0`` (Orlando's formula).
 
-Three generated / compiled pieces live here:
+Every floating-point verdict made here is *certified*: values carry a
+rigorous bound of their rounding error and a sign is only used when it
+exceeds the bound; otherwise the point is reported *uncertain* and the caller
+recomputes it by a robust route (:mod:`.robust`).
 
-* :func:`map_kernel` — for two axes of a :class:`~.space.ParameterSpace`,
-  the closed form (``closed_form("general")``, trivial silent motion) is
-  specialised symbolically, the quartic's coefficients (times their common
-  positive denominator) become polynomials in the *inner* axis whose
-  coefficients depend on the *outer* axis only; the outer part is evaluated
-  once per row with NumPy, the inner loop is a few fused multiply-adds and
-  the Hurwitz inequalities, compiled with numba.
-* :func:`omega_coefficients` / :func:`critical_speeds_batch` — ``Mbar, Dbar,
-  Kbar`` are Laurent polynomials in Ω (gyroscopic ``ΦΩ``, friction damping
-  ``∝ 1/Ω``), so ``Ω^6 H3`` is a polynomial in Ω; its real roots are isolated
-  exactly (derivative cascade + safeguarded Newton) in compiled code.
-* :func:`path_polynomials` — the same for one arbitrary axis (``crossings``).
+Generated / compiled pieces:
+
+* :func:`quartic_numerators` — the closed form (``closed_form("general")``,
+  trivial silent motion) specialised to a parameter space with some axes
+  symbolic; entries are converted to elements of a rational function field
+  (``sympy.polys.fields``, exact rational arithmetic with cancellation), so
+  ``a_i = N_i / Den`` with small, exact numerator polynomials.  Constants such
+  as π are extra generators.
+* :func:`grid_kernel` / :func:`map_kernel` — numerators as polynomials in one
+  *inner* axis whose coefficients depend on the other axes; the coefficient
+  table is evaluated per row in exponent-scaled floating point with an error
+  bound, the inner loop (unrolled Horner + Hurwitz inequalities + error
+  bounds) is generated and compiled with numba and returns 0 (unstable),
+  1 (stable) or 2 (uncertain).
+* :func:`trivial_entries` — ``Mbar, Dbar, Kbar`` from a parameter vector with
+  a rigorous rounding bound per entry (generated, compiled).
+* :func:`omega_entries` / :func:`critical_speeds_batch` — ``Mbar, Dbar, Kbar``
+  are Laurent polynomials in Ω, so ``Ω^6 H3`` is a polynomial in Ω; its real
+  roots are isolated with certified Descartes bisection in compiled code
+  (:func:`~._compiled.critical_batch`), sets that cannot be certified are
+  recomputed exactly (:mod:`.crossings`).
 """
 
 from __future__ import annotations
@@ -41,9 +54,14 @@ import numpy as np
 from .space import VECTOR_NAMES, ParameterSpace
 
 __all__ = [
-    "quartic_coefficients", "hurwitz_h3", "hurwitz_stable", "MapKernel", "map_kernel",
-    "real_roots", "omega_coefficients", "critical_speeds_batch", "path_polynomials",
+    "quartic_coefficients", "hurwitz_h3", "hurwitz_stable", "QuarticNumerators", "quartic_numerators",
+    "GridKernel", "grid_kernel", "MapKernel", "map_kernel", "classify_numpy", "real_roots", "trivial_entries",
+    "omega_entries", "omega_coefficients", "critical_speeds_batch", "omega_subranges",
 ]
+
+_U = 2.0 ** -53
+#: Inner-axis block size of the compiled map kernel (error bounds are computed per block).
+BLOCK = 32
 
 
 # ---------------------------------------------------------------- generic formulas
@@ -72,7 +90,11 @@ def hurwitz_h3(a0: Any, a1: Any, a2: Any, a3: Any, a4: Any) -> Any:
 
 
 def hurwitz_stable(a0: Any, a1: Any, a2: Any, a3: Any, a4: Any) -> Any:
-    """Liénard–Chipart verdict (bool array): all roots of the quartic in the open left half-plane."""
+    """Liénard–Chipart verdict (bool array) in plain floating point, *not certified*.
+
+    Kept for quick checks on well-scaled coefficients; the analysis routes use
+    the certified tests of :mod:`.robust` (:func:`~.robust.routh_verdicts`).
+    """
     s = np.sign(a4)
     a0, a1, a2, a3, a4 = (np.asarray(a) * s for a in (a0, a1, a2, a3, a4))
     return (a0 > 0) & (a1 > 0) & (a2 > 0) & (a3 > 0) & (a4 > 0) & (hurwitz_h3(a0, a1, a2, a3, a4) > 0)
@@ -107,155 +129,336 @@ def _specialise(space: ParameterSpace, axes: dict[str, Any]) -> tuple[Any, Any, 
     return M.xreplace(sub), D.xreplace(sub), K.xreplace(sub), moment
 
 
-def _identically_zero(expr: Any) -> bool:
+def _exact_floats(e: Any) -> Any:
+    """Replace SymPy Floats by the exact rationals of their double values (what the float routes use)."""
     import sympy as sp
 
-    return sp.simplify(sp.together(expr)) == 0
+    fl = e.atoms(sp.Float)
+    return e.xreplace({f: sp.Rational(float(f)) for f in fl}) if fl else e
 
 
-def _numerators(M: Any, D: Any, K: Any, var_signs: dict[Any, int]) -> list[Any] | None:
-    """Numerators of ``a0..a4`` over a common denominator of known sign (sign folded in).
-
-    Returns ``None`` when the dependence is not rational.
-    """
+def _constants(exprs: list[Any]) -> list[Any]:
+    """Irrational numeric atoms (π, √2, exp(1), ...) of the expressions, used as extra field generators."""
     import sympy as sp
 
-    lam = sp.Symbol("lam")
-    det = sp.together((lam ** 2 * M + lam * D + K).det(method="berkowitz"))
-    num, den = sp.fraction(det)
-    gens = list(var_signs)
-    try:
-        poly = sp.Poly(sp.expand(num), lam, *gens)
-        den_poly = sp.Poly(sp.expand(den), *gens)
-    except sp.PolynomialError:
-        return None
-    if any(not c.is_number for c in poly.coeffs()) or any(not c.is_number for c in den_poly.coeffs()):
-        return None
-    # sign of the denominator for the axes' signs
-    pos = {v: sp.Symbol(f"_p{i}", positive=True) * s for i, (v, s) in enumerate(var_signs.items())}
-    dsub = sp.expand(den.xreplace(pos))
-    sign = 1 if dsub.is_positive else -1 if dsub.is_negative else 0
-    numer = sp.expand(num if sign != 0 else num * den) * (sign or 1)
-    p = sp.Poly(numer, lam)
-    coeffs = [p.coeff_monomial(lam ** i) for i in range(5)]
-    return [sp.expand(c) for c in coeffs]
+    out: set[Any] = set()
+    for e in exprs:
+        out |= e.atoms(sp.NumberSymbol)
+        out |= {a for a in e.atoms(sp.Pow) if a.is_number and not a.exp.is_Integer}
+        out |= {a for a in e.atoms(sp.Function) if a.is_number}
+    return sorted(out, key=sp.default_sort_key)
 
 
-# ---------------------------------------------------------------- 2-D map kernel
 @dataclass(frozen=True)
-class MapKernel:
-    """Compiled Hurwitz classifier for a map over two axes of a parameter space.
+class QuarticNumerators:
+    """Exact numerators of the quartic's coefficients, ``a_i = N_i / Den``.
 
     Attributes
     ----------
-    outer, inner : str
-        Axis names; the inner axis is the contiguous (fast) one, chosen as the
-        one in which the quartic's coefficients have the lowest degrees.
+    names : tuple of str
+        The symbolic axes (settable names of the space), in generator order.
+    constants : tuple
+        SymPy constants (π, ...) that are further generators of the ring.
+    N : tuple
+        ``N_0 .. N_4`` as ``sympy.polys.rings.PolyElement`` over QQ with
+        generators ``names + constants``.
+    den : PolyElement
+        The common denominator (its sign is never assumed).
+    """
+
+    names: tuple[str, ...]
+    constants: tuple[Any, ...]
+    N: tuple[Any, ...]
+    den: Any
+
+    @property
+    def ring(self) -> Any:
+        """The polynomial ring of ``N`` and ``den``."""
+        return self.den.ring
+
+    def hurwitz(self) -> Any:
+        """``H3`` of the numerators, ``N1 (N3 N2 - N4 N1) - N3² N0`` (exact)."""
+        n0, n1, n2, n3, n4 = self.N
+        return n1 * (n3 * n2 - n4 * n1) - n3 ** 2 * n0
+
+
+def _quartic_field(entries: list[Any], symbols: list[Any]) -> tuple[tuple[Any, ...], Any, tuple[Any, ...]] | None:
+    """``(N, den, constants)`` of ``det(λ²M + λD + K)`` for 12 SymPy entries rational in ``symbols``."""
+    import sympy as sp
+    from sympy.polys.fields import field
+
+    entries = [_exact_floats(sp.sympify(e)) for e in entries]
+    consts = _constants(entries)
+    F, *_ = field(list(symbols) + consts, sp.QQ)
+    try:
+        conv = [F.from_expr(e) if e != 0 else F(0) for e in entries]
+    except Exception:  # non-rational dependence (Abs, sqrt of an axis, ...)
+        return None
+    m11, m12, m21, m22, d11, d12, d21, d22, k11, k12, k21, k22 = conv
+    A = [k11 * k22 - k12 * k21,
+         d11 * k22 + k11 * d22 - d12 * k21 - k12 * d21,
+         m11 * k22 + d11 * d22 + k11 * m22 - m12 * k21 - d12 * d21 - k12 * m21,
+         m11 * d22 + d11 * m22 - m12 * d21 - d12 * m21,
+         m11 * m22 - m12 * m21]
+    den = A[0].denom
+    for a in A[1:]:
+        den = den.lcm(a.denom)
+    N = tuple(a.numer * den.exquo(a.denom) for a in A)
+    return N, den, tuple(consts)
+
+
+@lru_cache(maxsize=64)
+def quartic_numerators(space: ParameterSpace, names: tuple[str, ...]) -> QuarticNumerators | None:
+    """Exact numerators of ``a0..a4`` with the axes ``names`` symbolic (trivial silent motion).
+
+    Returns ``None`` when the silent motion is not identically trivial on the
+    axes (``mu1 h10 ≠ mu2 h20`` somewhere, eq. 49) or the dependence on an
+    axis is not rational.
+    """
+    import sympy as sp
+    from sympy.polys.fields import field
+
+    syms = [sp.Symbol(f"X{i}", real=True) for i in range(len(names))]
+    M, D, K, moment = _specialise(space, dict(zip(names, syms)))
+    moment = _exact_floats(moment)
+    try:
+        Fm, *_ = field(syms + _constants([moment]), sp.QQ)
+        if Fm.from_expr(moment) != 0:
+            return None
+    except Exception:
+        if sp.simplify(moment) != 0:
+            return None
+    res = _quartic_field(list(M) + list(D) + list(K), syms)
+    if res is None:
+        return None
+    N, den, consts = res
+    return QuarticNumerators(tuple(names), consts, N, den)
+
+
+def _const_values(consts: tuple[Any, ...], dps: int = 60) -> list[Any]:
+    import mpmath
+    import sympy as sp
+
+    with mpmath.workdps(dps):
+        return [mpmath.mpf(sp.N(c, dps + 10)) for c in consts]
+
+
+def numeric_terms(poly: Any, n_axes: int, consts: tuple[Any, ...]) -> dict[tuple[int, ...], Any]:
+    """Collect a ring element by axis exponents; constants evaluated with mpmath (60 digits)."""
+    import mpmath
+
+    cv = _const_values(consts)
+    out: dict[tuple[int, ...], Any] = {}
+    with mpmath.workdps(60):
+        for mon, c in poly.terms():
+            v = mpmath.mpf(c.numerator) / c.denominator
+            for g, k in zip(cv, mon[n_axes:]):
+                v *= g ** k
+            key = tuple(mon[:n_axes])
+            out[key] = out.get(key, 0) + v
+    return out
+
+
+def _frexp_mp(v: Any) -> tuple[float, int]:
+    import mpmath
+
+    if v == 0:
+        return 0.0, 0
+    m, e = mpmath.frexp(v)
+    return float(m), int(e)
+
+
+# ---------------------------------------------------------------- N-D grid kernel
+@dataclass(frozen=True)
+class GridKernel:
+    """Compiled, certified Hurwitz classifier over the axes of a grid.
+
+    Attributes
+    ----------
+    names : tuple of str
+        All axes; ``inner`` is the index of the contiguous (fast) one, chosen
+        as the axis in which the numerators have the lowest degrees.
     degrees : tuple of int
-        Degree of ``a0..a4`` in the inner axis.
-    row_coefficients : callable
-        ``f(outer_values, inner_ref) -> (C, sigma)``: per-row coefficient table
-        (``n_outer × Σ(deg+1)``) for the scaled inner variable ``t = inner/inner_ref``,
-        normalised per row, and the per-row time scale ``sigma`` (roots are ``σ μ``).
+        Degree of ``N_0..N_4`` in the inner axis.
+    exps, slot, mant, e2 : ndarray
+        Coefficient table: term ``t`` contributes
+        ``mant[t] 2^e2[t] Π_j outer_j^exps[t, j]`` to column ``slot[t]``
+        (``slot`` enumerates ``(i, k)``: coefficient of ``inner^k`` in ``N_i``),
+        with the inner power ``ipow[t]``.
+    ipow : ndarray
+        Inner exponent of every term.
+    nops : ndarray
+        Per column, a bound on the floating-point operations of its evaluation.
     classify : callable
-        ``classify(C, t, out)`` writes the verdict (uint8, 1 = stable) to ``out[n_outer, n_inner]``.
+        ``classify(C, EC, t, seg, Tseg, out)``: 0 unstable, 1 stable, 2
+        uncertain at ``(row i, inner t[j])`` (see :func:`_kernel_source`,
+        :func:`kernel_segments`; :func:`run_classify` wraps it).
     coefficients : callable
-        ``coefficients(C, t, out)`` writes ``a0..a4`` (scaled) to ``out[5, n_outer, n_inner]``.
+        ``coefficients(C, t, out)`` writes ``a0..a4`` (scaled) to ``out[5, rows, n_inner]``.
     source : str
         Generated kernel source.
     """
 
-    outer: str
-    inner: str
+    names: tuple[str, ...]
+    inner: int
     degrees: tuple[int, ...]
-    row_coefficients: Callable[[np.ndarray, float], tuple[np.ndarray, np.ndarray]]
+    exps: np.ndarray
+    ipow: np.ndarray
+    slot: np.ndarray
+    mant: np.ndarray
+    e2: np.ndarray
+    nops: np.ndarray
     classify: Callable[..., None]
     coefficients: Callable[..., None]
     source: str
 
+    def row_coefficients(self, outer: list[np.ndarray], inner_exp: int) -> tuple[np.ndarray, np.ndarray]:
+        """Per-row coefficient table ``C`` and its absolute error bound ``EC``.
 
-def normalise_rows(C: np.ndarray, degrees: tuple[int, ...], inner_ref: float) -> tuple[np.ndarray, np.ndarray]:
-    """Scale per-row quartic coefficient tables for the compiled Hurwitz classifier.
+        Parameters
+        ----------
+        outer : list of ndarray
+            Values of the outer axes (``names`` without ``inner``), each of
+            length ``rows``.
+        inner_exp : int
+            The inner variable is ``t = inner / 2^inner_exp``.
 
-    ``C`` holds, per row, the inner-axis polynomial coefficients of ``a0..a4``
-    (``degrees[i] + 1`` columns each).  The inner variable is divided by
-    ``inner_ref``, time is rescaled per row by ``sigma = (|a0| / |a4|)^(1/4)``
-    (``λ → σ λ``, which keeps the roots' magnitudes near one and does not change
-    the Hurwitz signs), and each row is divided by its largest entry.
+        Returns
+        -------
+        C, EC : ndarray, shape (rows, Σ(degrees + 1))
+            Coefficients of ``t^k`` in ``N_i`` (column blocks ``i = 0..4``),
+            each row multiplied by one positive power of two (balanced with
+            ``λ -> 2^e λ`` and normalised); ``EC`` bounds their errors.
+        """
+        from ._rows import normalise_rows, rows_eval
 
-    Parameters
-    ----------
-    C : ndarray, shape (rows, sum(degrees) + 5)
-        Coefficient table (modified copy returned).
-    degrees : tuple of int
-        Inner-axis degree of each of ``a0..a4``.
-    inner_ref : float
-        Scale of the inner axis.
-
-    Returns
-    -------
-    C : ndarray
-        The normalised, C-contiguous table.
-    sigma : ndarray, shape (rows,)
-        The per-row time scales.
-    """
-    C = C * np.concatenate([inner_ref ** np.arange(d + 1) for d in degrees])
-    offs = np.concatenate([[0], np.cumsum([d + 1 for d in degrees])])
-    mag = [np.max(np.abs(C[:, offs[i]:offs[i + 1]]), axis=1) for i in range(5)]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        sigma = np.where((mag[0] > 0) & (mag[4] > 0), (mag[0] / mag[4]) ** 0.25, 1.0)
-    for i in range(5):
-        C[:, offs[i]:offs[i + 1]] *= (sigma ** i)[:, None]
-    scale = np.max(np.abs(C), axis=1)
-    scale[~(scale > 0)] = 1.0
-    C /= scale[:, None]
-    return np.ascontiguousarray(C), sigma
+        n_rows = int(np.size(outer[0])) if outer else 1
+        ncol = int(sum(d + 1 for d in self.degrees))
+        nout = len(outer)
+        Um = np.empty((n_rows, max(nout, 1)))
+        Qe = np.zeros((n_rows, max(nout, 1)), dtype=np.int64)
+        for j, v in enumerate(outer):
+            m, e = np.frexp(np.asarray(v, dtype=float))
+            Um[:, j], Qe[:, j] = m, e
+        e2 = self.e2 + inner_exp * self.ipow
+        C = np.zeros((n_rows, ncol))
+        EC = np.zeros((n_rows, ncol))
+        rows_eval(self.exps, self.slot, self.mant, e2, Um, Qe, self.nops, C, EC)
+        normalise_rows(C, EC, np.array(self.degrees, dtype=np.int64))
+        bad = ~(np.all(np.isfinite(C), axis=1) & np.all(np.isfinite(EC), axis=1))
+        if bad.any():  # such rows are classified uncertain (a4 = 0 with an infinite bound)
+            C[bad] = 0.0
+            EC[bad] = np.inf
+        return C, EC
 
 
 def _kernel_source(degrees: tuple[int, ...]) -> str:
+    """Numba source of the certified classifier for inner-axis degrees ``degrees`` of ``N_0..N_4``.
+
+    Two passes per row: a vectorizable pass with one error bound per row
+    (valid for every ``|t| <= max|t|``), then, only for the rare points it
+    leaves uncertain, a scalar pass with the point's own (tighter) bounds.
+    """
     offs = np.concatenate([[0], np.cumsum([d + 1 for d in degrees])]).tolist()
     load = "; ".join(f"c{i}_{k} = C[i, {offs[i] + k}]" for i in range(5) for k in range(degrees[i] + 1))
+    gam = [(2 * d + 4) * _U * 1.0001 for d in degrees]
+    loadb = "\n".join(f"        b{i}_{k} = EC[i, {offs[i] + k}] + {gam[i]!r} * abs(c{i}_{k})"
+                      for i in range(5) for k in range(degrees[i] + 1))
 
-    def horner(i: int) -> str:
+    def horner(i: int, pre: str, var: str, wrap: str = "") -> str:
         d = degrees[i]
-        expr = f"c{i}_{d}"
+        expr = f"{wrap}({pre}{i}_{d})" if wrap else f"{pre}{i}_{d}"
         for k in range(d - 1, -1, -1):
-            expr = f"(c{i}_{k} + x * {expr})"
+            term = f"{wrap}({pre}{i}_{k})" if wrap else f"{pre}{i}_{k}"
+            expr = f"({term} + {var} * {expr})"
         return expr
 
-    body = "\n".join(f"            a{i} = {horner(i)}" for i in range(5))
-    h3 = "a1 * (a3 * a2 - a4 * a1) - a3 * a3 * a0"
-    return f'''"""Generated by brakesqueal.analysis.kernels (degrees {degrees}). Do not edit."""
-import numba
+    def indent(text: str, n: int) -> str:
+        return "\n".join(" " * n + ln for ln in text.splitlines())
 
-
-@numba.njit(cache=True, fastmath={{"contract"}}, error_model="numpy", boundscheck=False)
-def classify(C, t, out):
-    """Hurwitz verdict of the quartic: out[i, j] = 1 iff stable at (outer i, inner t[j])."""
-    for i in range(C.shape[0]):
-        {load}
-        o = out[i]
-        for j in range(t.shape[0]):
-            x = t[j]
-{body}
-            h3 = {h3}
-            o[j] = (a0 > 0.0) & (a1 > 0.0) & (a2 > 0.0) & (a3 > 0.0) & (a4 > 0.0) & (h3 > 0.0)
-
-
-@numba.njit(cache=True, fastmath={{"contract"}}, error_model="numpy", boundscheck=False)
-def coefficients(C, t, out):
-    """Scaled quartic coefficients: out[k, i, j] = a_k at (outer i, inner t[j])."""
-    for i in range(C.shape[0]):
-        {load}
-        for j in range(t.shape[0]):
-            x = t[j]
-{body}
-            out[0, i, j] = a0
-            out[1, i, j] = a1
-            out[2, i, j] = a2
-            out[3, i, j] = a3
-            out[4, i, j] = a4
-'''
+    poly = "\n".join(f"a{i} = {horner(i, 'c', 'x')}" for i in range(5))
+    rowb = "\n".join(f"E{i} = ({horner(i, 'b', 'T')}) * 1.0000000001 + 1e-300" for i in range(5))
+    rowB = "\n".join(f"B{i} = {horner(i, 'c', 'T', 'abs')} * 1.0000000001 + E{i}" for i in range(5))
+    ehrow = ("ehb = (E1 * B3 * B2 + B1 * E3 * B2 + B1 * B3 * E2 + E4 * B1 * B1 + 2.0 * B4 * E1 * B1\n"
+             "       + 2.0 * E3 * B3 * B0 + B3 * B3 * E0 + 1.2e-15 * (B1 * B3 * B2 + B4 * B1 * B1 + B3 * B3 * B0))"
+             " * 1.0000001 + 1e-300")
+    test = ("s = math.copysign(1.0, a4)\n"
+            "d0 = s * a0\nd1 = s * a1\nd2 = s * a2\nd3 = s * a3\n"
+            "h = d1 * (d3 * d2 - abs(a4) * d1) - d3 * d3 * d0\n"
+            "sg = abs(a4) > E4\n"
+            "st = sg & (d0 > E0) & (d1 > E1) & (d2 > E2) & (d3 > E3) & (h > ehb)\n"
+            "ng = sg & ((d0 < -E0) | (d1 < -E1) | (d2 < -E2) | (d3 < -E3) | (h < -ehb))")
+    # pass 1: d_k / E_k > 1 for all k <=> certified stable, < -1 for one k <=> certified unstable; the
+    # reciprocals are rounded down by 4.5e-16 so that fl(d_k r_k) > 1 implies d_k > E_k (no NaN can occur:
+    # finite tables, |t|^deg < 2^300, see maps._kernel_usable and GridKernel.row_coefficients)
+    fast = ("s = math.copysign(1.0, a4)\n"
+            "d0 = s * a0\nd1 = s * a1\nd2 = s * a2\nd3 = s * a3\n"
+            "h = d1 * (d3 * d2 - abs(a4) * d1) - d3 * d3 * d0\n"
+            "sg = abs(a4) > E4\n"
+            "m = min(min(min(d0 * r0, d1 * r1), min(d2 * r2, d3 * r3)), h * rh)")
+    ehpt = ("A0 = abs(a0) + E0\nA1 = abs(a1) + E1\nA2 = abs(a2) + E2\nA3 = abs(a3) + E3\nA4 = abs(a4) + E4\n"
+            "ehb = (E1 * A3 * A2 + abs(a1) * E3 * A2 + abs(a1 * a3) * E2 + E4 * A1 * A1"
+            " + abs(a4) * E1 * (A1 + abs(a1))\n"
+            "       + E3 * (A3 + abs(a3)) * A0 + a3 * a3 * E0 + 1.2e-15 * (A1 * A3 * A2 + A4 * A1 * A1 + A3 * A3 * A0))"
+            " * 1.0000001 + 1e-300")
+    lines = [
+        f'"""Generated by brakesqueal.analysis.kernels (degrees {degrees}). Do not edit."""',
+        "import math", "", "import numba", "import numpy as np", "", "",
+        '@numba.njit(cache=True, fastmath={"contract"}, error_model="numpy", boundscheck=False)',
+        "def classify(C, EC, t, seg, Tseg, out):",
+        '    """Certified Hurwitz verdict: out[i, j] = 1 stable, 0 unstable, 2 uncertain at (row i, inner t[j]).',
+        "",
+        "    a_k = Horner(C row, t) with |error| <= E_k (coefficient bounds EC plus Horner rounding);",
+        "    s = sign(a4) per point (a common denominator of any sign drops out), d_k = s a_k and",
+        "    s H3 = d1 (d3 d2 - |a4| d1) - d3^2 d0; H3's error bound",
+        "    follows from the E_k by interval reasoning.  Pass 1 uses one bound per segment",
+        "    t[seg[q]:seg[q+1]] (valid for |t| <= Tseg[q]), pass 2 re-tests its uncertain points",
+        "    with their own bounds.",
+        '    """',
+        "    n = t.shape[0]",
+        "    for i in range(C.shape[0]):",
+        f"        {load}",
+        loadb,
+        "        orow = out[i]",
+        "        for q in range(seg.shape[0] - 1):",
+        "            T = Tseg[q]",
+        indent(rowb, 12), indent(rowB, 12), indent(ehrow, 12),
+        "            r0 = (1.0 / E0) * (1.0 - 4.5e-16)",
+        "            r1 = (1.0 / E1) * (1.0 - 4.5e-16)",
+        "            r2 = (1.0 / E2) * (1.0 - 4.5e-16)",
+        "            r3 = (1.0 / E3) * (1.0 - 4.5e-16)",
+        "            rh = (1.0 / ehb) * (1.0 - 4.5e-16)",
+        "            ts = t[seg[q]:seg[q + 1]]",
+        "            o = orow[seg[q]:seg[q + 1]]",
+        "            for j in range(ts.shape[0]):",
+        "                x = ts[j]",
+        indent(poly, 16), indent(fast, 16),
+        "                o[j] = 2 - (sg & (m > 1.0)) - 2 * (sg & (m < -1.0))",
+        "        o = orow",
+        "        nu = np.uint8(0)",
+        "        for j in range(n):",
+        "            nu = max(nu, o[j])",
+        "        if nu < 2:",
+        "            continue",
+        "        for j in range(n):",
+        "            if o[j] != 2:",
+        "                continue",
+        "            x = t[j]",
+        "            T = abs(x)",
+        indent(rowb, 12), indent(poly, 12), indent(ehpt, 12), indent(test, 12),
+        "            o[j] = 1 if st else (0 if ng else 2)",
+        "", "",
+        '@numba.njit(cache=True, fastmath={"contract"}, error_model="numpy", boundscheck=False)',
+        "def coefficients(C, t, out):",
+        '    """Scaled quartic numerators: out[k, i, j] = N_k at (row i, inner t[j]) (no error bound)."""',
+        "    for i in range(C.shape[0]):",
+        f"        {load}",
+        "        for j in range(t.shape[0]):",
+        "            x = t[j]",
+        indent(poly, 12),
+    ]
+    lines += [f"            out[{i}, i, j] = a{i}" for i in range(5)]
+    return "\n".join(lines) + "\n"
 
 
 def _load_generated(source: str, tag: str) -> Any:
@@ -266,80 +469,288 @@ def _load_generated(source: str, tag: str) -> Any:
     return cache.load_module("stability-kernels", f"brakesqueal_kernel_{tag}_{digest}.py", lambda: source)
 
 
+#: Kernels are refused (callers use the per-point route) above these inner / outer degrees.
+MAX_INNER_DEGREE = 12
+MAX_OUTER_DEGREE = 40
+
+
 @lru_cache(maxsize=32)
-def _map_kernel_cached(space: ParameterSpace, x: str, y: str, sx: int, sy: int) -> MapKernel | None:
-    import sympy as sp
+def grid_kernel(space: ParameterSpace, names: tuple[str, ...]) -> GridKernel | None:
+    """Build (or fetch) the certified classifier for a grid over ``names``.
 
-    X, Y = sp.Symbol("X", real=True), sp.Symbol("Y", real=True)
-    M, D, K, moment = _specialise(space, {x: X, y: Y})
-    if not _identically_zero(moment):
+    Returns ``None`` when no closed-form kernel applies: non-trivial silent
+    motion somewhere on the grid, non-rational dependence, or degrees above
+    :data:`MAX_INNER_DEGREE` / :data:`MAX_OUTER_DEGREE` (callers then use the
+    per-point route of :mod:`.robust`, which is always correct but slower).
+    Nothing is assumed about the signs of the axes.
+    """
+    qn = quartic_numerators(space, tuple(names))
+    if qn is None:
         return None
-    nums = _numerators(M, D, K, {X: sx, Y: sy})
-    if nums is None:
+    nax = len(names)
+    terms = [numeric_terms(p, nax, qn.constants) for p in qn.N]
+    degs = [tuple(max((m[j] for m in t), default=0) for t in terms) for j in range(nax)]
+    totals = [sum(d) for d in degs]
+    inner = max(i for i in range(nax) if totals[i] == min(totals))  # ties: the trailing axis
+    degrees = degs[inner]
+    if max(degrees) > MAX_INNER_DEGREE:
         return None
-    deg_x = tuple(sp.Poly(a, X, Y).degree(X) if a != 0 else 0 for a in nums)
-    deg_y = tuple(sp.Poly(a, X, Y).degree(Y) if a != 0 else 0 for a in nums)
-    if sum(deg_x) <= sum(deg_y):
-        inner, outer, I, O, degrees = x, y, X, Y, deg_x
-    else:
-        inner, outer, I, O, degrees = y, x, Y, X, deg_y
-    exprs = []
-    for a, d in zip(nums, degrees):
-        p = sp.Poly(a, I)
-        exprs.extend(p.coeff_monomial(I ** k) if k else p.coeff_monomial(1) for k in range(d + 1))
-    fn = sp.lambdify([O], exprs, modules="numpy")
-    degs = degrees
-
-    def row_coefficients(outer_values: np.ndarray, inner_ref: float) -> tuple[np.ndarray, np.ndarray]:
-        ov = np.asarray(outer_values, dtype=float)
-        cols = [np.broadcast_to(np.asarray(c, dtype=float), ov.shape) for c in fn(ov)]
-        C = np.stack(cols, axis=1) if cols else np.zeros((ov.size, 0))
-        return normalise_rows(C, degs, inner_ref)
-
+    offs = np.concatenate([[0], np.cumsum([d + 1 for d in degrees])])
+    rows_e, rows_k, rows_s, rows_m, rows_x = [], [], [], [], []
+    for i, t in enumerate(terms):
+        for mon, v in t.items():
+            if v == 0:
+                continue
+            m, e = _frexp_mp(v)
+            outer_exp = [mon[j] for j in range(nax) if j != inner]
+            if sum(outer_exp) > MAX_OUTER_DEGREE:
+                return None
+            rows_e.append(outer_exp)
+            rows_k.append(mon[inner])
+            rows_s.append(int(offs[i] + mon[inner]))
+            rows_m.append(m)
+            rows_x.append(e)
+    ncol = int(offs[-1])
+    nterms = np.bincount(np.array(rows_s, dtype=np.int64), minlength=ncol)
+    tdeg = np.zeros(ncol, dtype=np.int64)
+    for s, ex in zip(rows_s, rows_e):
+        tdeg[s] = max(tdeg[s], sum(ex))
+    nops = (nterms + tdeg + 4).astype(float)
+    exps = np.array(rows_e, dtype=np.int64).reshape(len(rows_s), nax - 1)
     source = _kernel_source(degrees)
     mod = _load_generated(source, "map")
-    return MapKernel(outer=outer, inner=inner, degrees=degrees, row_coefficients=row_coefficients,
-                     classify=mod.classify, coefficients=mod.coefficients, source=source)
+    return GridKernel(names=tuple(names), inner=inner, degrees=degrees, exps=exps,
+                      ipow=np.array(rows_k, dtype=np.int64), slot=np.array(rows_s, dtype=np.int64),
+                      mant=np.array(rows_m), e2=np.array(rows_x, dtype=np.int64), nops=nops,
+                      classify=mod.classify, coefficients=mod.coefficients, source=source)
 
 
-def classify_numpy(kernel: MapKernel, C: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """NumPy (no compiler) version of ``kernel.classify`` on the same row coefficients."""
-    offs = np.concatenate([[0], np.cumsum([d + 1 for d in kernel.degrees])])
+def inner_exponent(values: np.ndarray) -> int:
+    """Power-of-two scale of an inner axis: ``t = value / 2^e`` has magnitudes near one."""
+    a = np.abs(np.asarray(values, dtype=float))
+    a = a[np.isfinite(a) & (a > 0)]
+    if a.size == 0:
+        return 0
+    return int(round(0.5 * (math.log2(a.min()) + math.log2(a.max()))))
+
+
+def kernel_segments(t: np.ndarray, min_len: int = 64) -> tuple[np.ndarray, np.ndarray]:
+    """Segments of the inner values for the kernel's first pass: ``|t|`` within a factor 8, at least ``min_len`` long.
+
+    Returns ``(seg, Tseg)``: boundaries ``seg[0] = 0 < ... < seg[-1] = len(t)``
+    and the largest ``|t|`` of every segment (the error bounds hold for every
+    point of a segment; longer segments only make them looser).
+    """
+    a = np.abs(np.asarray(t, dtype=float))
+    n = a.size
+    if n == 0:
+        return np.array([0], dtype=np.int64), np.zeros(0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cls = np.where(a > 0, np.floor(np.log2(np.where(a > 0, a, 1.0)) / 3.0), -1e6)
+    cls[~np.isfinite(a)] = 1e6
+    cuts = np.flatnonzero(np.diff(cls)) + 1
+    seg = [0]
+    for c in cuts:
+        if c - seg[-1] >= min_len:
+            seg.append(int(c))
+    if n - seg[-1] < min_len and len(seg) > 1:
+        seg.pop()
+    seg.append(n)
+    segs = np.array(seg, dtype=np.int64)
+    with np.errstate(invalid="ignore"):
+        T = np.maximum.reduceat(a, segs[:-1])
+    return segs, T
+
+
+def run_classify(kern: GridKernel | MapKernel, C: np.ndarray, EC: np.ndarray, t: np.ndarray,
+                 out: np.ndarray | None = None) -> np.ndarray:
+    """Call the compiled classifier on row tables ``C, EC`` and inner values ``t`` (codes 0/1/2)."""
+    t = np.ascontiguousarray(t, dtype=float)
+    if out is None:
+        out = np.empty((C.shape[0], t.size), dtype=np.uint8)
+    seg, T = kernel_segments(t)
+    kern.classify(C, EC, t, seg, T, out)
+    return out
+
+
+def classify_grid_values(kern: GridKernel, outer: list[np.ndarray], inner_values: np.ndarray) -> np.ndarray:
+    """Verdict codes ``(rows, n_inner)`` (0 unstable, 1 stable, 2 uncertain) of a grid kernel."""
+    e = inner_exponent(inner_values)
+    C, EC = kern.row_coefficients(outer, e)
+    t = np.ldexp(np.asarray(inner_values, dtype=float), -e)
+    return run_classify(kern, C, EC, t)
+
+
+# ---------------------------------------------------------------- 2-D map kernel
+@dataclass(frozen=True)
+class MapKernel:
+    """The grid kernel of a 2-D map, with the axis roles named.
+
+    Attributes
+    ----------
+    outer, inner : str
+        Axis names; the inner axis is the contiguous (fast) one.
+    degrees : tuple of int
+        Degree of ``N_0..N_4`` in the inner axis.
+    grid : GridKernel
+        The underlying kernel.
+    """
+
+    outer: str
+    inner: str
+    degrees: tuple[int, ...]
+    grid: GridKernel
+
+    @property
+    def classify(self) -> Callable[..., None]:
+        """``classify(C, EC, t, seg, Tseg, out)`` (see :class:`GridKernel`, :func:`run_classify`)."""
+        return self.grid.classify
+
+    @property
+    def coefficients(self) -> Callable[..., None]:
+        """``coefficients(C, t, out)`` (see :class:`GridKernel`)."""
+        return self.grid.coefficients
+
+    @property
+    def source(self) -> str:
+        """Generated kernel source."""
+        return self.grid.source
+
+    def row_coefficients(self, outer_values: np.ndarray, inner_exp: int) -> tuple[np.ndarray, np.ndarray]:
+        """``(C, EC)`` per outer value for ``t = inner / 2^inner_exp`` (see :meth:`GridKernel.row_coefficients`)."""
+        return self.grid.row_coefficients([np.asarray(outer_values, dtype=float)], inner_exp)
+
+    def verdicts(self, outer_values: np.ndarray, inner_values: np.ndarray) -> np.ndarray:
+        """Verdict codes ``(n_outer, n_inner)``: 0 unstable, 1 stable, 2 uncertain."""
+        return classify_grid_values(self.grid, [np.asarray(outer_values, dtype=float)], inner_values)
+
+
+def map_kernel(space: ParameterSpace, x: str, y: str) -> MapKernel | None:
+    """Build (or fetch) the certified map kernel over axes ``x`` and ``y``.
+
+    Returns ``None`` when the silent motion is not identically trivial on the
+    map (``mu1 h10 ≠ mu2 h20`` somewhere), the dependence is not rational, or
+    the degrees are too high; callers then use the per-point route.  The
+    result does not depend on the axes' ranges or signs.
+    """
+    g = grid_kernel(space, (x, y))
+    if g is None:
+        return None
+    names = (x, y)
+    return MapKernel(outer=names[1 - g.inner], inner=names[g.inner], degrees=g.degrees, grid=g)
+
+
+def _np_bounds(C: np.ndarray, EC: np.ndarray, degrees: tuple[int, ...], T: np.ndarray | float
+               ) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """Error bounds ``E_k`` and magnitude bounds ``B_k`` of the ``a_k`` for ``|t| <= T`` (broadcast to rows × T)."""
+    offs = np.concatenate([[0], np.cumsum([d + 1 for d in degrees])])
+    E, B = [], []
+    for i, d in enumerate(degrees):
+        g = (2 * d + 4) * _U * 1.0001
+        c = C[:, offs[i]:offs[i + 1], None]
+        b = EC[:, offs[i]:offs[i + 1], None] + g * np.abs(c)
+        e = b[:, d]
+        m = np.abs(c[:, d])
+        for k in range(d - 1, -1, -1):
+            e = e * T + b[:, k]
+            m = m * T + np.abs(c[:, k])
+        E.append(e * 1.0000000001 + 1e-300)
+        B.append(m * 1.0000000001 + E[-1])
+    return E, B
+
+
+def _np_values(C: np.ndarray, degrees: tuple[int, ...], t: np.ndarray) -> list[np.ndarray]:
+    offs = np.concatenate([[0], np.cumsum([d + 1 for d in degrees])])
     a = []
-    for i, d in enumerate(kernel.degrees):
+    for i, d in enumerate(degrees):
         v = np.broadcast_to(C[:, offs[i] + d, None], (C.shape[0], t.size)).copy()
         for k in range(d - 1, -1, -1):
             v *= t
             v += C[:, offs[i] + k, None]
         a.append(v)
+    return a
+
+
+def _np_test(a: list[np.ndarray], E: list[np.ndarray], eh: np.ndarray) -> np.ndarray:
     a0, a1, a2, a3, a4 = a
-    h3 = a3 * a2
-    h3 -= a4 * a1
-    h3 *= a1
-    h3 -= a3 * a3 * a0
-    return (a0 > 0) & (a1 > 0) & (a2 > 0) & (a3 > 0) & (a4 > 0) & (h3 > 0)
+    E0, E1, E2, E3, E4 = E
+    s = np.where(a4 > 0, 1.0, -1.0)
+    d0, d1, d2, d3 = s * a0, s * a1, s * a2, s * a3
+    h = d1 * (d3 * d2 - np.abs(a4) * d1) - d3 * d3 * d0
+    sg = np.abs(a4) > E4
+    st = sg & (d0 > E0) & (d1 > E1) & (d2 > E2) & (d3 > E3) & (h > eh)
+    ng = sg & ((d0 < -E0) | (d1 < -E1) | (d2 < -E2) | (d3 < -E3) | (h < -eh))
+    return np.where(st, 1, np.where(ng, 0, 2)).astype(np.uint8)
 
 
-def map_kernel(space: ParameterSpace, x: str, y: str, x_positive: bool = True, y_positive: bool = True
-               ) -> MapKernel | None:
-    """Build (or fetch) the compiled Hurwitz map kernel over axes ``x`` and ``y``.
+def _eh(A: list[np.ndarray], E: list[np.ndarray], a: list[np.ndarray] | None = None) -> np.ndarray:
+    """Error bound of ``s H3`` from bounds ``E_k`` and magnitudes ``A_k`` (``|a_k| <= A_k - E_k``)."""
+    A0, A1, A2, A3, A4 = A
+    E0, E1, E2, E3, E4 = E
+    v1, v3, v4 = (A1 - E1, A3 - E3, A4 - E4) if a is None else (np.abs(a[1]), np.abs(a[3]), np.abs(a[4]))
+    return (E1 * A3 * A2 + v1 * E3 * A2 + v1 * v3 * E2 + E4 * A1 * A1 + v4 * E1 * (A1 + v1)
+            + E3 * (A3 + v3) * A0 + v3 * v3 * E0 + 1.2e-15 * (A1 * A3 * A2 + A4 * A1 * A1 + A3 * A3 * A0)) * 1.0000001 \
+        + 1e-300
 
-    Returns ``None`` when the silent motion is not identically trivial on the
-    map (``mu1 h10 ≠ mu2 h20`` somewhere) or the dependence is not rational;
-    callers then fall back to numeric linearization / batched eigenvalues.
-    ``x_positive`` / ``y_positive`` state the signs of the axis ranges (used to
-    prove the sign of the common denominator).
+
+def classify_numpy(kernel: MapKernel | GridKernel, C: np.ndarray, EC: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """NumPy (no compiler) version of the compiled classifier on the same row tables (codes 0/1/2).
+
+    Same two passes: bounds per segment of :func:`kernel_segments`, then the
+    points left uncertain with their own bounds.
     """
-    return _map_kernel_cached(space, x, y, 1 if x_positive else -1, 1 if y_positive else -1)
+    degrees = kernel.degrees
+    t = np.asarray(t, dtype=float)
+    out = np.empty((C.shape[0], t.size), dtype=np.uint8)
+    seg, Tseg = kernel_segments(t)
+    with np.errstate(all="ignore"):
+        for q in range(seg.size - 1):
+            ts = t[seg[q]:seg[q + 1]]
+            E, B = _np_bounds(C, EC, degrees, float(Tseg[q]))
+            eh = _eh(B, E)
+            a0, a1, a2, a3, a4 = _np_values(C, degrees, ts)
+            s = np.copysign(1.0, a4)
+            for x in (a0, a1, a2, a3):
+                x *= s
+            np.abs(a4, out=a4)
+            h = a3 * a2
+            h -= a4 * a1
+            h *= a1
+            h -= a3 * a3 * a0
+            f = 1.0 - 4.5e-16  # fl(d r) > 1 implies d > E (see the compiled kernel)
+            m = h * (f / eh)
+            for x, e in zip((a0, a1, a2, a3), E[:4]):
+                np.minimum(m, x * (f / e), out=m)
+            sg = a4 > E[4]
+            out[:, seg[q]:seg[q + 1]] = 2 - (sg & (m > 1.0)) - 2 * (sg & (m < -1.0))
+        rr, cc = np.nonzero(out == 2)
+        if rr.size:
+            tt = t[cc]
+            Cp, ECp = C[rr], EC[rr]
+            offs = np.concatenate([[0], np.cumsum([d + 1 for d in degrees])])
+            a, E = [], []
+            for i, d in enumerate(degrees):
+                g = (2 * d + 4) * _U * 1.0001
+                v = Cp[:, offs[i] + d].copy()
+                e = ECp[:, offs[i] + d] + g * np.abs(Cp[:, offs[i] + d])
+                for k in range(d - 1, -1, -1):
+                    v = v * tt + Cp[:, offs[i] + k]
+                    e = e * np.abs(tt) + ECp[:, offs[i] + k] + g * np.abs(Cp[:, offs[i] + k])
+                a.append(v)
+                E.append(e * 1.0000000001 + 1e-300)
+            A = [np.abs(x) + e for x, e in zip(a, E)]
+            out[rr, cc] = _np_test(a, E, _eh(A, E, a))
+    return out
 
 
-# ---------------------------------------------------------------- real roots (compiled)
+# ---------------------------------------------------------------- real roots (compiled, floating point)
 def real_roots(coeffs: np.ndarray, lo: float, hi: float) -> np.ndarray:
-    """Real roots of the polynomial ``Σ coeffs[k] x^k`` in the open interval ``(lo, hi)``.
+    """Real roots of the polynomial ``Σ coeffs[k] x^k`` in the open interval ``(lo, hi)`` (floating point).
 
-    Exact isolation by the derivative cascade (the roots of ``p'`` split the
-    interval into monotone pieces), each root polished by safeguarded Newton
-    to about one ulp of the polynomial's evaluation.
+    Derivative cascade (the roots of ``p'`` split the interval into monotone
+    pieces), each root polished by safeguarded Newton.  Not certified; the
+    analysis routes use :func:`~.robust.isolate_real_roots` (exact) or the
+    certified compiled isolation.
     """
     from ._compiled import real_roots as _rr
 
@@ -349,43 +760,137 @@ def real_roots(coeffs: np.ndarray, lo: float, hi: float) -> np.ndarray:
     return out[:n].copy()
 
 
+# ---------------------------------------------------------------- bounded closed-form entries (generated)
+def _bounded_source(fname: str, slots: list[list[tuple[Any, dict[int, int]]]], doc: str) -> str:
+    """Numba source ``fname(P, V, R)``: ``V[n, s]`` = Σ terms of slot ``s``, ``R[n, s]`` its rounding bound."""
+    import sympy as sp
+
+    lines = [f'"""Generated by brakesqueal.analysis.kernels: {doc}. Do not edit."""', "import numba", "", "",
+             '@numba.njit(cache=True, error_model="numpy")', f"def {fname}(P, V, R):",
+             f'    """{doc}; R bounds the rounding error of V."""',
+             "    for n in range(P.shape[0]):", "        p = P[n]"]
+    lines.append("        " + ", ".join(f"x{i}" for i in range(17)) + " = "
+                 + ", ".join(f"p[{i}]" for i in range(17)))
+    for s, terms in enumerate(slots):
+        if not terms:
+            lines.append(f"        V[n, {s}] = 0.0")
+            lines.append(f"        R[n, {s}] = 0.0")
+            continue
+        lines.append("        v = 0.0")
+        lines.append("        a = 0.0")
+        kmax = 0
+        for c, powers in terms:
+            fac = [repr(float(sp.Float(c, 30)))]
+            ops = 1
+            for i, k in sorted(powers.items()):
+                if k > 0:
+                    fac.extend([f"x{i}"] * k)
+                ops += abs(k)
+            den = [f"x{i}" for i, k in sorted(powers.items()) for _ in range(-k)]
+            expr = " * ".join(fac)
+            if den:
+                expr = f"({expr}) / ({' * '.join(den)})"
+            kmax = max(kmax, ops)
+            lines.append(f"        t = {expr}")
+            lines.append("        v += t")
+            lines.append("        a += abs(t)")
+        g = (kmax + len(terms) + 4) * _U * 1.001
+        lines.append(f"        V[n, {s}] = v")
+        lines.append(f"        R[n, {s}] = {g!r} * a + 1e-300")
+    return "\n".join(lines) + "\n"
+
+
+def _terms(expr: Any, syms: list[Any]) -> list[tuple[Any, dict[int, int]]]:
+    """Expanded terms ``c Π syms^k`` of a Laurent polynomial in ``syms``."""
+    import sympy as sp
+
+    out = []
+    index = {s: i for i, s in enumerate(syms)}
+    for term in sp.Add.make_args(sp.expand(expr)):
+        if term == 0:
+            continue
+        c, rest = term.as_coeff_Mul()
+        powers: dict[int, int] = {}
+        for base, k in rest.as_powers_dict().items():
+            if base == 1:
+                continue
+            if base not in index or not sp.Integer(k).is_integer:
+                c = c * base ** k
+                continue
+            powers[index[base]] = powers.get(index[base], 0) + int(k)
+        if not c.is_number:
+            raise NotImplementedError(f"closed-form term {term} is not a Laurent monomial")
+        out.append((c, powers))
+    return out
+
+
+@lru_cache(maxsize=1)
+def _entries_generated() -> Any:
+    M, D, K, syms = _closed_form_compliance()
+    args = [syms[n] for n in VECTOR_NAMES]
+    slots = [_terms(X[i, j], args) for X in (M, D, K) for i in range(2) for j in range(2)]
+    return _load_generated(_bounded_source("entries_batch", slots, "Mbar, Dbar, Kbar entries (row-major)"),
+                           "entries")
+
+
+def trivial_entries(P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``Mbar, Dbar, Kbar`` (trivial silent motion, closed form) with rigorous rounding bounds.
+
+    Parameters
+    ----------
+    P : ndarray, shape (n, 17)
+        Parameter vectors in :data:`~.space.VECTOR_NAMES` order (compliances
+        ``c_ip = 1/k_ip``).
+
+    Returns
+    -------
+    E, R : ndarray, shape (n, 12)
+        Entries of ``M, D, K`` (row-major) and bounds on their rounding errors
+        (exact for the given parameter vector).
+    """
+    P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
+    E = np.empty((P.shape[0], 12))
+    R = np.empty((P.shape[0], 12))
+    with np.errstate(all="ignore"):
+        _entries_generated().entries_batch(P, E, R)
+    return E, R
+
+
 # ---------------------------------------------------------------- Omega: Laurent coefficients
 @lru_cache(maxsize=1)
 def _omega_generated() -> Any:
-    """Generate and compile ``entries(p) -> (12, 4)``: coefficients of ``Ω·entry`` in powers Ω^0..Ω^3."""
+    """Generate and compile ``entries_batch(P, V, R)``: coefficients of ``Ω·entry`` in powers Ω^0..Ω^3 with bounds."""
     import sympy as sp
 
     M, D, K, syms = _closed_form_compliance()
     W = syms["Omega"]
-    rows = []
+    args = [syms[n] for n in VECTOR_NAMES]
+    slots = []
     for m in (M, D, K):
         for i in range(2):
             for j in range(2):
-                e = sp.cancel(m[i, j] * W)
-                num, den = sp.fraction(e)
-                if W in den.free_symbols:
-                    raise NotImplementedError("closed form is not a Laurent polynomial in Omega")
-                p = sp.Poly(sp.expand(num), W)
-                if p.degree() > 3:
-                    raise NotImplementedError("closed form has powers of Omega above 2")
-                rows.append([sp.cancel(p.coeff_monomial(W ** k) / den) for k in range(4)])
-    flat = [e for row in rows for e in row]
-    args = [syms[n] for n in VECTOR_NAMES]
-    reps, reduced = sp.cse(flat)
-    lines = ['"""Generated by brakesqueal.analysis.kernels: Laurent coefficients in Omega. Do not edit."""',
-             "import numba", "import numpy as np", "", "",
-             '@numba.njit(cache=True, error_model="numpy")', "def entries_batch(P, OUT):",
-             '    """OUT[n, e, k]: coefficient of Omega^(k-1) in entry e of (Mbar, Dbar, Kbar) row-major."""',
-             "    for n in range(P.shape[0]):", "        p = P[n]", "        out = OUT[n]"]
-    lines.append("        " + ", ".join(str(a) for a in args) + (" = " + ", ".join(f"p[{i}]" for i in range(len(args)))))
-    pr = sp.printing.pycode
-    for s, v in reps:
-        lines.append(f"        {s} = {pr(v, fully_qualified_modules=False)}")
-    for idx, e in enumerate(reduced):
-        lines.append(f"        out[{idx // 4}, {idx % 4}] = {pr(e, fully_qualified_modules=False)}")
-    lines.append("")
-    source = "\n".join(lines).replace("math.", "np.") + "\n"
-    return _load_generated(source, "omega")
+                groups: list[list[tuple[Any, dict[int, int]]]] = [[], [], [], []]
+                iw = args.index(W)
+                for c, powers in _terms(m[i, j] * W, args):
+                    k = powers.pop(iw, 0)
+                    if not 0 <= k <= 3:
+                        raise NotImplementedError("closed form is not a Laurent polynomial in Omega of degree <= 2")
+                    groups[k].append((c, powers))
+                slots.extend(groups)
+    return _load_generated(_bounded_source("entries_batch", slots, "Laurent coefficients in Omega"), "omega")
+
+
+def omega_entries(P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Laurent coefficients in Ω of the 12 entries of ``Mbar, Dbar, Kbar``, with rounding bounds.
+
+    Returns ``E, R`` of shape ``(n, 12, 4)``: ``entry = Σ_k E[.., e, k] Ω^(k-1)``.
+    """
+    P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
+    V = np.empty((P.shape[0], 48))
+    R = np.empty((P.shape[0], 48))
+    with np.errstate(all="ignore"):
+        _omega_generated().entries_batch(P, V, R)
+    return V.reshape(-1, 12, 4), R.reshape(-1, 12, 4)
 
 
 def omega_coefficients(p: np.ndarray) -> np.ndarray:
@@ -394,14 +899,33 @@ def omega_coefficients(p: np.ndarray) -> np.ndarray:
     ``p`` is in :data:`~.space.VECTOR_NAMES` order (compliances); returns
     ``(12, 4)``: ``entry = Σ_k out[e, k] Ω^(k-1)``.
     """
-    out = np.zeros((1, 12, 4))
-    _omega_generated().entries_batch(np.ascontiguousarray(np.atleast_2d(p), dtype=float), out)
-    return out[0]
+    return omega_entries(np.atleast_2d(p))[0][0]
 
 
-def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossings: int = 8
-                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def omega_subranges(lo: float, hi: float, decades: float = 6.0) -> np.ndarray:
+    """Sub-range limits ``lo = b_0 < ... < b_J = hi`` with internal limits powers of two, ratio ≤ ~``10^decades``."""
+    if not (0 < lo < hi and math.isfinite(hi)):
+        from ..errors import ParameterError
+
+        raise ParameterError(f"the Omega range needs 0 < START < STOP (finite); got {lo!r}:{hi!r}")
+    step = max(1, int(decades * math.log2(10)))
+    e0, e1 = math.floor(math.log2(lo)) + 1, math.ceil(math.log2(hi)) - 1
+    inner = [2.0 ** e for e in range(e0 + step // 2, e1, step)] if e1 - e0 > step else []
+    pts = [lo] + [b for b in inner if lo < b < hi] + [hi]
+    return np.array(pts, dtype=float)
+
+
+def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossings: int = 8, *,
+                          return_status: bool = False) -> tuple[np.ndarray, ...]:
     """All stability changes along Ω in ``(lo, hi)`` for many parameter vectors (trivial silent motion).
+
+    Each set is first handled by the certified compiled kernel
+    (:func:`~._compiled.critical_batch`); sets it cannot certify (roots
+    closer than 2^-40 relative, a root at ``lo``/``hi``, overflow) are
+    recomputed by exact rational root isolation
+    (:func:`~.crossings.exact_omega_crossings`).  The result is complete: every
+    stability change in ``(lo, hi)`` is reported (up to ``max_crossings``
+    columns; ``counts`` holds the true number).
 
     Parameters
     ----------
@@ -409,7 +933,11 @@ def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossing
         Parameter vectors in :data:`~.space.VECTOR_NAMES` order (Ω ignored);
         every row must satisfy ``mu1 h10 = mu2 h20``.
     lo, hi : float
-        The Ω range [rad/s], ``0 < lo < hi``.
+        The Ω range [rad/s], ``0 < lo < hi``; any width (split internally).
+    max_crossings : int
+        Columns of the outputs.
+    return_status : bool
+        Also return the per-set status (0 complete, 5 undecided somewhere in the range).
 
     Returns
     -------
@@ -421,40 +949,34 @@ def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossing
         Number of crossings found (may exceed ``max_crossings``).
     stable_at_start : ndarray (n,) bool
         Verdict just above ``lo``.
+    status : ndarray (n,) int8, only with ``return_status``
+        0 if the result is complete, 5 if a part of the range stayed undecided.
     """
+    from ._compiled import critical_batch
+
     P = np.ascontiguousarray(np.atleast_2d(params), dtype=float)
     n = P.shape[0]
+    bounds = omega_subranges(float(lo), float(hi))
     roots = np.full((n, max_crossings), np.nan)
     dirs = np.zeros((n, max_crossings), dtype=np.int8)
     counts = np.zeros(n, dtype=np.int64)
     start = np.zeros(n, dtype=np.bool_)
-    from ._compiled import critical_batch
+    flags = np.zeros(n, dtype=np.uint8)
+    status = np.zeros(n, dtype=np.int8)
+    E, R = omega_entries(P)
+    critical_batch(E, R, bounds, roots, dirs, counts, start, flags)
+    for i in np.flatnonzero(flags):
+        from .crossings import exact_omega_crossings
 
-    E = np.zeros((n, 12, 4))
-    _omega_generated().entries_batch(P, E)
-    critical_batch(E, float(lo), float(hi), roots, dirs, counts, start)
+        st, found, undecided = exact_omega_crossings(P[i], float(lo), float(hi))
+        roots[i] = np.nan
+        dirs[i] = 0
+        for k, (v, d) in enumerate(found[:max_crossings]):
+            roots[i, k] = v
+            dirs[i, k] = 1 if d == "stabilizing" else -1
+        counts[i] = len(found)
+        start[i] = bool(st)
+        status[i] = 5 if undecided else 0
+    if return_status:
+        return roots, dirs, counts, start, status
     return roots, dirs, counts, start
-
-
-# ---------------------------------------------------------------- one arbitrary axis
-def path_polynomials(space: ParameterSpace, name: str, positive: bool = True
-                     ) -> tuple[list[np.ndarray], bool] | None:
-    """Numerator polynomials of ``a0..a4`` in one axis (ascending float coefficients).
-
-    Returns ``(polys, trivial)`` or ``None`` when the dependence is not rational
-    or the silent motion is not identically trivial along the axis.
-    """
-    import sympy as sp
-
-    X = sp.Symbol("X", real=True)
-    M, D, K, moment = _specialise(space, {name: X})
-    if not _identically_zero(moment):
-        return None
-    nums = _numerators(M, D, K, {X: 1 if positive else -1})
-    if nums is None:
-        return None
-    polys = []
-    for a in nums:
-        p = sp.Poly(a, X)
-        polys.append(np.array([float(p.coeff_monomial(X ** k)) for k in range(p.degree() + 1)]))
-    return polys, True

@@ -1,14 +1,18 @@
 """Stability maps, crossings and critical speeds of built models (batched eigenvalues).
 
 Built models have no closed-form quartic, so the verdict comes from the
-eigenvalues of the ``2n × 2n`` state matrix.  Where the zero state is the
-silent motion (checked point by point from the residuals), ``M, D, K`` are
-evaluated for a whole batch at once with the generated code bound to NumPy,
-and the eigenvalues are computed batched; other points use
-:func:`~.numeric.linearize_model` one by one.  Crossings along a path are
-bracketed on a grid of the largest real part and refined with Brent's method
-(``xtol`` 1e-12 relative): unlike the 2-DOF Hurwitz route this is not an exact
-root isolation, so two crossings closer than the grid spacing can be missed.
+eigenvalues of the ``2n × 2n`` state matrix with a condition-number error
+bound (:func:`~brakesqueal.analysis.robust.matrix_verdicts`: certified Routh
+on the interval quartic for ``n = 2``, eigenvalues for any ``n``); points it
+cannot decide get status 5 (undecided) and are never stable.  Where the zero
+state is the silent motion (checked point by point from the residuals),
+``M, D, K`` are evaluated for a whole batch at once with the generated code
+bound to NumPy; other points use :func:`~.numeric.linearize_model` one by one.
+Crossings along a path are bracketed on a grid of the certified verdict and
+refined with Brent's method on the largest real part (``xtol`` 1e-12
+relative): unlike the 2-DOF Hurwitz route this is not an exact root
+isolation, so two crossings closer than the grid spacing can be missed
+(results carry ``exhaustive=False``).
 """
 
 from __future__ import annotations
@@ -28,7 +32,7 @@ from .numeric import compile_model, linearize_model, model_values
 __all__ = ["ModelSpace", "model_stability_map", "model_crossings", "model_critical_speeds"]
 
 # status codes shared with brakesqueal.results.StabilityMap
-OK, NONTRIVIAL, NO_SILENT, CONTACT_LOSS, INVALID = 0, 1, 2, 3, 4
+OK, NONTRIVIAL, NO_SILENT, CONTACT_LOSS, INVALID, UNDECIDED_STATUS = 0, 1, 2, 3, 4, 5
 
 
 @dataclass
@@ -112,7 +116,9 @@ def _matrices_at_zero(space: ModelSpace, cm: Any, vec: Any, p: list[Any], size: 
 
 
 def _batch(space: ModelSpace, grid: Mapping[str, np.ndarray], shape: tuple[int, ...]) -> dict[str, np.ndarray]:
-    """max_real, frequency, status for every point of a grid given as broadcastable arrays."""
+    """Certified ``stable``, ``max_real``, ``frequency``, ``status`` for every point of a grid (broadcastable arrays)."""
+    from ..analysis.robust import STABLE, UNDECIDED, matrix_verdicts
+
     spec = space.spec
     cm = compile_model(spec)
     vec = _vectorized(cm)
@@ -123,30 +129,28 @@ def _batch(space: ModelSpace, grid: Mapping[str, np.ndarray], shape: tuple[int, 
     p = _params(space, cm, flat, size)
     M, D, K, res, scale = _matrices_at_zero(space, cm, vec, p, size)
     trivial = np.all(np.abs(res) <= 1e-12 * scale, axis=1) & (status == OK)
-    n = cm.n
     vals = flat
     max_real = np.full(size, np.nan)
     freq = np.full(size, np.nan)
+    stable = np.zeros(size, bool)
     idx = np.flatnonzero(trivial)
     if idx.size:
-        Minv = np.linalg.inv(M[idx])
-        A = np.zeros((idx.size, 2 * n, 2 * n))
-        A[:, :n, n:] = np.eye(n)
-        A[:, n:, :n] = -Minv @ K[idx]
-        A[:, n:, n:] = -Minv @ D[idx]
-        lam = np.linalg.eigvals(A)
-        k = np.argmax(lam.real, axis=1)
-        sel = lam[np.arange(idx.size), k]
-        max_real[idx], freq[idx] = sel.real, np.abs(sel.imag) / (2 * np.pi)
+        codes, mr, fr = matrix_verdicts(M[idx], D[idx], K[idx])
+        max_real[idx], freq[idx] = mr, fr
+        stable[idx] = codes == STABLE
+        status[idx[codes == UNDECIDED]] = UNDECIDED_STATUS
     for i in np.flatnonzero(~trivial & (status == OK)):
         try:
             lm = linearize_model(spec, {**space.overrides, **{k: float(vals[k][i]) for k in grid}})
         except SilentMotionError as exc:
             status[i] = CONTACT_LOSS if "loses contact" in str(exc) else NO_SILENT
             continue
-        z = lm.eigenvalues[0]
-        max_real[i], freq[i], status[i] = z.real, abs(z.imag) / (2 * np.pi), NONTRIVIAL
-    return {"max_real": max_real.reshape(shape), "frequency": freq.reshape(shape), "status": status.reshape(shape)}
+        c, mr, fr = matrix_verdicts(lm.M, lm.D, lm.K)
+        max_real[i], freq[i] = mr[0], fr[0]
+        stable[i] = c[0] == STABLE
+        status[i] = UNDECIDED_STATUS if c[0] == UNDECIDED else NONTRIVIAL
+    return {"max_real": max_real.reshape(shape), "frequency": freq.reshape(shape), "status": status.reshape(shape),
+            "stable": stable.reshape(shape)}
 
 
 def model_stability_map(space: ModelSpace, x: Any, y: Any, *, eigen: bool = True, chunk_points: int = 20000,
@@ -161,10 +165,13 @@ def model_stability_map(space: ModelSpace, x: Any, y: Any, *, eigen: bool = True
         Horizontal (inner) and vertical (outer) axes, each a parameter of the model.
     eigen : bool
         ``True``: batched eigenvalues give ``max_real`` and ``frequency`` too.
-        ``False``: only the verdict, from the eigenvalue-free Routh classification of
-        :mod:`.fastmap` where the silent motion is trivial (``max_real`` and
-        ``frequency`` are NaN there); falls back to eigenvalues when the
-        characteristic polynomial has no low-degree structure in the axes.
+        ``False``: only the verdict, from the eigenvalue-free certified Routh
+        classification of :mod:`.fastmap` where the silent motion is trivial
+        (``max_real`` and ``frequency`` are NaN there; points it cannot certify
+        use eigenvalues); falls back to eigenvalues everywhere when the
+        characteristic polynomial has no low-degree structure in the axes or
+        the Routh test cannot decide most points of a probe grid (lightly
+        damped models with more than two DOF).
     chunk_points : int
         Points per batch of the eigenvalue path.
     progress : callable, optional
@@ -173,7 +180,9 @@ def model_stability_map(space: ModelSpace, x: Any, y: Any, *, eigen: bool = True
     Returns
     -------
     brakesqueal.results.StabilityMap
-        Dimensions ``(y.name, x.name)``; points that are not ``status == 0/1`` are never stable.
+        Dimensions ``(y.name, x.name)``; points that are not ``status == 0/1``
+        are never stable (5: undecided); for status 0/1 with eigenvalues,
+        ``stable`` ⇔ ``max_real < 0``.
     """
     from ..results import StabilityMap
 
@@ -185,10 +194,10 @@ def model_stability_map(space: ModelSpace, x: Any, y: Any, *, eigen: bool = True
            "status": np.zeros(shape, np.int8)}  # fmt: skip
     stable = np.zeros(shape, bool)
     fast = None if eigen else _fast_classify(space, x, y, xs, ys)
-    method = "batched eigenvalues (built model)"
+    method = "batched eigenvalues with condition-number bounds (built model)"
     if fast is not None:
         stable, todo = fast
-        method = "Routh test on the interpolated characteristic polynomial (built model)"
+        method = "certified Routh test on the interpolated characteristic polynomial (built model)"
     else:
         todo = np.ones(shape, bool)
     rows = max(1, chunk_points // xs.size)
@@ -200,15 +209,15 @@ def model_stability_map(space: ModelSpace, x: Any, y: Any, *, eigen: bool = True
             mask = todo[sl]
             for k in out:
                 out[k][sl][mask] = r[k][mask]
-            stable[sl][mask] = (r["max_real"][mask] < 0) & (r["status"][mask] <= NONTRIVIAL)
+            stable[sl][mask] = r["stable"][mask] & (r["status"][mask] <= NONTRIVIAL)
         if progress:
             progress(min(1.0, (j0 + rows) / ys.size))
     if fast is not None:
         out["status"][~todo] = OK
     sm = StabilityMap.from_arrays(space, y, x, stable=stable, status=out["status"], max_real=out["max_real"],
                                   frequency=out["frequency"], method=method)  # fmt: skip
-    sm.data.attrs["criterion"] = ("Routh test of det(lambda^2 M + lambda D + K)" if fast is not None
-                                  else "largest real part of the eigenvalues of the state matrix")  # fmt: skip
+    sm.data.attrs["criterion"] = ("certified Routh test of det(lambda^2 M + lambda D + K)" if fast is not None
+                                  else "eigenvalues of the state matrix with condition-number error bounds")  # fmt: skip
     sm.data.attrs["model"] = json.dumps(space.spec.name)
     return sm
 
@@ -238,17 +247,26 @@ def _fast_classify(space: ModelSpace, x: Any, y: Any, xs: np.ndarray, ys: np.nda
         M, D, K, _, _ = _matrices_at_zero(space, cm, vec, pp, xv.size)
         return M, D, K
 
-    verdict = fastmap.classify(mats, xs, ys, x_log=x.log, y_log=y.log)
-    if verdict is None:
+    # probe: the certified Routh test of a degree-2n polynomial loses about (n - 1) log10(|λ| / |Re λ|)
+    # digits for lightly damped modes (Orlando's formula); if it cannot decide most points, use eigenvalues
+    px, py = xs[:: max(1, xs.size // 12)], ys[:: max(1, ys.size // 12)]
+    probe = fastmap.classify(mats, px, py, x_log=x.log, y_log=y.log)
+    if probe is None or np.mean(probe == 2) > 0.25:
         return None
-    return verdict & ~todo, todo
+    codes = fastmap.classify(mats, xs, ys, x_log=x.log, y_log=y.log)
+    if codes is None:
+        return None
+    todo |= codes == 2
+    return (codes == 1) & ~todo, todo
 
 
-def _max_real_along(space: ModelSpace, name: str, values: np.ndarray) -> np.ndarray:
+def _verdicts_along(space: ModelSpace, name: str, values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(max_real, stable, decided)`` along a path (NaN / undecided where no silent motion or no verdict)."""
     r = _batch(space, {name: values}, values.shape)
     mr = r["max_real"].copy()
-    mr[r["status"] > NONTRIVIAL] = np.nan
-    return mr
+    mr[np.isin(r["status"], (NO_SILENT, CONTACT_LOSS, INVALID))] = np.nan
+    ok = r["status"] <= NONTRIVIAL
+    return mr, r["stable"] & ok, ok
 
 
 def _path_crossings(space: ModelSpace, name: str, lo: float, hi: float, log: bool, samples: int,
@@ -259,18 +277,36 @@ def _path_crossings(space: ModelSpace, name: str, lo: float, hi: float, log: boo
     if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo) or (log and lo <= 0):
         raise ParameterError(f"path '{name}': need 0 < START < STOP for a log path, START < STOP otherwise")
     grid = np.geomspace(lo, hi, samples) if log else np.linspace(lo, hi, samples)
-    mr = _max_real_along(space, name, grid)
-    if np.isnan(mr).any():
-        bad = grid[np.isnan(mr)][0]
+    r = _batch(space, {name: grid}, grid.shape)
+    ok = r["status"] <= NONTRIVIAL
+    mr = r["max_real"]
+    st = r["stable"] & ok
+    if np.any(np.isin(r["status"], (NO_SILENT, CONTACT_LOSS, INVALID))):
+        bad = grid[np.isin(r["status"], (NO_SILENT, CONTACT_LOSS, INVALID))][0]
         raise SilentMotionError(f"no valid silent motion at {name} = {bad:g} on the path")
-    f = lambda v: float(_max_real_along(space, name, np.array([v]))[0])  # noqa: E731
+    f = lambda v: float(_verdicts_along(space, name, np.array([v]))[0][0])  # noqa: E731
     found = []
-    for a, b, fa, fb in zip(grid[:-1], grid[1:], mr[:-1], mr[1:]):
-        if (fa < 0) != (fb < 0):
+    undecided = []
+    for k in range(samples):
+        if not ok[k]:
+            undecided.append((float(grid[max(k - 1, 0)]), float(grid[min(k + 1, samples - 1)])))
+    for k in range(samples - 1):
+        a, b = grid[k], grid[k + 1]
+        if not (ok[k] and ok[k + 1]) or st[k] == st[k + 1]:
+            continue
+        root = a
+        if mr[k] * mr[k + 1] < 0:
             root = brentq(f, a, b, xtol=1e-14 * abs(b), rtol=1e-12)
-            found.append((float(root), "destabilizing" if fa < 0 else "stabilizing"))
-    method = f"grid bracketing ({samples} points) + Brent on max Re(lambda), built model"
-    return cls(name, lo, hi, log, bool(mr[0] < 0), tuple(found), method)
+        found.append((float(root), "destabilizing" if st[k] else "stabilizing"))
+    merged: list[tuple[float, float]] = []
+    for a, b in undecided:
+        if merged and a <= merged[-1][1]:
+            merged[-1] = (merged[-1][0], max(merged[-1][1], b))
+        else:
+            merged.append((a, b))
+    method = f"grid bracketing ({samples} points, certified verdicts) + Brent on max Re(lambda), built model"
+    return cls(name, lo, hi, log, bool(st[0]), tuple(found), method, undecided_ranges=tuple(merged),
+               exhaustive=False)
 
 
 def model_crossings(space: ModelSpace, axis: Any, *, samples: int = 400) -> Any:

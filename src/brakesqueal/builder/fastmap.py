@@ -7,23 +7,25 @@ parameter or its reciprocal (the matrix entries are polynomial in masses,
 stiffnesses and friction coefficients, and in compliances ``1/k_ip`` and
 ``1/Omega``).  The degrees are detected numerically; the coefficients are
 sampled on a small Chebyshev tensor grid (eigenvalues of the state matrix,
-``numpy.poly``), interpolated, and evaluated per point by a compiled kernel
-that applies the Routh test (all first-column entries of the Routh array
-positive ⇔ every root in the open left half-plane).  Points then cost a few
-hundred floating-point operations instead of a ``2n × 2n`` eigenvalue solve.
+``numpy.poly``), interpolated, and evaluated per point; the verdict is the
+*certified* Routh test of :func:`~brakesqueal.analysis.robust.routh_verdicts`
+with coefficient error radii estimated from the interpolation: the
+interpolant is compared with directly computed coefficients at validation
+points, and the radius is 100 times the largest deviation plus a floor.
+Points whose verdict cannot be certified within these radii are returned as
+"to do" and computed with the eigenvalue route (with its own error bound).
 
-The verdict is exact up to rounding; near the stability boundary it can differ
-from the eigenvalue route, whose own verdict there is decided by rounding too
-(see the tests for the agreement margin).  When no polynomial structure is found
-(degree > ``MAX_DEGREE``), :func:`classify` returns ``None`` and callers use
-batched eigenvalues.
+When no polynomial structure is found (degree > ``MAX_DEGREE``),
+:func:`classify` returns ``None`` and callers use batched eigenvalues.
 """
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
+
+from ..analysis.robust import routh_verdicts
 
 __all__ = ["classify", "MAX_DEGREE"]
 
@@ -64,78 +66,12 @@ def _degree(f: Callable[[np.ndarray], np.ndarray]) -> int | None:
     return None
 
 
-def _routh_kernel() -> Any:
-    import numba
-
-    from ..numeric.cache import guard_numba_caches
-
-    @numba.njit(cache=True, fastmath=False)
-    def routh(B: np.ndarray, T: np.ndarray, out: np.ndarray) -> None:  # pragma: no cover - compiled
-        # B[j, l]: Chebyshev coefficients (in t_x) of coefficient j (highest power first); T[i, l]: T_l(u_i)
-        npts, dx1 = T.shape
-        m = B.shape[0]
-        a = np.empty(m)
-        r0 = np.empty(m)
-        r1 = np.empty(m)
-        for i in range(npts):
-            for j in range(m):
-                s = 0.0
-                for l in range(dx1):
-                    s += B[j, l] * T[i, l]
-                a[j] = s
-            if a[0] < 0:
-                for j in range(m):
-                    a[j] = -a[j]
-            ok = a[0] > 0
-            # Routh array rows: r0 = a0 a2 a4 ..., r1 = a1 a3 a5 ...
-            n0 = (m + 1) // 2
-            n1 = m // 2
-            for k in range(n0):
-                r0[k] = a[2 * k]
-            for k in range(n1):
-                r1[k] = a[2 * k + 1]
-            for k in range(n1, m):
-                r1[k] = 0.0
-            for k in range(n0, m):
-                r0[k] = 0.0
-            rows = m - 1
-            for _ in range(rows):
-                if not ok:
-                    break
-                p = r1[0]
-                if not p > 0:
-                    ok = False
-                    break
-                q = r0[0]
-                for k in range(m - 1):
-                    r0[k] = r0[k + 1] - q / p * r1[k + 1]
-                r0[m - 1] = 0.0
-                for k in range(m):
-                    t = r0[k]
-                    r0[k] = r1[k]
-                    r1[k] = t
-                # norm the new row to avoid over/underflow
-                big = 0.0
-                for k in range(m):
-                    if abs(r1[k]) > big:
-                        big = abs(r1[k])
-                if big > 0:
-                    for k in range(m):
-                        r1[k] /= big
-                if r1[0] == 0.0 and big == 0.0:
-                    break
-            out[i] = ok
-
-    guard_numba_caches([routh])  # a damaged numba cache file is recompiled, never an error
-    return routh
-
-
-_ROUTH: list[Any] = []
-
-
 def classify(mats: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
              xv: np.ndarray, yv: np.ndarray, *, x_log: bool, y_log: bool) -> np.ndarray | None:
-    """Stable/unstable verdicts on the grid ``yv × xv`` (shape ``(len(yv), len(xv))``), or ``None``.
+    """Certified verdict codes on the grid ``yv × xv`` (shape ``(len(yv), len(xv))``), or ``None``.
+
+    Codes: 0 unstable, 1 stable, 2 uncertain within the estimated coefficient
+    errors (callers compute those points with eigenvalues).
 
     Parameters
     ----------
@@ -149,7 +85,7 @@ def classify(mats: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarr
 
     Returns
     -------
-    ndarray of bool, or None
+    ndarray of uint8, or None
         ``None`` when the coefficients are not polynomial of degree ≤ :data:`MAX_DEGREE`
         in the parameter or its reciprocal.
     """
@@ -196,13 +132,32 @@ def classify(mats: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarr
     vals = C.reshape(dy + 1, dx + 1, m)
     # Chebyshev coefficients G[j, ly, lx] with vals[iy, ix, j] = sum Vy[iy, ly] Vx[ix, lx] G[j, ly, lx]
     G = np.einsum("ab,bcj,dc->jad", np.linalg.inv(Vy), vals, np.linalg.inv(Vx))
-    if not _ROUTH:
-        _ROUTH.append(_routh_kernel())
-    routh = _ROUTH[0]
+    radius = _interpolation_radius(mats, G, fx, fy, dx, dy, scale)
     Tx = np.polynomial.chebyshev.chebvander(ix(xv), dx)
     Ty = np.polynomial.chebyshev.chebvander(iy(yv), dy)
-    out = np.empty((yv.size, xv.size), dtype=np.bool_)
+    out = np.empty((yv.size, xv.size), dtype=np.uint8)
     for r in range(yv.size):
-        B = np.ascontiguousarray(np.einsum("jab,a->jb", G, Ty[r]))
-        routh(B, Tx, out[r])
+        B = np.einsum("jab,a->jb", G, Ty[r])  # (m, dx+1)
+        coef = (Tx @ B.T)[:, ::-1]  # ascending in μ
+        out[r] = routh_verdicts(coef, np.broadcast_to(radius[::-1], coef.shape))
     return out
+
+
+def _interpolation_radius(mats: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]],
+                          G: np.ndarray, fx: Callable[[np.ndarray], np.ndarray], fy: Callable[[np.ndarray], np.ndarray],
+                          dx: int, dy: int, scale: float, n: int = 24) -> np.ndarray:
+    """Estimated absolute error of every interpolated coefficient (highest power first).
+
+    Deviation of the interpolant from directly computed coefficients at
+    ``n`` pseudo-random validation points of ``[-1, 1]²``, times 100, plus
+    ``1e-12`` of the coefficient's largest magnitude (the direct values come
+    from eigenvalues and carry their own rounding).
+    """
+    u = np.random.default_rng(12345).uniform(-1, 1, (2, n))
+    direct = _charpoly(mats, fx(u[0]), fy(u[1]), scale)
+    Tx = np.polynomial.chebyshev.chebvander(u[0], dx)
+    Ty = np.polynomial.chebyshev.chebvander(u[1], dy)
+    interp = np.einsum("jab,na,nb->nj", G, Ty, Tx)
+    dev = np.max(np.abs(interp - direct), axis=0)
+    mag = np.max(np.abs(direct), axis=0)
+    return 100.0 * dev + 1e-12 * np.max(mag) + 1e-13 * mag

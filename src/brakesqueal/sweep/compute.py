@@ -1,39 +1,43 @@
 """Per-chunk computation of a study (runs in the client or on Dask workers).
 
-Everything here reuses the stability kernels of :mod:`brakesqueal.analysis`:
+Everything here reuses the certified stability routes of :mod:`brakesqueal.analysis`:
 
-* **Verdict on grids** — the generated Hurwitz classifier of
-  :mod:`~brakesqueal.analysis.kernels` (same source, same numba cache as
-  ``stability_map``).  For an N-D grid the closed form is specialised once with
-  *all* grid axes symbolic (:func:`~brakesqueal.analysis.kernels._specialise`,
-  ``_numerators``); the quartic's coefficients become polynomials in one
-  *inner* axis whose coefficients depend on the other axes, evaluated per row
-  with NumPy and normalised exactly like ``MapKernel.row_coefficients``.  With
-  two axes this is the map kernel.
-* **Samples, or grids without a closed-form kernel** — closed-form matrices per
-  point (``compiled_model().trivial_matrices``) + :func:`quartic_coefficients`
-  + :func:`hurwitz_stable`.
-* ``margin``, ``max_real``, ``frequency`` — roots of the quartic (batched
-  companion eigenvalues, ``analysis.maps._roots_summary``), in sub-batches.
-* ``critical_speed`` — :func:`~brakesqueal.analysis.kernels.critical_speeds_batch`.
+* **Verdict on grids** — the generated certified Hurwitz classifier of
+  :mod:`~brakesqueal.analysis.kernels` (:func:`~brakesqueal.analysis.kernels.grid_kernel`,
+  same source and numba cache as ``stability_map``): the closed form is
+  specialised once with *all* grid axes symbolic, the exact numerators of the
+  quartic's coefficients are polynomials in one *inner* axis whose
+  coefficients depend on the other axes; rows are evaluated in
+  exponent-scaled floating point with error bounds, and every point is
+  classified stable / unstable / uncertain.  With two axes this is the map kernel.
+* **Uncertain points, samples, or grids without a kernel** — the per-point
+  robust route :func:`~brakesqueal.analysis.robust.trivial_verdicts`
+  (bounded closed-form matrices → interval quartic → certified Routh → exact
+  rational evaluation).
+* ``margin``, ``max_real``, ``frequency`` — roots of the quartic, reconciled
+  with the verdict (a stable point has ``max_real < 0``, an unstable one
+  ``max_real >= 0``).
+* ``critical_speed`` — :func:`~brakesqueal.analysis.kernels.critical_speeds_batch`
+  (certified compiled kernel, exact fallback); a point whose critical speed
+  could not be established gets status 5.
 * Points with a non-trivial silent motion use the numeric linearization
-  (``analysis.maps._numeric_point``); invalid parameters, no silent motion and
-  contact loss are flagged in ``status`` (codes of ``analysis.maps.STATUS``)
-  and never marked stable.
+  (:func:`~brakesqueal.analysis.maps.numeric_point_verdict`); invalid
+  parameters, no silent motion, contact loss and undecided verdicts are
+  flagged in ``status`` (codes of ``analysis.maps.STATUS``) and never marked stable.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
 import numpy as np
 
-from ..analysis.kernels import critical_speeds_batch, hurwitz_stable, normalise_rows, quartic_coefficients
-from ..analysis.maps import _numeric_point, _roots_summary, _trivial
+from ..analysis.kernels import critical_speeds_batch, grid_kernel, kernel_segments
+from ..analysis.maps import _kernel_usable, _trivial, numeric_point_verdict, point_verdicts
+from ..analysis.robust import STABLE, STATUS_UNDECIDED, UNDECIDED
 from ..analysis.space import VECTOR_NAMES, ParameterSpace
 from ..parameters import _BOUNDS, PARAMETER_NAMES, Value
 
@@ -57,8 +61,9 @@ class ChunkSpec:
 
     ``names`` are the grid dimensions (grid) or the sampled names (samples);
     ``refs`` and ``signs`` are per grid axis: the scale magnitude of the whole
-    axis and the sign of all its values (0 = mixed), so that a chunk's result
-    does not depend on how the study is chunked.
+    axis and the sign of all its values (0 = mixed).  They are kept for
+    provenance only: no verdict depends on them (the kernels scale every
+    chunk exactly and take signs per point).
     """
 
     key: str
@@ -142,7 +147,7 @@ def _model_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, np
         grid = {n: np.asarray(coords[n], dtype=float) for n in spec.names}
     r = _batch(space, grid, shape)
     mr, fr = r["max_real"], r["frequency"]
-    out: dict[str, np.ndarray] = {"stable": (mr < 0) & (r["status"] <= NONTRIVIAL), "status": r["status"]}
+    out: dict[str, np.ndarray] = {"stable": r["stable"] & (r["status"] <= NONTRIVIAL), "status": r["status"]}
     with np.errstate(all="ignore"):
         s = {"max_real": mr, "frequency": fr, "margin": -mr / np.hypot(mr, 2 * np.pi * fr)}
     for q in FLOAT_QUANTITIES:
@@ -151,56 +156,6 @@ def _model_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, np
             a[np.isnan(a)] = np.nan
             out[q] = a
     return out
-
-
-# ---------------------------------------------------------------- N-D grid kernel
-@dataclass(frozen=True)
-class GridKernel:
-    """Compiled Hurwitz classifier over the grid axes (``inner`` = index of the contiguous axis)."""
-
-    inner: int
-    degrees: tuple[int, ...]
-    rows: Callable[..., list[Any]]
-    classify: Callable[..., None]
-
-    def row_coefficients(self, outer: list[np.ndarray], n_rows: int, inner_ref: float) -> np.ndarray:
-        """Per-row coefficient table, scaled and normalised as ``MapKernel.row_coefficients``."""
-        cols = [np.broadcast_to(np.asarray(c, dtype=float), (n_rows,)) for c in self.rows(*outer)]
-        return normalise_rows(np.stack(cols, axis=1), self.degrees, inner_ref)[0]
-
-
-@lru_cache(maxsize=8)
-def grid_kernel(space: ParameterSpace, names: tuple[str, ...], signs: tuple[int, ...]) -> GridKernel | None:
-    """Build the classifier for a grid over ``names``; ``None`` if no closed-form kernel applies.
-
-    That is the case when the silent motion is not identically trivial on the
-    grid, the dependence is not rational, or an axis has values of both signs.
-    """
-    import sympy as sp
-
-    from ..analysis.kernels import _identically_zero, _kernel_source, _load_generated, _numerators, _specialise
-
-    if 0 in signs:
-        return None
-    syms = [sp.Symbol(f"X{i}", real=True) for i in range(len(names))]
-    M, D, K, moment = _specialise(space, dict(zip(names, syms)))
-    if not _identically_zero(moment):
-        return None
-    nums = _numerators(M, D, K, dict(zip(syms, signs)))
-    if nums is None:
-        return None
-    polys = [sp.Poly(a, *syms) if a != 0 else None for a in nums]
-    degs = [tuple(p.degree(s) if p is not None else 0 for p in polys) for s in syms]
-    totals = [sum(d) for d in degs]
-    inner = max(i for i in range(len(syms)) if totals[i] == min(totals))  # ties: the trailing axis
-    I, others = syms[inner], [s for i, s in enumerate(syms) if i != inner]
-    exprs = []
-    for a, d in zip(nums, degs[inner]):
-        p = sp.Poly(a, I)
-        exprs.extend(p.coeff_monomial(I ** k) if k else p.coeff_monomial(1) for k in range(d + 1))
-    rows = sp.lambdify(others, exprs, modules="numpy")
-    mod = _load_generated(_kernel_source(degs[inner]), "map")
-    return GridKernel(inner=inner, degrees=degs[inner], rows=rows, classify=mod.classify)
 
 
 # ---------------------------------------------------------------- masks
@@ -222,14 +177,15 @@ def _valid(arr: dict[str, np.ndarray]) -> np.ndarray:
         c = np.asarray(c)
         parts[c.shape] = parts[c.shape] & c if c.shape in parts else c
 
-    for name, vname in zip(PARAMETER_NAMES, VECTOR_NAMES):
-        v = arr[vname]
-        if vname != name:
-            add((v >= 0) & np.isfinite(v))
-            continue
-        low, high, low_open, high_open = _BOUNDS[name]
-        add((v > low if low_open else v >= low) & (v < high if high_open else v <= high))
-    add(arr["h10"] + arr["h20"] > 0)
+    with np.errstate(all="ignore"):
+        for name, vname in zip(PARAMETER_NAMES, VECTOR_NAMES):
+            v = arr[vname]
+            if vname != name:
+                add((v >= 0) & np.isfinite(v))
+                continue
+            low, high, low_open, high_open = _BOUNDS[name]
+            add((v > low if low_open else v >= low) & (v < high if high_open else v <= high))
+        add(arr["h10"] + arr["h20"] > 0)
     if all(bool(np.all(c)) for c in parts.values()):
         return np.ones((1,) * max(len(k) for k in parts), dtype=bool)
     ok: Any = np.True_
@@ -239,37 +195,45 @@ def _valid(arr: dict[str, np.ndarray]) -> np.ndarray:
 
 
 # ---------------------------------------------------------------- per-point quantities
-def _points(arr: dict[str, np.ndarray], shape: tuple[int, ...], flat: np.ndarray) -> list[np.ndarray]:
+def _points(arr: dict[str, np.ndarray], shape: tuple[int, ...], flat: np.ndarray) -> np.ndarray:
     ix = np.unravel_index(flat, shape)
-    return [np.broadcast_to(arr[n], shape)[ix] for n in VECTOR_NAMES]
+    return np.stack([np.broadcast_to(arr[n], shape)[ix] for n in VECTOR_NAMES], axis=1)
 
 
-def _quartic(p: list[np.ndarray]) -> tuple[np.ndarray, ...]:
-    from ..numeric.compiled import compiled_model
-
-    n = p[0].size
-    with np.errstate(all="ignore"):
-        ent = [np.broadcast_to(np.asarray(e, dtype=float), (n,)) for e in compiled_model().trivial_matrices(p)]
-    M = np.stack(ent[0:4], -1).reshape(n, 2, 2)
-    D = np.stack(ent[4:8], -1).reshape(n, 2, 2)
-    K = np.stack(ent[8:12], -1).reshape(n, 2, 2)
-    return quartic_coefficients(M, D, K)
-
-
-def _summary(coef: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
-    mr, fr = _roots_summary(coef)
+def _summary(mr: np.ndarray, fr: np.ndarray) -> dict[str, np.ndarray]:
     with np.errstate(all="ignore"):
         margin = -mr / np.hypot(mr, 2 * np.pi * fr)
     return {"max_real": mr, "frequency": fr, "margin": margin}
 
 
-def _omega_crit(p: list[np.ndarray], lo: float, hi: float) -> np.ndarray:
-    P = np.stack(p, axis=1)
-    roots, dirs, counts, _ = critical_speeds_batch(P, lo, hi, max_crossings=8)
+def _omega_crit(P: np.ndarray, lo: float, hi: float) -> tuple[np.ndarray, np.ndarray]:
+    roots, dirs, counts, _, status = critical_speeds_batch(P, lo, hi, max_crossings=8, return_status=True)
     k = np.arange(roots.shape[1])
     onset = (dirs == -1) & (k[None, :] < counts[:, None])
     first = np.argmax(onset, axis=1)
-    return np.where(onset.any(axis=1), roots[np.arange(roots.shape[0]), first], np.nan)
+    crit = np.where(onset.any(axis=1), roots[np.arange(roots.shape[0]), first], np.nan)
+    # an onset beyond the stored columns cannot be the first one (columns are ascending)
+    return crit, status
+
+
+def _kernel_codes(spec: ChunkSpec, space: ParameterSpace, coords: dict[str, np.ndarray],
+                  shape: tuple[int, ...]) -> np.ndarray | None:
+    """Certified kernel codes on the chunk's grid (0/1/2, study dimension order), or None without a kernel."""
+    kern = grid_kernel(space, tuple(spec.names))
+    if kern is None:
+        return None
+    i = kern.inner
+    iv = np.asarray(coords[spec.names[i]], dtype=float)
+    scaled = _kernel_usable(kern, iv)
+    if scaled is None:
+        return None
+    others = [k for k in range(len(shape)) if k != i]
+    mesh = np.meshgrid(*[np.asarray(coords[spec.names[k]], dtype=float) for k in others], indexing="ij")
+    C, EC = kern.row_coefficients([m.ravel() for m in mesh], scaled[0])
+    seg, T = kernel_segments(scaled[1])
+    res = np.empty((C.shape[0], shape[i]), dtype=np.uint8)
+    kern.classify(C, EC, scaled[1], seg, T, res)
+    return np.moveaxis(res.reshape([shape[k] for k in others] + [shape[i]]), -1, i)
 
 
 def compute_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -287,7 +251,8 @@ def compute_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, n
     -------
     dict of ndarray
         ``stable`` (bool), ``status`` (int8) and the requested float
-        quantities, shaped like the chunk (dimensions in study order).
+        quantities, shaped like the chunk (dimensions in study order).  For
+        status 0/1, ``stable`` ⇔ ``max_real < 0``.
     """
     if spec.model is not None:
         return _model_chunk(spec, coords)
@@ -302,48 +267,39 @@ def compute_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, n
         axes = {n: np.asarray(coords[n], dtype=float) for n in spec.names}
     arr = {k: _compact(v) for k, v in space.arrays(axes).items()}
     valid = _valid(arr)
-    triv = valid & _trivial(arr)
-    all_good = bool(np.all(triv))
+    triv = np.broadcast_to(valid & _trivial(arr), shape)
     stable = np.zeros(shape, dtype=bool)
     status = np.zeros(shape, dtype=np.int8)
-    if not all_good:
-        status[~np.broadcast_to(valid, shape)] = 4
+    status[~np.broadcast_to(valid, shape)] = 4
     floats = [q for q in FLOAT_QUANTITIES if q in spec.quantities]
     out: dict[str, np.ndarray] = {q: np.full(shape, np.nan) for q in floats}
-    kern = grid_kernel(space, spec.names, spec.signs) if spec.kind == "grid" else None
-    if kern is not None:
-        i = kern.inner
-        others = [k for k in range(len(shape)) if k != i]
-        mesh = np.meshgrid(*[np.asarray(coords[spec.names[k]], dtype=float) for k in others], indexing="ij")
-        n_rows = math.prod(shape[k] for k in others)
-        C = kern.row_coefficients([m.ravel() for m in mesh], n_rows, spec.refs[i])
-        res = np.empty((n_rows, shape[i]), dtype=np.uint8)
-        kern.classify(C, np.asarray(coords[spec.names[i]], dtype=float) / spec.refs[i], res)
-        res = np.moveaxis(res.reshape([shape[k] for k in others] + [shape[i]]), -1, i)
-        stable[...] = res.view(bool)
-        if not all_good:
-            stable &= np.broadcast_to(triv, shape)
-    need_points = kern is None or floats
-    if need_points and np.any(triv):
-        flat_all = np.flatnonzero(np.broadcast_to(triv, shape)) if not all_good else None
-        n_t = flat_all.size if flat_all is not None else math.prod(shape)
-        for b0 in range(0, n_t, _BATCH):
-            flat = flat_all[b0:b0 + _BATCH] if flat_all is not None else np.arange(b0, min(n_t, b0 + _BATCH))
-            p = _points(arr, shape, flat)
-            ix = np.unravel_index(flat, shape)
-            if kern is None or set(floats) - {"critical_speed"}:
-                coef = _quartic(p)
-                if kern is None:
-                    stable[ix] = hurwitz_stable(*coef)
-                if set(floats) - {"critical_speed"}:
-                    s = _summary(coef)
-                    for q in floats:
-                        if q in s:
-                            out[q][ix] = s[q]
-            if "critical_speed" in floats:
-                out["critical_speed"][ix] = _omega_crit(p, *spec.critical_speed_range)
-    if not all_good:
-        _nontrivial(spec, space, coords, shape, np.broadcast_to(valid & ~triv, shape), stable, status, out, floats)
+    codes = _kernel_codes(spec, space, coords, shape) if spec.kind == "grid" else None
+    eig = bool(set(floats) - {"critical_speed"})
+    if codes is None:
+        codes = np.full(shape, UNDECIDED, dtype=np.uint8)
+    elif not eig:
+        sure = triv & (codes != UNDECIDED)
+        stable[sure] = codes[sure] == STABLE
+    need = triv if (eig or "critical_speed" in floats) else (triv & (codes == UNDECIDED))
+    flat_all = np.flatnonzero(need)
+    for b0 in range(0, flat_all.size, _BATCH):
+        flat = flat_all[b0:b0 + _BATCH]
+        ix = np.unravel_index(flat, shape)
+        P = _points(arr, shape, flat)
+        c, mr, fr = point_verdicts(P, eigen=eig, codes=codes[ix])
+        stable[ix] = c == STABLE
+        status[ix] = np.where(c == UNDECIDED, STATUS_UNDECIDED, status[ix])
+        if eig:
+            s = _summary(mr, fr)
+            for q in floats:
+                if q in s:
+                    out[q][ix] = s[q]
+        if "critical_speed" in floats:
+            crit, cst = _omega_crit(P, *spec.critical_speed_range)
+            out["critical_speed"][ix] = crit
+            status[ix] = np.where(cst != 0, STATUS_UNDECIDED, status[ix])
+            stable[ix] &= cst == 0
+    _nontrivial(spec, space, coords, shape, np.broadcast_to(valid, shape) & ~triv, stable, status, out, floats)
     for q in floats:
         a = out[q]
         a[np.isnan(a)] = np.nan  # one NaN bit pattern (checksums, zarr's empty-chunk test)
@@ -353,19 +309,19 @@ def compute_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, n
 def _nontrivial(spec: ChunkSpec, space: ParameterSpace, coords: dict[str, np.ndarray], shape: tuple[int, ...],
                 mask: np.ndarray, stable: np.ndarray, status: np.ndarray, out: dict[str, np.ndarray],
                 floats: list[str]) -> None:
-    """Points with a non-trivial silent motion: numeric linearization one by one."""
+    """Points with a non-trivial silent motion: numeric linearization one by one (robust verdict)."""
     for flat in np.flatnonzero(mask):
         ix = np.unravel_index(flat, shape)
         if spec.kind == "grid":
             vals = {n: float(coords[n][ix[k]]) for k, n in enumerate(spec.names)}
         else:
             vals = {n: float(coords[n][ix[0]]) for n in spec.names}
-        code, c = _numeric_point(space, vals)
+        code, st, mr, fr = numeric_point_verdict(space, vals)
         status[ix] = code
-        if c is None:
+        stable[ix] = st
+        if code in (2, 3, 4):
             continue
-        stable[ix] = bool(hurwitz_stable(*c))
-        s = _summary(tuple(np.atleast_1d(x) for x in c))
+        s = _summary(np.array([mr]), np.array([fr]))
         for q in floats:
             if q in s:
                 out[q][ix] = s[q][0]

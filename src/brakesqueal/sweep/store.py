@@ -62,7 +62,8 @@ __all__ = ["StoreError", "MARKERS", "MANIFEST", "study_attrs", "variable_attrs",
 MARKERS = "_sweep_chunks"
 MANIFEST = f"{MARKERS}/_creation.json"
 _FORMAT = "brakesqueal-sweep-store/1"
-_STATUS_MEANINGS = "not_computed ok ok_nontrivial_silent_motion no_silent_motion pad_loses_contact invalid_parameters"
+_STATUS_MEANINGS = ("not_computed ok ok_nontrivial_silent_motion no_silent_motion pad_loses_contact invalid_parameters"
+                    " undecided")
 
 
 class StoreError(BrakesquealError):
@@ -214,7 +215,7 @@ def variable_attrs(study: Any) -> dict[str, dict[str, Any]]:
     """Attributes of every data variable."""
     extra = {"coordinates": " ".join(study.sample_names)} if study.kind == "samples" else {}
     out = {"stable": {"long_name": "silent motion asymptotically stable (Hurwitz)", **extra},
-           "status": {"flag_values": list(range(-1, 5)), "flag_meanings": _STATUS_MEANINGS, **extra}}
+           "status": {"flag_values": list(range(-1, 6)), "flag_meanings": _STATUS_MEANINGS, **extra}}
     for q, qa in FLOAT_QUANTITIES.items():
         if q in study.quantities:
             out[q] = {**qa, **extra}
