@@ -32,12 +32,19 @@ PKG = Path(cache.__file__).resolve().parent.parent
 
 # ------------------------------------------------------------------ the real commands
 #: kind of cache entry -> (command, glob of its entry file below the cache root)
+def _key(name: str) -> str:
+    from brakesqueal.codegen import model_key
+    from brakesqueal.model import get_model
+
+    return model_key(get_model(name))
+
+
 KINDS = {
-    "numeric": (["linearize", "--format", "json"], "*/model-*/model.py"),
+    "numeric": (["linearize", "--format", "json"], f"*/{_key('paper')}/model.py"),
     "stability": (["map", "--x", "mu=0.1:0.8:12", "--y", "Omega=1:100:9", "--out", "m.nc", "--no-eigen"],
                   "*/stability-kernels/brakesqueal_kernel_map_*.py"),
     "simulation": (["simulate", "--t-end", "0.01", "--format", "json", "--no-progress"], "*/simulate-rhs/kernels_*.py"),
-    "built": (["linearize", "--model", "six-dof", "--format", "json"], "*/model-*/numeric.py"),
+    "built": (["linearize", "--model", "six-dof", "--format", "json"], f"*/{_key('six-dof')}/model.py"),
     "text": (["derive", "--case", "symmetric"], "*/closed-forms/symmetric.text"),
 }  # fmt: skip
 
