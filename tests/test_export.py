@@ -901,6 +901,14 @@ def test_reserved_names_get_local_aliases(tmp_path):
     assert main(["export", "--to", "c", "--model", str(path), "--out", str(src)]) == 0
     c = src.read_text()
     assert "const double int_ = p[" in c and "const double end_ = p[" in c and ", end, " in c and ", int, " in c
+    cm = compile_model(spec)
+    rng = np.random.default_rng(1)
+    x = rng.uniform(-1e-3, 1e-3, cm.nx)
+    p = resolve_space(spec).resolve({}).vector()
+    kinds = [f"R{kind(c)}" for c in cm.coords] + ["G"] * cm.m
+    py = tmp_path / "bs_reserved.py"
+    assert main(["export", "--to", "python", "--model", str(path), "--out", str(py)]) == 0
+    assert close_grouped(_import(py).residuals(list(x), list(p)), cm.residuals(list(x), list(p)), kinds)
     gcc = shutil.which("gcc")
     if gcc is None:
         pytest.skip("gcc is not on PATH")
@@ -908,13 +916,8 @@ def test_reserved_names_get_local_aliases(tmp_path):
     res = subprocess.run([gcc, "-std=c99", "-O0", "-Wall", "-Wextra", "-Werror", "-shared", "-fPIC", "-o", str(so),
                           str(src), "-lm"], capture_output=True, text=True)  # fmt: skip
     assert res.returncode == 0, res.stderr[-2000:]
-    cm = compile_model(spec)
-    rng = np.random.default_rng(1)
-    x = rng.uniform(-1e-3, 1e-3, cm.nx)
-    p = resolve_space(spec).resolve({}).vector()
     out = _arr(n=cm.n + cm.m)
     ctypes.CDLL(str(so)).brakesqueal_residuals(_arr(x), _arr(p), out)
-    kinds = [f"R{kind(c)}" for c in cm.coords] + ["G"] * cm.m
     assert close_grouped(out[:], cm.residuals(list(x), list(p)), kinds)
 
 

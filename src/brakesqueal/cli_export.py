@@ -95,7 +95,7 @@ def _export_cmd(
         sys.stdout.write(text)
         return
     with atomic_write(path, what="--out") as tmp:
-        tmp.write_text(text)
+        tmp.write_text(text, encoding="utf-8")
     print(f"wrote {path} ({to.value}, {what.value}, model {space.model.name})", file=sys.stderr)
 
 
