@@ -1,18 +1,18 @@
 """``brakesqueal export`` (registered by :mod:`brakesqueal.cli`).
 
-SymPy and the printers are imported inside the command.
+SymPy and the printers are imported inside the command.  The output path is
+checked before any work and written atomically (:mod:`brakesqueal.outputs`).
 """
 
 from __future__ import annotations
 
 import sys
 from enum import Enum
-from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated, Any, Optional
 
 import typer
 
-__all__ = ["register"]
+__all__ = ["register", "describe_source"]
 
 
 class Target(str, Enum):
@@ -28,44 +28,75 @@ class What(str, Enum):
     linear = "linear"
 
 
+def describe_source(space: Any, model: str | None, params: str | None, sets: list[str]) -> str:
+    """Header description of the parameter options, e.g. ``model six-dof, preset six-dof, --set mu1=0.4``.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The resolved space (:func:`brakesqueal.model.options.resolve_space`).
+    model, params : str or None
+        The ``--model`` and ``--params`` options.
+    sets : list of str
+        The ``--set`` options.
+
+    Returns
+    -------
+    str
+    """
+    parts = []
+    if model is not None:
+        parts.append(f"model {space.model.name}")
+    if params is not None:
+        parts.append(f"file {params}")
+    if space.label != "parameters":
+        parts.append(f"preset {space.label}")
+    if sets:
+        parts.append("--set " + " ".join(sets))
+    return ", ".join(parts)
+
+
 def _export_cmd(
     to: Annotated[Target, typer.Option("--to", help="Output language: latex, octave (also MATLAB), c, julia or python.")],
     out: Annotated[str, typer.Option("--out", help="Output file ('-' for stdout); its stem names the Octave function.")],
     what: Annotated[
         What,
         typer.Option(
-            "--what", help="nonlinear: residuals, pad residuals, ODE right-hand side; linear: closed-form Mbar, Dbar, "
-            "Kbar about the trivial silent motion.",
+            "--what", help="nonlinear: residuals, pad solver, ODE right-hand side; linear: closed-form M, D, K about "
+            "the zero state (refused unless that is the silent motion).",
         ),
     ] = What.nonlinear,
+    model: Annotated[
+        Optional[str], typer.Option("--model", help="Model TOML file or built-in model name (default: the paper's).")
+    ] = None,
     preset: Annotated[
-        Optional[str], typer.Option("--preset", help="Named parameter template for parameters() (default paper-fig2).")
+        Optional[str],
+        typer.Option("--preset", help="Named parameter template for parameters() (default: the model's, or paper-fig2)."),
     ] = None,
     params: Annotated[Optional[str], typer.Option("--params", help="TOML parameter file for parameters().")] = None,
     set_: Annotated[
         Optional[list[str]], typer.Option("--set", help="Override NAME=VALUE (repeatable; VALUE may be 'inf').")
     ] = None,
 ) -> None:
-    """Write the equations (nonlinear or closed-form linear) as C, Octave, Julia, Python or LaTeX."""
-    from .errors import ParameterError
-    from .export import TARGETS, export_code
-    from .export.model import _source
-    from .parameters import resolve_parameters
+    """Write any model's equations (nonlinear or closed-form linear) as C, Octave, Julia, Python or LaTeX."""
+    from .export import TARGETS, check_name, export_code
+    from .model.options import resolve_space
+    from .outputs import atomic_write, check_output
 
-    p = resolve_parameters(preset, params, list(set_ or []))
-    path = None if out == "-" else Path(out)
-    if path is not None and path.suffix != TARGETS[to.value]:
-        raise ParameterError(f"The option '--out' must end in {TARGETS[to.value]} for --to {to.value}; got {out!r}")
+    suffix = TARGETS[to.value]
+    path = None if out == "-" else check_output(out, what="--out", suffixes=(suffix,))
     name = "brakesqueal_model" if path is None else path.stem
-    text = export_code(to.value, what.value, p, name=name, source=_source(preset, params, list(set_ or [])))  # type: ignore[arg-type]
+    check_name(name, to.value)
+    sets = list(set_ or [])
+    space = resolve_space(model, preset, params, sets)
+    source = describe_source(space, model, params, sets)
+    text = export_code(to.value, what.value, space.resolve({}), name=name, source=source)  # type: ignore[arg-type]
     if path is None:
         sys.stdout.write(text)
         return
-    try:
-        path.write_text(text)
-    except OSError as exc:
-        raise ParameterError(f"The option '--out' names a file that cannot be written: {out!r} ({exc.strerror})") from None
-    print(f"wrote {path} ({to.value}, {what.value})", file=sys.stderr)
+    with atomic_write(path, what="--out") as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    print(f"wrote {path} ({to.value}, {what.value}, model {space.model.name})", file=sys.stderr)
 
 
 def register(app: typer.Typer, bench_app: typer.Typer) -> None:
