@@ -122,6 +122,9 @@ def atomic_write(path: str | os.PathLike[str], *, what: str = "output file") -> 
         raise OutputError(f"{what}: cannot write '{path}': {describe_oserror(exc)}") from None
     os.close(fd)
     tmp = Path(tmp_name)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the file the usual permissions
     try:
         yield tmp
         with open(tmp, "rb+") as fh:
