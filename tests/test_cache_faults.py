@@ -420,7 +420,7 @@ EXEMPT = {
                         "its lambdify output is not cached",
     "simulation/bench.py": "lambdify baseline of a benchmark, not cached",
     "simulation/_integrate.py": "calls load_kernels; the source comes from simulation/_kernels.py (listed)",
-    "cli.py": "caches the output of render.py (listed)",
+    "cli/__init__.py": "caches the output of render.py (listed)",
     "model/io.py": "model description <-> TOML; the code cache key is a hash of the components (content-addressed)",
     "model/library.py": "built-in model definitions: their components are hashed into the code cache key",
     "model/parameters.py": "parameter values and presets: never enter generated code",

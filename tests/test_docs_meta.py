@@ -240,4 +240,4 @@ def test_cli_has_help(label, cmd, param):
 
 def test_cli_walk_finds_the_commands():
     labels = {c[0] for c in CLI}
-    assert {"brakesqueal linearize", "brakesqueal export", "brakesqueal bench derive", "brakesqueal export --to"} <= labels
+    assert {"brakesqueal linearize", "brakesqueal export", "brakesqueal export --to"} <= labels

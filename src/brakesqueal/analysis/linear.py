@@ -322,5 +322,17 @@ def pad_rate_eigenvalues(params: Any, *, model: Any = None) -> np.ndarray:
     """Finite eigenvalues with the pads' tangential rates kept (the default :func:`linearize`).
 
     Kept for compatibility: equals ``linearize(params).eigenvalues``.
+
+    Parameters
+    ----------
+    params : Parameters
+        The model and its parameter values.
+    model : CompiledModel, optional
+        Compiled model (default: compiled on demand).
+
+    Returns
+    -------
+    ndarray of complex
+        The finite eigenvalues [1/s], sorted by decreasing real part.
     """
     return linearize(params, model=model, pad_rates="kept").eigenvalues

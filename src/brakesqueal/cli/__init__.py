@@ -220,7 +220,18 @@ _register_plugins()
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point: run the CLI, turning user errors into one stderr line (exit 2) and interrupts into exit 130."""
+    """Entry point: run the CLI, turning user errors into one stderr line (exit 2) and interrupts into exit 130.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``); none prints the help.
+
+    Returns
+    -------
+    int
+        The exit status: 0 success, 2 a user error, 130 an interrupt.
+    """
     args = sys.argv[1:] if argv is None else list(argv)
     if not args:
         args = ["--help"]

@@ -37,7 +37,18 @@ CONTACT_FIELDS = ("F_n", "v_rx", "v_ry", "v_rz", "h", "hdot", "l")
 
 
 def model_key(spec: Any) -> str:
-    """Cache key of a model's equations: a hash of its components (not defaults, presets or texts)."""
+    """Cache key of a model's equations: a hash of its components (not defaults, presets or texts).
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+
+    Returns
+    -------
+    str
+        ``"model-<20 hex digits>"``.
+    """
     from ..model.io import spec_to_dict
 
     d = spec_to_dict(spec, presets=False)

@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Literal, Union
+from typing import Any, Literal, Union
 
 from ..errors import ParameterError
 
@@ -36,7 +36,6 @@ __all__ = ["Value", "FrictionLaw", "Disk", "Pad", "Caliper", "ModelSpec", "MAX_P
 
 Value = Union[float, str]
 FACES = ("upper", "lower")
-LAWS = ("coulomb", "linear", "stribeck")
 _NAME = re.compile(r"^\w+$", re.ASCII)
 
 
@@ -57,45 +56,96 @@ def _check_value(component: str, field_name: str, v: object, *, allow_inf: bool 
         raise ParameterError(f"{component}: {field_name} must be finite{' or +inf' if allow_inf else ''}; got {v}")
 
 
-@dataclass(frozen=True)
 class FrictionLaw:
-    """Coefficient of kinetic friction as a function of the sliding speed ``v``.
+    """Coefficient of kinetic friction as a function of the sliding speed ``v`` (laws: :mod:`.friction`).
 
     Parameters
     ----------
-    law : {"coulomb", "linear", "stribeck"}
-        ``coulomb``: ``mu(v) = mu``.  ``linear``: ``mu(v) = mu - slope * v``
-        (the negative-slope mechanism of planar models; ``slope >= 0`` falls).
-        ``stribeck``: ``mu(v) = mu + (mu_s - mu) exp(-v / v_s)``.
+    law : str
+        A law of :data:`brakesqueal.model.friction.LAWS`: ``"coulomb"``
+        (``mu(v) = mu``), ``"linear"`` (``mu(v) = mu - slope v``, the
+        negative-slope mechanism of planar models) or ``"stribeck"``
+        (``mu(v) = mu + (mu_s - mu) exp(-v / v_s)``).
     mu : float or str
-        Kinetic coefficient (``coulomb``, ``stribeck``) or intercept at ``v = 0`` (``linear``).
-    slope : float or str, optional
-        ``-dmu/dv`` of the ``linear`` law [s/m].
-    mu_s : float or str, optional
-        Static coefficient of the ``stribeck`` law.
-    v_s : float or str, optional
-        Stribeck speed [m/s].
+        Kinetic coefficient (the intercept at ``v = 0`` for ``linear``): a
+        number or a parameter name.
+    **fields : float or str
+        The law's other fields (``slope``; ``mu_s``, ``v_s``), numbers or
+        parameter names.
     """
 
-    law: Literal["coulomb", "linear", "stribeck"] = "coulomb"
-    mu: Value = "mu"
-    slope: Value | None = None
-    mu_s: Value | None = None
-    v_s: Value | None = None
+    __slots__ = ("law", "mu", "fields")
+
+    def __init__(self, law: str = "coulomb", mu: Value = "mu", **fields: Value | None) -> None:
+        object.__setattr__(self, "law", law)
+        object.__setattr__(self, "mu", mu)
+        object.__setattr__(self, "fields", tuple((k, v) for k, v in fields.items() if v is not None))
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("_"):
+            raise AttributeError(name)
+        return dict(object.__getattribute__(self, "fields")).get(name)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError("FrictionLaw is immutable")
+
+    def __eq__(self, other: object) -> bool:
+        return (isinstance(other, FrictionLaw) and (self.law, self.mu, dict(self.fields))
+                == (other.law, other.mu, dict(other.fields)))
+
+    def __hash__(self) -> int:
+        return hash((self.law, self.mu, self.fields))
+
+    def __repr__(self) -> str:
+        extra = "".join(f", {k}={v!r}" for k, v in self.fields)
+        return f"FrictionLaw({self.law!r}, mu={self.mu!r}{extra})"
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (_friction_law, (self.law, self.mu, dict(self.fields)))
+
+    @property
+    def __dict__(self) -> dict[str, Any]:  # type: ignore[override]
+        """``law``, ``mu`` and the fields (for ``vars()``)."""
+        return {"law": self.law, **self.values()}
+
+    @property
+    def definition(self) -> Any:
+        """The :class:`~brakesqueal.model.friction.LawDef` of this law."""
+        from .friction import LAWS
+
+        return LAWS[self.law]
+
+    @property
+    def rate_dependent(self) -> bool:
+        """Whether ``mu`` depends on the sliding speed."""
+        return bool(self.definition.rate_dependent)
+
+    def values(self) -> dict[str, Value]:
+        """``mu`` and the law's fields, by name."""
+        return {"mu": self.mu, **dict(self.fields)}
 
     def validate(self, component: str) -> None:
-        """Check the law's fields; raise :class:`ParameterError` naming ``component``."""
-        if self.law not in LAWS:
-            raise ParameterError(f"{component}: friction law must be one of {', '.join(LAWS)}; got {self.law!r}")
+        """Check the law and its fields; raise :class:`ParameterError` naming ``component``."""
+        from ..suggest import did_you_mean
+        from .friction import LAWS
+
+        if not isinstance(self.law, str) or self.law not in LAWS:
+            raise ParameterError(f"{component}: friction law must be one of {', '.join(LAWS)}; got {self.law!r}"
+                                 f"{did_you_mean(str(self.law), LAWS)}")
         _check_value(component, "mu", self.mu)
-        needed = {"linear": ("slope",), "stribeck": ("mu_s", "v_s"), "coulomb": ()}[self.law]
-        for name in ("slope", "mu_s", "v_s"):
-            v = getattr(self, name)
-            if name in needed and v is None:
+        needed = self.definition.fields
+        for name, v in self.fields:
+            if name not in needed:
+                raise ParameterError(f"{component}: '{name}' does not belong to the {self.law} friction law"
+                                     f"{did_you_mean(name, needed)}" + (f"; its fields: mu, {', '.join(needed)}"))
+            _check_value(component, name, v)
+        for name in needed:
+            if name not in dict(self.fields):
                 raise ParameterError(f"{component}: the {self.law} friction law needs '{name}'")
-            if name not in needed and v is not None:
-                raise ParameterError(f"{component}: '{name}' does not belong to the {self.law} friction law")
-            _check_value(component, name, v, optional=True)
+
+
+def _friction_law(law: str, mu: Value, fields: dict[str, Value]) -> FrictionLaw:
+    return FrictionLaw(law, mu, **fields)
 
 
 @dataclass(frozen=True)
@@ -439,8 +489,8 @@ class ModelSpec:
         for p in self.pads:
             for f in ("radius", "k", "d", "preload", "k_ip", "d_ip", "mass", "k_c", "d_c"):
                 add(getattr(p, f))
-            for f in ("mu", "slope", "mu_s", "v_s"):
-                add(getattr(p.friction, f))
+            for v in p.friction.values().values():
+                add(v)
         for c in self.calipers:
             for f in ("mass", "k_n", "d_n", "k_t", "d_t"):
                 add(getattr(c, f))

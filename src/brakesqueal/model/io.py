@@ -192,8 +192,8 @@ def spec_from_dict(data: Mapping[str, Any], *, source: str = "model") -> ModelSp
                 raise ParameterError(f"{where}: friction must be a table like {{ law = 'coulomb', mu = 'mu1' }}")
             if "name" not in raw or "face" not in raw:
                 raise ParameterError(f"{where}: a pad needs 'name' and 'face'")
-            pads.append(Pad(**_fields(Pad, raw, where),
-                            friction=FrictionLaw(**_fields(FrictionLaw, fr, f"{where} friction"))))
+            fr = {k: (math.inf if v == "inf" else v) for k, v in fr.items()}
+            pads.append(Pad(**_fields(Pad, raw, where), friction=FrictionLaw(**fr)))
         calipers = []
         for i, raw in enumerate(_table(data, "calipers", source, kind=list, what="a list of [[calipers]] tables")):
             where = f"{source}: calipers[{i}]"
@@ -245,7 +245,7 @@ def spec_to_dict(spec: ModelSpec, *, presets: bool = True) -> dict[str, Any]:
         for f in dataclasses.fields(obj):
             v = getattr(obj, f.name)
             if f.name == "friction":
-                out["friction"] = {k: _plain(x) for k, x in comp(v).items()}
+                out["friction"] = {"law": v.law, **{k: _plain(x) for k, x in v.values().items()}}
             elif v is not None:
                 out[f.name] = _plain(v)
         return out

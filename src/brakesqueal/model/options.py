@@ -95,5 +95,15 @@ def resolve_space(model: Any = None, preset: str | None = None, params: str | No
 
 def resolve_parameters(model: Any = None, preset: str | None = None, params: str | None = None,
                        sets: Sequence[str] | dict[str, Any] = ()) -> Parameters:
-    """The validated parameter set of :func:`resolve_space` at its current point."""
+    """The validated parameter set of :func:`resolve_space` at its current point.
+
+    Parameters
+    ----------
+    model, preset, params, sets
+        As for :func:`resolve_space`.
+
+    Returns
+    -------
+    Parameters
+    """
     return resolve_space(model, preset, params, sets).resolve({})

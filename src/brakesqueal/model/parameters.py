@@ -535,6 +535,16 @@ class ParameterSpace:
 def parse_sets(sets: Sequence[str]) -> dict[str, Value]:
     """Parse repeated ``--set NAME=VALUE`` options (values: floats where plain numbers, else expressions).
 
+    Parameters
+    ----------
+    sets : sequence of str
+        The ``NAME=VALUE`` texts.
+
+    Returns
+    -------
+    dict
+        ``{name: value}``.
+
     Raises
     ------
     ParameterError

@@ -123,9 +123,6 @@ ROLES: Mapping[str, Role] = {r.key: r for r in (
     _role("pad.k_c", "N/m", "contact stiffness of {owner}", *_POS),
     _role("pad.d_c", "N s/m", "contact damping of {owner}", *_NONNEG),
     _role("friction.mu", "", "kinetic friction coefficient at {owner}", *_NONNEG),
-    _role("friction.slope", "s/m", "friction slope -dmu/dv at {owner}", *_REAL),
-    _role("friction.mu_s", "", "static friction coefficient (Stribeck) at {owner}", *_NONNEG),
-    _role("friction.v_s", "m/s", "Stribeck speed at {owner}", *_POS),
     _role("caliper.mass", "kg", "mass of {owner}", *_POS),
     _role("caliper.k_n", "N/m", "normal stiffness of {owner} to ground", *_NONNEG),
     _role("caliper.d_n", "N s/m", "normal damping of {owner} to ground", *_NONNEG),
@@ -133,9 +130,21 @@ ROLES: Mapping[str, Role] = {r.key: r for r in (
     _role("caliper.d_t", "N s/m", "tangential damping of {owner} to ground", *_NONNEG),
 )}
 
+def _friction_roles() -> dict[str, Role]:
+    from .friction import LAWS
+
+    out = {}
+    for law in LAWS.values():
+        for name, f in law.fields.items():
+            out[f"friction.{name}"] = Role(f"friction.{name}", f.unit, f.description, f.low, f.high, f.low_open,
+                                           f.high_open)
+    return out
+
+
+ROLES = {**ROLES, **_friction_roles()}
+
 _DISK_FIELDS = ("Theta", "Phi", "k_t", "d_t", "h_upper", "h_lower", "Omega", "radius")
 _PAD_FIELDS = ("radius", "k", "d", "preload", "k_ip", "d_ip", "mass", "k_c", "d_c")
-_FRICTION_FIELDS = ("mu", "slope", "mu_s", "v_s")
 _CALIPER_FIELDS = ("mass", "k_n", "d_n", "k_t", "d_t")
 
 
@@ -234,8 +243,8 @@ def parameter_roles(spec: Any) -> ParameterRoles:
         owner = _owner_pad(p)
         for f in _PAD_FIELDS:
             add("pad", f, getattr(p, f), owner)
-        for f in _FRICTION_FIELDS:
-            add("friction", f, getattr(p.friction, f), owner)
+        for f, v in p.friction.values().items():
+            add("friction", f, v, owner)
     cal_dofs = []
     for c in spec.calipers:
         owner = f"caliper '{c.name}'"

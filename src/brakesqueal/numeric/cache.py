@@ -65,6 +65,7 @@ GENERATOR_MODULES: tuple[str, ...] = (
     "symbolic/*.py",  # the equations themselves
     "codegen/*.py",  # the unified code generator and compiled models
     "model/components.py",  # components: their equations and parameter order
+    "model/friction.py",  # friction laws: their formulas enter the equations
     "numeric/*.py",  # code generation (CSE), this cache, the compiled 2-DOF model
     "builder/assemble.py",  # built-model equations
     "builder/components.py",  # built-model components (their equations and parameter order)
@@ -75,6 +76,7 @@ GENERATOR_MODULES: tuple[str, ...] = (
     "simulation/_kernels.py",  # simulation kernels and their static template
     "export/*.py",  # exported code and LaTeX
     "render.py",  # the rendered closed forms cached by ``derive``
+    "nonlinear/*.py",  # compiled flows of the continuation (numba) and what they import
 )
 
 #: Third-party code generators: the content of these files (relative to the

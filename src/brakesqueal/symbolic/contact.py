@@ -101,13 +101,11 @@ def angle_cos_sin(sm: ModuleType, deg: float) -> tuple[Any, Any]:
 
 
 def friction_coefficient(sm: ModuleType, law: Any, v: Any, val: Callable[[Any], Any]) -> Any:
-    """``mu(v)`` of a :class:`~brakesqueal.model.components.FrictionLaw` (``val`` maps fields to symbols)."""
-    mu = val(law.mu)
-    if law.law == "coulomb":
-        return mu
-    if law.law == "linear":
-        return mu - val(law.slope) * v
-    return mu + (val(law.mu_s) - mu) * sm.exp(-v / val(law.v_s))
+    """``mu(v)`` of a :class:`~brakesqueal.model.components.FrictionLaw` (``val`` maps fields to symbols).
+
+    The formula is the law's own (:data:`brakesqueal.model.friction.LAWS`).
+    """
+    return law.definition.formula(sm, v, {k: val(x) for k, x in law.values().items()})
 
 
 def pad_contact(

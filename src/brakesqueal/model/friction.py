@@ -1,0 +1,95 @@
+r"""Friction laws: the coefficient of kinetic friction as a function of the sliding speed.
+
+This module is the one place a friction law is defined: its fields (with
+their unit, meaning and allowed range), its formula ``mu(v)`` (written with
+the functions of the symbolic backend it is given, so this module imports no
+computer algebra) and whether it depends on the sliding speed.  Adding a law
+means adding one :class:`LawDef` to :data:`LAWS`; validation, TOML files,
+parameter roles, the symbolic assembly (:mod:`brakesqueal.symbolic.contact`),
+the pads' treatment in linearization, simulation and export all read it from
+here.  See ``docs/extending.md``.
+
+========== ================================== ==========================================
+law        fields                             ``mu(v)``
+========== ================================== ==========================================
+coulomb    ``mu``                             ``mu`` (the paper's model, eqs. 31-32)
+linear     ``mu``, ``slope``                  ``mu - slope v`` (falling for ``slope > 0``)
+stribeck   ``mu``, ``mu_s``, ``v_s``          ``mu + (mu_s - mu) exp(-v / v_s)``
+========== ================================== ==========================================
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
+from typing import Any
+
+__all__ = ["FieldDef", "LawDef", "LAWS"]
+
+_INF = math.inf
+
+
+@dataclass(frozen=True)
+class FieldDef:
+    """One field of a friction law: unit, meaning and allowed interval (for :mod:`.roles`).
+
+    Attributes
+    ----------
+    unit, description : str
+        SI unit (``""`` dimensionless) and a description template with ``{owner}``.
+    low, high : float
+        Interval bounds.
+    low_open, high_open : bool
+        Whether they are excluded.
+    """
+
+    unit: str
+    description: str
+    low: float
+    high: float
+    low_open: bool
+    high_open: bool
+
+
+@dataclass(frozen=True)
+class LawDef:
+    """A friction law.
+
+    Attributes
+    ----------
+    name : str
+        Its name in model files (``law = "stribeck"``).
+    fields : Mapping[str, FieldDef]
+        Its fields besides the kinetic coefficient ``mu`` (which every law has).
+    formula : callable
+        ``formula(sm, v, f)`` → ``mu(v)`` for the symbolic backend ``sm``
+        (``symengine`` or ``sympy``), the sliding speed ``v`` and ``f``, a
+        mapping from field name (``"mu"`` included) to its symbolic value.
+    rate_dependent : bool
+        Whether ``mu`` depends on ``v``; a massless pad with such a law keeps
+        its tangential rate as a first-order state (``docs/theory.md``).
+    """
+
+    name: str
+    fields: Mapping[str, FieldDef]
+    formula: Callable[[Any, Any, Mapping[str, Any]], Any]
+    rate_dependent: bool
+
+
+_MU = FieldDef("", "kinetic friction coefficient at {owner}", 0.0, _INF, False, True)
+
+#: Every friction law, by name.
+LAWS: Mapping[str, LawDef] = MappingProxyType({law.name: law for law in (
+    LawDef("coulomb", {}, lambda sm, v, f: f["mu"], rate_dependent=False),
+    LawDef("linear", {"slope": FieldDef("s/m", "friction slope -dmu/dv at {owner}", -_INF, _INF, True, True)},
+           lambda sm, v, f: f["mu"] - f["slope"] * v, rate_dependent=True),
+    LawDef("stribeck", {"mu_s": FieldDef("", "static friction coefficient (Stribeck) at {owner}", 0.0, _INF,
+                                         False, True),
+                        "v_s": FieldDef("m/s", "Stribeck speed at {owner}", 0.0, _INF, True, True)},
+           lambda sm, v, f: f["mu"] + (f["mu_s"] - f["mu"]) * sm.exp(-v / f["v_s"]), rate_dependent=True),
+)})
+
+#: The field every law has.
+MU_FIELD = _MU
