@@ -34,8 +34,8 @@ from brakesqueal.analysis.robust import (
     STABLE, UNDECIDED, UNSTABLE, eigen_verdicts, isolate_real_roots, isolate_real_roots_float, routh_exact,
     routh_verdicts,
 )
-from brakesqueal.analysis.space import ParameterSpace
 from brakesqueal.errors import BrakesquealError
+from brakesqueal.model import ParameterSpace
 from brakesqueal.sweep.compute import build_space
 
 pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")
@@ -81,13 +81,19 @@ def ref_margin(params) -> tuple[float, float]:
         return float(top.real), float(top.real / scale)
 
 
+def trivial_eq49(prm) -> bool:
+    """The paper's condition for the trivial silent motion, ``mu1 h10 = mu2 h20`` (eq. 49), to 1e-12 relative."""
+    a, b = prm.mu1 * prm.h10, prm.mu2 * prm.h20
+    return abs(a - b) <= 1e-12 * max(abs(a), abs(b))
+
+
 def reference_point(space, values):
     """``None`` (invalid), ``"nontrivial"``, or ``(max_real, rel)``."""
     try:
         prm = space.resolve(values)
     except BrakesquealError:
         return None
-    if not prm.trivial_silent_motion():
+    if not trivial_eq49(prm):
         return "nontrivial"
     return ref_margin(prm)
 
@@ -291,25 +297,27 @@ def test_critical_speed_batch_kernel_equals_exact_isolation():
     ("paper-2dof", Axis("k_ip1", 1e3, 1e12, 6, True), Axis("k1", 0.0, 1e7, 5)),
     ("minimal", Axis("mu", 0.0, 1.0, 6), Axis("d", 0.0, 50.0, 4)),
     ("six-dof", Axis("k_c", 1e7, 1e11, 5, True), Axis("mu2", 0.3, 0.7, 3)),
+    ("eight-dof", Axis("k_c", 1e8, 1e10, 4, True), Axis("k_cn", 1e6, 1e9, 3, True)),
 ])
 def test_built_model_maps_against_mpmath_eigenvalues(model, x, y):
-    """Built models: certified verdicts vs mpmath eigenvalues of the model's own M, D, K (40 digits)."""
-    from brakesqueal.builder import get_model, linearize_model
-    from brakesqueal.builder.analysis import ModelSpace, model_stability_map
+    """Every built-in model: certified verdicts vs mpmath eigenvalues of the model's own M, D, K (40 digits)."""
+    from brakesqueal.analysis.linear import linearize
+    from brakesqueal.model import resolve_space
 
-    spec = get_model(model)
-    space = ModelSpace(spec)
+    space = resolve_space(model)
     for eigen in (True, False):
-        ds = model_stability_map(space, x, y, eigen=eigen).data
+        ds = stability_map(space, x, y, eigen=eigen).data
+        assert ("max_real" in ds) == eigen
         for yv in y.values():
             for xv in x.values():
                 pt = ds.sel({x.name: xv, y.name: yv})
                 st, code = bool(pt["stable"]), int(pt["status"])
                 try:
-                    lm = linearize_model(spec, {x.name: float(xv), y.name: float(yv)})
+                    lm = linearize(space.resolve({x.name: float(xv), y.name: float(yv)}))
                 except BrakesquealError:
                     assert code >= 2 and not st
                     continue
+                assert not lm.pad_states  # these models keep no pad state at these points
                 n = lm.M.shape[0]
                 with mpmath.workdps(40):
                     A = mpmath.zeros(2 * n, 2 * n)
@@ -327,6 +335,7 @@ def test_built_model_maps_against_mpmath_eigenvalues(model, x, y):
                     assert abs(rel) < 1e-6, where  # built models: norm-wise input bound 2^-42
                     continue
                 assert code in (0, 1), where
+                assert (code == 0) == lm.silent.trivial, where
                 if eigen:
                     assert st == (float(pt["max_real"]) < 0), where
                 if abs(rel) > SAFE:
@@ -373,9 +382,11 @@ def test_issue6_exact_crossings_over_huge_ranges():
     space = ParameterSpace.from_preset("paper-fig2", {"mu": 0.5})
     narrow = crossings(space, Axis("k_ip", 1e5, 1e10, 2, True))
     assert [d for _, d in narrow.crossings] == ["stabilizing", "destabilizing"]
+    # finite parameter values are valid up to a magnitude of 1e100 (model.roles.MAX_MAGNITUDE)
     for lo, hi in [(1e-100, 1e100), (1e-300, 1e300), (1.0, 1e60)]:
         wide = crossings(space, Axis("k_ip", lo, hi, 2, True))
-        assert wide.complete
+        assert wide.complete == (hi <= 1e100)
+        assert all(a >= narrow.crossings[-1][0] * (1 - 1e-12) and b == hi for a, b in wide.undecided_ranges)
         assert [d for _, d in wide.crossings] == [d for _, d in narrow.crossings]
         for (a, _), (b, _) in zip(wide.crossings, narrow.crossings):
             assert math.isclose(a, b, rel_tol=1e-12)
@@ -509,7 +520,6 @@ def test_map_kernel_has_no_axis_sign_assumption(preset, tied, x, y, xr, yr):
     assume the sign of any common denominator).
     """
     from brakesqueal.analysis.robust import exact_trivial_entries
-    from brakesqueal.analysis.space import VECTOR_NAMES
 
     space = build_space(preset, (), tied)
     k = map_kernel(space, x, y)
@@ -518,13 +528,15 @@ def test_map_kernel_has_no_axis_sign_assumption(preset, tied, x, y, xr, yr):
     o, i = ax[k.outer], ax[k.inner]
     codes = k.verdicts(o, i)
     arr = space.arrays({k.outer: o[:, None], k.inner: i[None, :]})
+    with np.errstate(all="ignore"):
+        vec = [np.broadcast_to(v, (o.size, i.size)) for v in space.vectors(arr)]
     checked = 0
     for a in range(o.size):
         for b in range(i.size):
-            p = [float(arr[n][a, b]) for n in VECTOR_NAMES]
+            p = [float(v[a, b]) for v in vec]
             if not all(math.isfinite(v) for v in p):
                 continue
-            e = exact_trivial_entries(p)
+            e = exact_trivial_entries(p, space.model)
             q = [e[8] * e[11] - e[9] * e[10],
                  e[4] * e[11] + e[8] * e[7] - e[5] * e[10] - e[9] * e[6],
                  e[0] * e[11] + e[4] * e[7] + e[8] * e[3] - e[1] * e[10] - e[5] * e[6] - e[9] * e[2],
@@ -553,7 +565,7 @@ def test_known_crossings_against_reference(preset, tied, name, lo, hi, log, fixe
 
 
 def test_numeric_route_is_marked_not_exhaustive():
-    base = ParameterSpace.from_preset("paper-fig3", {"k_ip": 1e8}).resolve({})
+    base = ParameterSpace.from_preset("paper-fig3", {"k_ip": "inf"}).resolve({})
     space = ParameterSpace.from_parameters(base.replace(h10=0.009))  # breaks eq. 49: non-trivial silent motion
     r = crossings(space, Axis("Omega", 10, 100, 2, True))
     assert not r.exhaustive and "grid" in r.text() and r.to_dict()["exhaustive"] is False

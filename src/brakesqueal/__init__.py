@@ -5,10 +5,15 @@ The public API follows the layers of the package:
 * :func:`derive_equations` — nonlinear equations of motion (paper eqs. 2-45),
 * :func:`closed_form` — closed-form ``Mbar, Dbar, Kbar`` about the trivial
   silent motion (eqs. 47-61),
-* :class:`Parameters`, :func:`get_preset`, :func:`resolve_parameters` — validated
-  parameter sets and the paper's presets,
+* :class:`ModelSpec`, :func:`get_model`, :func:`load_model` — models (the
+  paper's and any other), :class:`Parameters`, :func:`get_preset`,
+  :class:`ParameterSpace`, :func:`resolve_space` — validated parameter sets,
+  presets and parameter spaces,
 * :func:`silent_motion`, :func:`linearize` — numeric silent motion and linear
-  model (eqs. 46-48).
+  model (eqs. 46-48) of any model,
+* :func:`stability_map`, :func:`crossings`, :func:`critical_speeds` — the
+  stability routes of every model (closed-form kernels where the model allows
+  them, certified per-point eigenvalue verdicts otherwise).
 
 Heavy symbolic modules are imported lazily.
 """
@@ -32,7 +37,7 @@ __all__ = [
     "PRESETS",
     "get_preset",
     "resolve_parameters",
-    "parameters_from_toml",
+    "resolve_space",
     "derive_equations",
     "closed_form",
     "compiled_model",
@@ -54,6 +59,8 @@ __all__ = [
     "build_equations",
     "linearize_model",
     "stability_map",
+    "evaluate_point",
+    "PointStatus",
     "crossings",
     "critical_speeds",
     "critical_speeds_many",
@@ -74,12 +81,12 @@ __all__ = [
 ]
 
 _LAZY = {
-    "Parameters": "parameters",
-    "Preset": "parameters",
-    "PRESETS": "parameters",
-    "get_preset": "parameters",
-    "resolve_parameters": "parameters",
-    "parameters_from_toml": "parameters",
+    "Parameters": "model",
+    "Preset": "model",
+    "PRESETS": "model.library",
+    "get_preset": "model",
+    "resolve_parameters": "model",
+    "resolve_space": "model",
     "derive_equations": "symbolic.model",
     "closed_form": "symbolic.linearize",
     "compiled_model": "numeric.compiled",
@@ -91,23 +98,25 @@ _LAZY = {
     "simulate": "simulation",
     "Trajectory": "simulation",
     "SimulationModel": "simulation",
-    "ModelSpec": "builder",
-    "Disk": "builder",
-    "Pad": "builder",
-    "Caliper": "builder",
-    "FrictionLaw": "builder",
-    "get_model": "builder",
-    "load_model": "builder",
-    "build_equations": "builder",
+    "ModelSpec": "model",
+    "Disk": "model",
+    "Pad": "model",
+    "Caliper": "model",
+    "FrictionLaw": "model",
+    "get_model": "model",
+    "load_model": "model",
+    "build_equations": "symbolic.assemble",
     "linearize_model": "builder",
     "stability_map": "analysis.stability",
+    "evaluate_point": "analysis.stability",
+    "PointStatus": "status",
     "crossings": "analysis.stability",
     "critical_speeds": "analysis.stability",
     "critical_speeds_many": "analysis.stability",
     "eigen_analysis": "analysis.stability",
     "EigenAnalysis": "analysis.stability",
     "Verdict": "analysis.stability",
-    "ParameterSpace": "analysis.stability",
+    "ParameterSpace": "model",
     "Axis": "analysis.stability",
     "StabilityMap": "results",
     "CrossingResult": "results",

@@ -57,20 +57,30 @@ def plot_map(m: Any, ax: Any = None, *, x: str | None = None, title: str | None 
     return fig
 
 
-def plot_path(r: Any, ax: Any = None, n: int = 400) -> Any:
-    """Largest real part along a 1-D path with its crossings marked."""
-    from .analysis.maps import Axis, _numeric_point, _roots_summary
+def plot_path(r: Any, ax: Any = None) -> Any:
+    """Largest real part along a 1-D path (the result's stored ``profile``) with its crossings marked.
 
+    Parameters
+    ----------
+    r : CrossingResult
+        A result of :func:`~brakesqueal.analysis.crossings.crossings` or
+        :func:`~brakesqueal.analysis.crossings.critical_speeds`.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     fig, ax = new_figure(ax)
-    grid = Axis(r.parameter, r.start, r.stop, n, r.log).values()
-    vals = []
-    for v in grid:
-        _, c = _numeric_point(r.space, {r.parameter: float(v)})
-        vals.append(np.nan if c is None else _roots_summary(c)[0][0])
-    ax.plot(grid, vals, "k-", lw=1)
+    if r.profile is not None:
+        grid, vals = r.profile
+        ax.plot(grid, vals, "k-", lw=1)
     ax.axhline(0, color="0.5", lw=0.8)
     for v, d in r.crossings:
         ax.axvline(v, color="tab:red" if d == "destabilizing" else "tab:green", ls="--", lw=1)
+    for a, b in r.undecided_ranges:
+        ax.axvspan(a, b, color="0.85", lw=0)
     if r.log:
         ax.set_xscale("log")
     ax.set_yscale("symlog", linthresh=1e-2)

@@ -30,16 +30,24 @@ def _noop(frac: float) -> None:
     pass
 
 
+def _write(path: Path, writer: Any) -> None:
+    """Write one output file atomically (a failure never leaves a truncated file)."""
+    from .outputs import write_with
+
+    write_with(path, writer)
+
+
 def reproduce_fig2(out: str | Path, *, n_kip: int = 301, n_mu: int = 241, mu_line: float = FIG2_MU,
                    progress: Callable[[float], None] = _noop) -> dict[str, Any]:
     """Write ``fig2.png``, ``fig2.nc``, ``fig2.csv``, ``fig2.json`` to ``out``; returns the summary."""
     from .analysis.crossings import crossings
     from .analysis.maps import Axis, stability_map
-    from .analysis.space import ParameterSpace
+    from .model.parameters import ParameterSpace
     from .plotting import save
 
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    from .outputs import check_output_dir
+
+    out = check_output_dir(out, what="--out")
     space = ParameterSpace.from_preset("paper-fig2")
     kip = Axis("k_ip", 1e5, 1e10, n_kip, True)
     m = stability_map(space, kip, Axis("mu", 0.05, 1.0, n_mu), progress=lambda f: progress(0.8 * f))
@@ -58,16 +66,16 @@ def reproduce_fig2(out: str | Path, *, n_kip: int = 301, n_mu: int = 241, mu_lin
         if v is not None:
             ax.plot([v], [mu_line], "ko", ms=5)
             ax.annotate(label, (v, mu_line), textcoords="offset points", xytext=(4, 6))
-    save(fig, str(out / "fig2.png"))
-    m.to_netcdf(str(out / "fig2.nc"))
-    m.to_csv(str(out / "fig2.csv"))
+    _write(out / "fig2.png", lambda t: save(fig, str(t)))
+    _write(out / "fig2.nc", lambda t: m.to_netcdf(str(t)))
+    _write(out / "fig2.csv", lambda t: m.to_csv(str(t)))
     st = m.data["stable"].values
     summary = {"figure": "fig2", "preset": "paper-fig2", "mu_line": mu_line, "A_k_ip": A, "B_k_ip": B,
                "line_crossings": line.to_dict(), "grid": {"k_ip": [kip.start, kip.stop, n_kip, "log"],
                                                           "mu": [0.05, 1.0, n_mu, "linear"]},
                "stable_fraction": float(st.mean()),
                "files": [str(out / f"fig2.{e}") for e in ("png", "nc", "csv", "json")]}
-    (out / "fig2.json").write_text(json.dumps(summary, indent=2) + "\n")
+    _write(out / "fig2.json", lambda t: t.write_text(json.dumps(summary, indent=2) + "\n"))
     progress(1.0)
     return summary
 
@@ -78,17 +86,20 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
     import xarray as xr
 
     from .analysis.crossings import critical_speeds_many
-    from .analysis.space import ParameterSpace
+    from .model.parameters import ParameterSpace
     from .plotting import plot_critical_curves, save
 
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    from .outputs import check_output_dir
+
+    out = check_output_dir(out, what="--out")
     diff = np.linspace(-0.98, 0.98, n_diff)
     mu1, mu2 = (1 + diff) / 2, (1 - diff) / 2
-    crit, restab, ncross = {}, {}, {}
+    crit, restab, ncross, certain = {}, {}, {}, {}
     for q, kip in enumerate(FIG3_KIP):
         space = ParameterSpace.from_preset("paper-fig3", {"k_ip": kip})
-        roots, dirs, counts, start = critical_speeds_many(space, {"mu1": mu1, "mu2": mu2}, *omega_range)
+        roots, dirs, counts, start, status = critical_speeds_many(space, {"mu1": mu1, "mu2": mu2}, *omega_range,
+                                                                  return_status=True)
+        certain[kip] = status == 0
         first = np.full(diff.size, np.nan)
         second = np.full(diff.size, np.nan)
         for i in range(diff.size):
@@ -103,20 +114,22 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
     fig = plot_critical_curves(diff, crit)
     ax = fig.axes[0]
     ax.set_title("Fig. 3: critical speed vs friction asymmetry (paper-fig3)")
-    save(fig, str(out / "fig3.png"))
+    _write(out / "fig3.png", lambda t: save(fig, str(t)))
     fig_full = plot_critical_curves(diff, crit, restab=restab)
     fig_full.axes[0].set_yscale("log")
     fig_full.axes[0].set_title("onset (solid) and re-stabilisation (dotted) of squeal")
-    save(fig_full, str(out / "fig3_restabilisation.png"))
+    _write(out / "fig3_restabilisation.png", lambda t: save(fig_full, str(t)))
     kvals = [math.inf if k == "inf" else float(k) for k in FIG3_KIP]
     ds = xr.Dataset(
         {"Omega_crit": (("k_ip", "mu_diff"), np.array([crit[k] for k in FIG3_KIP]), {"units": "rad/s"}),
          "Omega_restab": (("k_ip", "mu_diff"), np.array([restab[k] for k in FIG3_KIP]), {"units": "rad/s"}),
-         "n_crossings": (("k_ip", "mu_diff"), np.array([ncross[k] for k in FIG3_KIP], dtype=np.int32))},
+         "n_crossings": (("k_ip", "mu_diff"), np.array([ncross[k] for k in FIG3_KIP], dtype=np.int32)),
+         "certain": (("k_ip", "mu_diff"), np.array([certain[k] for k in FIG3_KIP], dtype=np.int8),
+                     {"long_name": "every crossing in the range established (1) or a part undecided (0)"})},
         coords={"k_ip": ("k_ip", kvals, {"units": "N/m"}), "mu_diff": ("mu_diff", diff, {"long_name": "mu1 - mu2"})},
         attrs={"preset": "paper-fig3", "constraint": "mu1 + mu2 = 1", "omega_range": list(omega_range)})
-    ds.to_netcdf(str(out / "fig3.nc"), engine="scipy")
-    ds.to_dataframe().reset_index().to_csv(str(out / "fig3.csv"), index=False)
+    _write(out / "fig3.nc", lambda t: ds.to_netcdf(str(t), engine="scipy"))
+    _write(out / "fig3.csv", lambda t: ds.to_dataframe().reset_index().to_csv(str(t), index=False))
     mid = int(np.argmin(np.abs(diff)))
     summary: dict[str, Any] = {"figure": "fig3", "preset": "paper-fig3", "omega_range": list(omega_range),
                                "files": [str(out / f) for f in ("fig3.png", "fig3_restabilisation.png",
@@ -129,8 +142,10 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
             "Omega_crit_at_equal_mu": float(c[mid]),
             "min_Omega_crit": float(np.nanmin(c)) if fin.any() else None,
             "argmin_mu_diff": float(diff[np.nanargmin(c)]) if fin.any() else None,
-            "stable_throughout_for_abs_mu_diff_above": float(np.min(np.abs(diff[~fin]))) if (~fin).any() else None,
+            "stable_throughout_for_abs_mu_diff_above": (float(np.min(np.abs(diff[~fin & certain[k]])))
+                                                        if (~fin & certain[k]).any() else None),
+            "undecided_points": int(np.count_nonzero(~certain[k])),
             "Omega_restab_at_equal_mu": float(restab[k][mid]),
         }
-    (out / "fig3.json").write_text(json.dumps(summary, indent=2) + "\n")
+    _write(out / "fig3.json", lambda t: t.write_text(json.dumps(summary, indent=2) + "\n"))
     return summary

@@ -17,13 +17,26 @@ import numpy as np
 
 __all__ = ["StabilityMap", "CrossingResult", "CriticalSpeedResult", "open_map"]
 
-_STATUS_MEANINGS = "ok ok_nontrivial_silent_motion no_silent_motion pad_loses_contact invalid_parameters undecided"
+_AUX_UNITS = {"mu": "", "k_ip": "N/m", "h": "m", "R_disk": "m"}
 
 
-def _units(name: str) -> str:
-    from .parameters import UNITS
+def _units(name: str, space: Any = None) -> str:
+    """SI unit of a settable name: from the space's preset (model roles, auxiliary names), else the paper's model."""
+    if space is not None:
+        try:
+            return str(space.preset.unit(name))
+        except Exception:  # an auxiliary name without a unit
+            return ""
+    from .model.library import get_model
 
-    return UNITS.get(name, {"mu": "", "k_ip": "N/m", "h": "m", "R_disk": "m"}.get(name, ""))
+    spec = get_model("paper")
+    return spec.unit(name) if name in spec.parameters else _AUX_UNITS.get(name, "")
+
+
+def _status_attrs() -> dict[str, Any]:
+    from .status import STATUS_MEANINGS, PointStatus
+
+    return {"flag_values": np.array([int(s) for s in PointStatus], dtype=np.int8), "flag_meanings": STATUS_MEANINGS}
 
 
 @dataclass
@@ -40,44 +53,68 @@ class StabilityMap:
         parameter, with coordinates carrying ``units`` (SI) and ``scale``
         (``"linear"`` or ``"log"``) attributes.  Variables:
 
-        * ``max_real``: largest real part of the eigenvalues of eq. (47) [1/s];
-        * ``stable``: bool, silent motion asymptotically stable (certified
-          Hurwitz test); for status 0/1 ``stable`` ⇔ ``max_real < 0``;
-        * ``frequency``: frequency of the least-stable mode [Hz];
-        * ``status``: int8 code, ``0`` ok, ``1`` ok with a non-trivial
-          silent motion, ``2`` no silent motion, ``3`` a pad loses contact,
-          ``4`` invalid parameters, ``5`` undecided (the verdict could not be
-          certified, e.g. exactly on a stability boundary; see its
-          ``flag_meanings``); points with ``status >= 2`` are never stable.
+        * ``stable``: bool, silent motion asymptotically stable (certified);
+          for status 0/1 ``stable`` ⇔ ``max_real < 0``;
+        * ``status``: int8 :class:`~brakesqueal.status.PointStatus` code
+          (``0`` ok, ``1`` ok with a non-trivial silent motion, ``2`` no
+          silent motion, ``3`` a pad loses contact, ``4`` invalid parameters,
+          ``5`` undecided, ``6`` solver failed, ``7`` a pad does not slide;
+          see its ``flag_meanings``); points with ``status >= 2`` are never
+          stable;
+        * ``max_real``: largest real part of the eigenvalues of the linear
+          model [1/s], and ``frequency``: frequency of the least-stable mode
+          [Hz] — only when they were computed (not for verdict-only maps).
 
-        Dataset attributes: ``space`` (preset label), ``settings`` and
-        ``tied`` (JSON), ``method`` and ``criterion``.
+        Dataset attributes: ``model``, ``space`` (preset label), ``settings``
+        and ``tied`` (JSON), ``method`` (the route) and ``criterion``.
     """
 
     data: Any
 
     @classmethod
     def from_arrays(cls, space: Any, outer: Any, inner: Any, *, stable: np.ndarray, status: np.ndarray,
-                    max_real: np.ndarray, frequency: np.ndarray, method: str) -> StabilityMap:
+                    max_real: np.ndarray | None, frequency: np.ndarray | None, method: str) -> StabilityMap:
+        """Build the Dataset from computed arrays (``max_real``/``frequency`` ``None``: not computed, left out).
+
+        Parameters
+        ----------
+        space : ParameterSpace
+            The parameter space of the map.
+        outer, inner : Axis
+            The axes (dimension order).
+        stable, status : ndarray
+            Verdicts and status codes, shape ``(outer.num, inner.num)``.
+        max_real, frequency : ndarray or None
+            Least-stable eigenvalue summary, or ``None``.
+        method : str
+            The route.
+
+        Returns
+        -------
+        StabilityMap
+        """
         import xarray as xr
 
         dims = (outer.name, inner.name)
         coords = {}
         for ax in (outer, inner):
             coords[ax.name] = xr.DataArray(ax.values(), dims=(ax.name,),
-                                           attrs={"units": _units(ax.name), "scale": "log" if ax.log else "linear"})
+                                           attrs={"units": _units(ax.name, space),
+                                                  "scale": "log" if ax.log else "linear"})
+        data: dict[str, Any] = {}
+        if max_real is not None:
+            data["max_real"] = (dims, max_real, {"units": "1/s", "long_name": "largest real part of the eigenvalues"})
+        data["stable"] = (dims, stable, {"long_name": "silent motion asymptotically stable (certified)"})
+        if frequency is not None:
+            data["frequency"] = (dims, frequency, {"units": "Hz", "long_name": "frequency of the least-stable mode"})
+        data["status"] = (dims, status, _status_attrs())
         ds = xr.Dataset(
-            {
-                "max_real": (dims, max_real, {"units": "1/s", "long_name": "largest real part of the eigenvalues"}),
-                "stable": (dims, stable, {"long_name": "silent motion asymptotically stable (Hurwitz)"}),
-                "frequency": (dims, frequency, {"units": "Hz", "long_name": "frequency of the least-stable mode"}),
-                "status": (dims, status, {"flag_values": np.arange(6, dtype=np.int8),
-                                          "flag_meanings": _STATUS_MEANINGS}),
-            },
-            coords=coords,
-            attrs={"space": space.label, "settings": json.dumps({k: str(v) for k, v in space.definitions().items()}),
+            data, coords=coords,
+            attrs={"model": space.model.name, "space": space.label,
+                   "settings": json.dumps({k: str(v) for k, v in space.definitions().items()}),
                    "tied": json.dumps(dict(space.tied)), "method": method,
-                   "criterion": "Lienard-Chipart on det(lambda^2 M + lambda D + K) (certified sign test)"},
+                   "criterion": "certified verdict from every eigenvalue of the linear model about the silent motion "
+                                "(Lienard-Chipart on the exact quartic where the closed form applies)"},
         )
         return cls(ds)
 
@@ -165,9 +202,8 @@ class CrossingResult:
     method : str
         How they were computed (exact roots or numeric linearization).
     space : ParameterSpace or None, optional
-        The parameter space the path lies in (default ``None``); used by
-        :meth:`plot` to evaluate the largest real part along the path.  Not
-        part of :meth:`to_dict`, the repr or comparisons.
+        The parameter space the path lies in (default ``None``).  Not part
+        of :meth:`to_dict`, the repr or comparisons.
     undecided_ranges : tuple of (float, float), optional
         Sub-ranges where the verdict could not be decided (default none);
         crossings inside them may be missing.
@@ -176,6 +212,10 @@ class CrossingResult:
         ``undecided_ranges`` is guaranteed to be listed (exact root
         isolation); ``False`` for grid searches, which can miss two crossings
         closer together than the grid spacing.
+    profile : tuple of ndarray or None, optional
+        ``(values, max_real)`` along the path, computed with the result
+        (NaN where no verdict was established); drawn by :meth:`plot`.  Not
+        part of :meth:`to_dict`, the repr or comparisons.
     """
 
     parameter: str
@@ -188,6 +228,7 @@ class CrossingResult:
     space: Any = field(default=None, repr=False, compare=False)
     undecided_ranges: tuple[tuple[float, float], ...] = ()
     exhaustive: bool = True
+    profile: Any = field(default=None, repr=False, compare=False)
 
     @property
     def complete(self) -> bool:
@@ -205,7 +246,8 @@ class CrossingResult:
         """Dataset with dimension ``crossing``: ``value`` and ``direction`` (+1 stabilizing, -1 destabilizing)."""
         import xarray as xr
 
-        return xr.Dataset({"value": ("crossing", [v for v, _ in self.crossings], {"units": _units(self.parameter)}),
+        return xr.Dataset({"value": ("crossing", [v for v, _ in self.crossings],
+                                     {"units": _units(self.parameter, self.space)}),
                            "direction": ("crossing", np.array([1 if d == "stabilizing" else -1
                                                                for _, d in self.crossings], dtype=np.int8))},
                           attrs={"parameter": self.parameter, "stable_at_start": int(self.stable_at_start)})
@@ -222,11 +264,21 @@ class CrossingResult:
             lines.append("  note: grid search, crossings closer together than the grid spacing may be missing")
         return "\n".join(lines) + "\n"
 
-    def plot(self, ax: Any = None, n: int = 400) -> Any:
-        """Largest real part along the path (numeric linearization) with the crossings marked; returns the figure."""
+    def plot(self, ax: Any = None) -> Any:
+        """Largest real part along the path (the stored :attr:`profile`) with the crossings marked; returns the figure.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Axes to draw into (default: a new figure).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
         from .plotting import plot_path
 
-        return plot_path(self, ax=ax, n=n)
+        return plot_path(self, ax=ax)
 
 
 @dataclass(frozen=True)
@@ -253,11 +305,13 @@ class CriticalSpeedResult(CrossingResult):
         How they were computed (compiled kernel or
         :func:`~brakesqueal.analysis.crossings.crossings`).
     space : ParameterSpace or None, optional
-        The parameter space (default ``None``), used by :meth:`plot`.
+        The parameter space (default ``None``).
     undecided_ranges : tuple of (float, float), optional
         Ω sub-ranges where the verdict could not be decided.
     exhaustive : bool, optional
         Whether every crossing outside ``undecided_ranges`` is guaranteed listed.
+    profile : tuple of ndarray or None, optional
+        ``(Omega, max_real)`` along the range, drawn by :meth:`plot`.
     """
 
     @property

@@ -11,11 +11,20 @@ such as π carried with 80 significant digits), and the verdict is evaluated
 exactly between consecutive roots.  Nothing is read from a grid and nothing
 overflows, so ``--along k_ip=1e-100:1e100:log`` is as exact as ``1e5:1e10``.
 
-The numeric fallback (non-trivial silent motion, non-rational ties) brackets
-sign changes of the certified per-point verdict on a grid and polishes with
-Brent's method; it is marked ``exhaustive=False`` (two crossings closer than
-the grid spacing can be missed) and points it cannot decide are reported in
-``undecided_ranges``.
+This exact route applies to any model with a closed form (two coordinates,
+rate-free pads: :func:`~.kernels.model_form`) whose silent motion is
+identically trivial along the path; the closed form is generated from the
+model (:func:`~brakesqueal.symbolic.linearize.model_closed_form`).  Every
+other case (more coordinates, pads with first-order dynamics, non-trivial
+silent motions, non-rational ties) uses the numeric route: the certified
+per-point verdict of :mod:`.points` on a grid, sign changes bracketed and
+polished with Brent's method on the largest real part.  It is marked
+``exhaustive=False`` (two crossings closer than the grid spacing can be
+missed) and points it cannot decide are reported in ``undecided_ranges``; it
+never claims "stable throughout".
+
+Every result stores the largest real part along the path (``profile``),
+computed when the result is made, for its plot.
 """
 
 from __future__ import annotations
@@ -26,14 +35,20 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError, SilentMotionError
-from ..expressions import names_in
-from .kernels import QuarticNumerators, critical_speeds_batch, quartic_numerators
+from ..errors import ParameterError
+from ..model.expressions import names_in
+from ..status import PointStatus
+from .kernels import QuarticNumerators, critical_speeds_batch, omega_kernel_available, quartic_numerators
 from .maps import Axis
 from .robust import isolate_real_roots
-from .space import ParameterSpace
 
-__all__ = ["crossings", "critical_speeds", "critical_speeds_many", "exact_crossings", "exact_omega_crossings"]
+__all__ = ["crossings", "critical_speeds", "critical_speeds_many", "exact_crossings", "exact_omega_crossings",
+           "omega_name", "PROFILE_POINTS", "NUMERIC_GRID"]
+
+#: Points of the stored ``max_real`` profile of a path (for plots).
+PROFILE_POINTS = 200
+#: Grid points of the numeric route.
+NUMERIC_GRID = 801
 
 _DIGITS = 80
 
@@ -130,8 +145,11 @@ def exact_crossings(qn: QuarticNumerators, lo: float, hi: float, log: bool = Tru
     log : bool
         Place test points geometrically (only where the verdict is sampled).
     valid : callable, optional
-        ``valid(x: float) -> bool``; pieces whose test point is invalid are
-        reported as undecided.
+        ``valid(x: float) -> bool``; a piece between candidates is decided at
+        a valid test point (the verdict is constant on the piece) and, if
+        one of its test points was invalid, reported in the undecided ranges
+        too (it holds invalid parameter sets); a piece without a valid test
+        point is undecided.
 
     Returns
     -------
@@ -163,13 +181,17 @@ def exact_crossings(qn: QuarticNumerators, lo: float, hi: float, log: bool = Tru
     edges = [lo_q] + [x for a, b in merged for x in (a, b)] + [hi_q]
     pieces = [(edges[2 * k], edges[2 * k + 1]) for k in range(len(merged) + 1)]
     verdicts: list[int | None] = []
+    partly_invalid: list[tuple[float, float]] = []
     for a, b in pieces:
         v = None
         if b > a:
-            for frac in (0.5, 0.25, 0.75, 0.125, 0.875):
+            for frac in (0.5, 0.25, 0.75, 0.125, 0.875, 0.0625, 0.9375):
                 x = _split_point(a, b, log, frac)
                 if valid is not None and not valid(float(x)):
-                    break
+                    # the verdict is constant on the piece, but not every parameter set of it is valid
+                    if not partly_invalid or partly_invalid[-1] != (float(a), float(b)):
+                        partly_invalid.append((float(a), float(b)))
+                    continue
                 v = _verdict(N, x, exact)
                 if v is not None:
                     break
@@ -193,7 +215,7 @@ def exact_crossings(qn: QuarticNumerators, lo: float, hi: float, log: bool = Tru
             prev = v
         else:
             prev = None
-    return start, found, _merge_ranges(undecided)
+    return start, found, _merge_ranges(undecided + partly_invalid)
 
 
 def _merge_ranges(r: list[tuple[float, float]]) -> list[tuple[float, float]]:
@@ -206,89 +228,123 @@ def _merge_ranges(r: list[tuple[float, float]]) -> list[tuple[float, float]]:
     return out
 
 
-def exact_omega_crossings(p: np.ndarray, lo: float, hi: float
+def exact_omega_crossings(p: np.ndarray, lo: float, hi: float, spec: Any = None
                           ) -> tuple[bool, list[tuple[float, str]], list[tuple[float, float]]]:
     """Exact stability changes along Ω in ``(lo, hi)`` for one parameter vector (trivial silent motion).
 
-    The closed-form matrices are evaluated with the (exact rational) parameter
-    values and Ω symbolic; see :func:`exact_crossings`.
+    Parameters
+    ----------
+    p : ndarray
+        Parameter vector in the model's packing order (compliances; Ω ignored).
+    lo, hi : float
+        The Ω range [rad/s].
+    spec : ModelSpec, optional
+        The model (default: the paper's); it needs a closed form with a named spin.
+
+    Returns
+    -------
+    stable_at_start, crossings, undecided
+        See :func:`exact_crossings`.  The closed-form matrices are evaluated
+        with the (exact rational) parameter values and Ω symbolic.
     """
     import sympy as sp
 
-    from .kernels import QuarticNumerators, _closed_form_compliance, _quartic_field
-    from .space import VECTOR_NAMES
+    from .kernels import _form, _paper, _quartic_field
 
-    M, D, K, syms = _closed_form_compliance()
+    form = _form(spec if spec is not None else _paper())
     W = sp.Symbol("X0", positive=True)
-    sub = {syms[n]: (W if n == "Omega" else sp.Rational(float(v))) for n, v in zip(VECTOR_NAMES, p)}
-    entries = [e.xreplace(sub) for X in (M, D, K) for e in X]
+    sub = {s: (W if n == form.omega else sp.Rational(float(v))) for n, s, v in zip(form.names, form.symbols, p)}
+    entries = [e.xreplace(sub) for X in (form.M, form.D, form.K) for e in X]
     res = _quartic_field(entries, [W])
-    if res is None:  # cannot happen for the closed form
+    if res is None:  # cannot happen for a Laurent closed form
         return False, [], [(lo, hi)]
     Nn, den, consts = res
     return exact_crossings(QuarticNumerators(("Omega",), consts, Nn, den), lo, hi, True)
 
 
-def _numeric(space: ParameterSpace, axis: Axis, n: int = 801
-             ) -> tuple[bool, list[tuple[float, str]], list[tuple[float, float]]]:
+def _grid(axis: Axis, n: int) -> np.ndarray:
+    return Axis(axis.name, axis.start, axis.stop, n, axis.log).values()
+
+
+def _profile(space: Any, axis: Axis, n: int = PROFILE_POINTS) -> tuple[np.ndarray, np.ndarray]:
+    """``(values, max_real)`` along a path from the per-point evaluator (NaN where undecidable)."""
+    from .points import evaluate
+
+    grid = _grid(axis, n)
+    r = evaluate(space, {axis.name: grid})
+    return grid, np.where(np.isin(r.status, _DECIDED), r.max_real, np.nan)
+
+
+_DECIDED = (int(PointStatus.OK), int(PointStatus.OK_NONTRIVIAL))
+
+
+def _numeric(space: Any, axis: Axis, n: int = NUMERIC_GRID
+             ) -> tuple[bool, list[tuple[float, str]], list[tuple[float, float]], tuple[np.ndarray, np.ndarray]]:
+    """Certified per-point verdicts on a grid, sign changes bracketed, Brent on max Re λ."""
     from scipy.optimize import brentq
 
-    from .maps import numeric_point_verdict
+    from .points import evaluate, evaluate_point
 
-    grid = Axis(axis.name, axis.start, axis.stop, n, axis.log).values()
-
-    def verdict(v: float) -> tuple[int, bool, float]:
-        code, st, mr, _ = numeric_point_verdict(space, {axis.name: float(v)})
-        return code, st, mr
-
-    vs = [verdict(v) for v in grid]
-    out: list[tuple[float, str]] = []
+    grid = _grid(axis, n)
+    r = evaluate(space, {axis.name: grid})
+    ok = np.isin(r.status, _DECIDED)
+    st = r.stable & ok
+    mr = r.max_real
     undecided: list[tuple[float, float]] = []
-    ok = [c <= 1 for c, _, _ in vs]
-    for k in range(n):
-        if not ok[k]:
-            undecided.append((float(grid[max(k - 1, 0)]), float(grid[min(k + 1, n - 1)])))
-    for k in range(n - 1):
-        (ca, sa, ma), (cb, sb, mb) = vs[k], vs[k + 1]
-        if not (ok[k] and ok[k + 1]) or sa == sb:
+    for k in np.flatnonzero(~ok):
+        undecided.append((float(grid[max(k - 1, 0)]), float(grid[min(k + 1, n - 1)])))
+    out: list[tuple[float, str]] = []
+
+    def f(v: float) -> float:
+        return evaluate_point(space, {axis.name: v}).max_real
+
+    dec = np.flatnonzero(ok)
+    for k0, k1 in zip(dec[:-1], dec[1:]):
+        # consecutive decided points; undecided ones (status UNDECIDED: max Re λ at the error bound) may lie in
+        # between and stay in undecided_ranges, other failures (no silent motion, invalid) separate the pieces
+        if st[k0] == st[k1] or not np.all(r.status[k0 + 1:k1] == int(PointStatus.UNDECIDED)):
             continue
-        a, b = grid[k], grid[k + 1]
-        x = a
-        if math.isfinite(ma) and math.isfinite(mb) and ma * mb < 0:
-            x = brentq(lambda v: verdict(v)[2], a, b, xtol=1e-300, rtol=1e-15, maxiter=200)
-        out.append((float(x), "stabilizing" if sb else "destabilizing"))
-    return bool(vs[0][1]), out, _merge_ranges(undecided)
+        a, b = float(grid[k0]), float(grid[k1])
+        x = math.sqrt(a * b) if axis.log else 0.5 * (a + b)
+        if math.isfinite(mr[k0]) and math.isfinite(mr[k1]) and mr[k0] * mr[k1] < 0:
+            try:
+                x = brentq(f, a, b, xtol=1e-300, rtol=1e-15, maxiter=200)
+            except ValueError:  # the sign of max Re λ is not continuous in between (a status change)
+                undecided.append((a, b))
+        out.append((float(x), "stabilizing" if st[k1] else "destabilizing"))
+    prof = (grid, np.where(ok, mr, np.nan))
+    return bool(st[0]), out, _merge_ranges(undecided), prof
 
 
-def _valid_fn(space: ParameterSpace, name: str) -> Any:
+def _valid_fn(space: Any, name: str) -> Any:
     def valid(x: float) -> bool:
         try:
             space.resolve({name: x})
-        except (ParameterError, SilentMotionError, ValueError, ZeroDivisionError, OverflowError):
+        except (ParameterError, ValueError, ZeroDivisionError, OverflowError):
             return False
         return True
 
     return valid
 
 
-def crossings(space: ParameterSpace, axis: Axis) -> object:
+def crossings(space: Any, axis: Axis) -> object:
     """Every value of ``axis.name`` in ``(start, stop)`` where stability of the silent motion changes.
 
     Stability is that of the linearized equations (47) about the silent
-    motion (eq. 46), decided by the Liénard–Chipart criterion on the
-    characteristic quartic ``det(λ² Mbar + λ Dbar + Kbar) = a4 λ⁴ + ... + a0``.
+    motion (eq. 46), with every eigenvalue of the linear model (the pads'
+    own modes included where they keep first-order dynamics).
 
     Parameters
     ----------
     space : ParameterSpace
-        The preset (with overrides) or complete parameter set; every other
-        settable name keeps its value in ``space`` and tied names follow.
+        The model, preset and overrides (any model); every other settable
+        name keeps its value in ``space`` and tied names follow.
     axis : Axis
         The path: ``axis.name`` must be a settable name of ``space``;
         ``start`` and ``stop`` bound it (SI unit of the parameter; any width,
         e.g. ``1e-100`` to ``1e100``).  ``log`` only selects where stability is
         sampled between candidates (geometric instead of arithmetic
-        midpoints) and the spacing of the numeric fallback's grid; ``num`` is
+        midpoints) and the spacing of the numeric route's grid; ``num`` is
         ignored.
 
     Returns
@@ -297,7 +353,8 @@ def crossings(space: ParameterSpace, axis: Axis) -> object:
         ``stable_at_start`` (verdict just above ``start``) and the crossings
         with their direction (``"destabilizing"``: stable before, unstable
         after, in the direction of increasing parameter), in increasing order,
-        ``method``, ``undecided_ranges`` and ``exhaustive``.
+        ``method``, ``undecided_ranges``, ``exhaustive`` and the stored
+        ``profile`` of max Re λ along the path.
 
     Raises
     ------
@@ -307,17 +364,16 @@ def crossings(space: ParameterSpace, axis: Axis) -> object:
 
     Notes
     -----
-    When the closed-form quartic is rational in the parameter and the silent
-    motion is trivial along the whole path (eq. 49), the candidates are the
-    real roots of the exact numerators of ``a0``, ``a4``, of the Hurwitz
-    determinant ``H3 = a1 (a2 a3 - a1 a4) - a0 a3²`` and of the common
-    denominator, isolated exactly on the whole range; the result is complete
-    and exact (crossing values to ~1e-15 relative).  Sub-ranges whose
-    parameters are invalid are reported in ``undecided_ranges``.  Otherwise
-    the numeric linearization is evaluated on an 801-point grid along the
-    path, sign changes of the certified verdict are bracketed and the
-    crossing is polished with Brent's method on the largest real part
-    (``exhaustive=False``).
+    Exact route (model with a closed form, silent motion identically trivial
+    along the path, rational dependence): the candidates are the real roots
+    of the exact numerators of ``a0``, ``a4``, of the Hurwitz determinant
+    ``H3 = a1 (a2 a3 - a1 a4) - a0 a3²`` and of the common denominator,
+    isolated exactly on the whole range; the result is complete and exact
+    (crossing values to ~1e-15 relative).  Sub-ranges whose parameters are
+    invalid are reported in ``undecided_ranges``.  Otherwise the certified
+    per-point verdict (:mod:`.points`) on a grid of :data:`NUMERIC_GRID`
+    points is bracketed and polished with Brent's method on the largest
+    real part (``exhaustive=False``).
     """
     from ..results import CrossingResult
 
@@ -327,91 +383,130 @@ def crossings(space: ParameterSpace, axis: Axis) -> object:
     if qn is not None:
         start, found, undecided = exact_crossings(qn, axis.start, axis.stop, axis.log, _valid_fn(space, axis.name))
         method, exhaustive = "exact (isolated real roots of the Hurwitz polynomials of the closed form)", True
+        prof = _profile(space, axis)
     else:
-        start, found, undecided = _numeric(space, axis)
-        method, exhaustive = "numeric linearization (certified verdicts on an 801-point grid + Brent)", False
+        start, found, undecided, prof = _numeric(space, axis)
+        method = (f"numeric (certified per-point verdicts on a {NUMERIC_GRID}-point grid + Brent on max Re lambda; "
+                  "grid search)")
+        exhaustive = False
     return CrossingResult(parameter=axis.name, start=axis.start, stop=axis.stop, log=axis.log,
                           stable_at_start=start, crossings=tuple(found), method=method, space=space,
-                          undecided_ranges=tuple(undecided), exhaustive=exhaustive)
+                          undecided_ranges=tuple(undecided), exhaustive=exhaustive, profile=prof)
 
 
-def _omega_batchable(space: ParameterSpace) -> bool:
-    if any("Omega" in names_in(e) for e in space.tied.values()):
+def omega_name(space: Any) -> str:
+    """The name of the disk's spin parameter of the space's model (a settable name of ``space``).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space.
+
+    Returns
+    -------
+    str
+        ``spec.disk.Omega`` (``"Omega"`` for the built-in models).
+
+    Raises
+    ------
+    ParameterError
+        If the spin is a fixed number of the model, or tied / not settable in ``space``.
+    """
+    spec = space.model
+    name = spec.disk.Omega
+    if not isinstance(name, str):
+        raise ParameterError(f"model '{spec.name}': the disk's spin Omega is the number {name!r}, not a parameter; "
+                             "critical speeds need it as a parameter")
+    space.check_axis(name)
+    return name
+
+
+def _omega_batchable(space: Any, name: str) -> bool:
+    if not omega_kernel_available(space.model):
         return False
-    return space.resolve({}).trivial_silent_motion()
+    if any(name in names_in(e) for e in space.tied.values()):
+        return False
+    return quartic_numerators(space, ()) is not None
 
 
-def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5) -> object:
+def critical_speeds(space: Any, lo: float = 1.0, hi: float = 1e5) -> object:
     """All onsets and re-stabilisations of squeal along the spin rate Ω in ``(lo, hi)`` [rad/s].
 
-    Uses the certified compiled Laurent-polynomial kernel when the silent
-    motion is trivial (eq. 49) and no tied name depends on ``Omega`` (sets it
-    cannot certify are recomputed by exact root isolation; at most 16
-    crossings reported), otherwise :func:`crossings` along a logarithmic Ω
-    axis.  The smallest destabilizing Ω is the critical speed ``Omega_crit``
-    of the paper's Fig. 3.  Any range ``0 < lo < hi`` is handled (split into
+    Uses the certified compiled Laurent-polynomial kernel when the model has
+    a closed form, the silent motion is trivial (exactly, for every Ω) and
+    no tied name depends on Ω (sets it cannot certify are recomputed by exact
+    root isolation; at most 16 crossings reported), otherwise
+    :func:`crossings` along a logarithmic Ω axis (exact or numeric).  The
+    smallest destabilizing Ω is the critical speed ``Omega_crit`` of the
+    paper's Fig. 3.  Any range ``0 < lo < hi`` is handled (split into
     sub-ranges internally).
 
     Parameters
     ----------
     space : ParameterSpace
-        The preset (with overrides) or complete parameter set; ``Omega`` must
-        be one of its settable names (not tied).
+        The model, preset and overrides (any model); the disk's spin
+        (:func:`omega_name`) must be one of its settable names (not tied).
     lo, hi : float, optional
         The Ω range [rad/s], ``0 < lo < hi`` (default ``1.0`` to ``1e5``).
 
     Returns
     -------
     CriticalSpeedResult
-        Crossings along ``Omega`` (``log=True``); its ``Omega_crit`` is the
-        first destabilizing one, or ``None``; ``Omega_crit_certain`` and
-        ``undecided_ranges`` state what is established.
+        Crossings along Ω (``log=True``); its ``Omega_crit`` is the first
+        destabilizing one, or ``None``; ``Omega_crit_certain``,
+        ``undecided_ranges`` and ``exhaustive`` state what is established.
 
     Raises
     ------
     ParameterError
-        If ``Omega`` is tied or not settable in ``space``, the range is empty,
+        If Ω is fixed, tied or not settable in ``space``, the range is empty,
         reversed or not positive, or the parameters are invalid.
     """
     from ..results import CriticalSpeedResult
 
-    axis = Axis("Omega", lo, hi, 2, True)
-    space.check_axis("Omega")
-    if _omega_batchable(space):
+    name = omega_name(space)
+    axis = Axis(name, lo, hi, 2, True)
+    if not (0 < lo):
+        raise ParameterError(f"the Omega range needs 0 < START < STOP; got {lo!r}:{hi!r}")
+    space.resolve({name: lo})
+    if _omega_batchable(space, name):
         from .equilibrium import parameter_vector
 
         p = np.array([parameter_vector(space.resolve({}))])
-        roots, dirs, counts, start, status = critical_speeds_batch(p, lo, hi, max_crossings=16, return_status=True)
+        roots, dirs, counts, start, status = critical_speeds_batch(p, lo, hi, max_crossings=16, return_status=True,
+                                                                   spec=space.model)
         found = tuple((float(roots[0, k]), "stabilizing" if dirs[0, k] > 0 else "destabilizing")
                       for k in range(min(int(counts[0]), 16)))
         undecided: tuple[tuple[float, float], ...] = ()
         if status[0] != 0:
-            _, _, und = exact_omega_crossings(p[0], lo, hi)
+            _, _, und = exact_omega_crossings(p[0], lo, hi, space.model)
             undecided = tuple(und) or ((lo, hi),)
-        return CriticalSpeedResult(parameter="Omega", start=lo, stop=hi, log=True, stable_at_start=bool(start[0]),
+        return CriticalSpeedResult(parameter=name, start=lo, stop=hi, log=True, stable_at_start=bool(start[0]),
                                    crossings=found, method="exact (certified compiled Laurent-polynomial Hurwitz "
-                                   "kernel, exact rational fallback)", space=space, undecided_ranges=undecided)
+                                   "kernel, exact rational fallback)", space=space, undecided_ranges=undecided,
+                                   profile=_profile(space, axis))
     r = crossings(space, axis)
-    return CriticalSpeedResult(parameter="Omega", start=lo, stop=hi, log=True, stable_at_start=r.stable_at_start,
+    return CriticalSpeedResult(parameter=name, start=lo, stop=hi, log=True, stable_at_start=r.stable_at_start,
                                crossings=r.crossings, method=r.method, space=space,
-                               undecided_ranges=r.undecided_ranges, exhaustive=r.exhaustive)
+                               undecided_ranges=r.undecided_ranges, exhaustive=r.exhaustive, profile=r.profile)
 
 
-def critical_speeds_many(space: ParameterSpace, changes: dict[str, np.ndarray], lo: float = 1.0, hi: float = 1e5,
-                         max_crossings: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Batched critical speeds over arrays of settable values (trivial silent motion required).
+def critical_speeds_many(space: Any, changes: dict[str, np.ndarray], lo: float = 1.0, hi: float = 1e5,
+                         max_crossings: int = 8, *, return_status: bool = False) -> tuple[np.ndarray, ...]:
+    """Critical speeds for many parameter sets (arrays of settable values), batched where possible.
 
-    Each of the ``n`` points resolves ``space`` with the values of
-    ``changes`` at that index, then the certified compiled kernel of
-    :func:`~brakesqueal.analysis.kernels.critical_speeds_batch` finds every
-    stability change along Ω in ``(lo, hi)`` (exact fallback per set).  Tied
-    names are evaluated with the space's own value of ``Omega`` (use
-    :func:`critical_speeds` when one depends on ``Omega``).
+    Each of the ``n`` points sets ``space``'s names to the values of
+    ``changes`` at that index.  Points whose silent motion is trivial, of a
+    model with a closed form and no tie depending on Ω, go through the
+    certified compiled kernel of
+    :func:`~brakesqueal.analysis.kernels.critical_speeds_batch` (every
+    stability change in ``(lo, hi)``, exact fallback per set); every other
+    point through :func:`critical_speeds` one by one (exact or numeric).
 
     Parameters
     ----------
     space : ParameterSpace
-        The preset (with overrides) or complete parameter set.
+        The model, preset and overrides (any model).
     changes : dict of str to array_like
         Settable names of ``space`` → values in their SI units; scalars and
         1-D arrays, broadcast to a common length ``n`` (an empty dict gives
@@ -421,6 +516,11 @@ def critical_speeds_many(space: ParameterSpace, changes: dict[str, np.ndarray], 
     max_crossings : int, optional
         Columns of the output arrays (default 8); further crossings are only
         counted.
+    return_status : bool, optional
+        Also return a per-set status (``PointStatus.OK``: complete and
+        exhaustive; ``PointStatus.UNDECIDED``: a part of the range is
+        undecided or the search was not exhaustive, so an onset may be
+        missing).
 
     Returns
     -------
@@ -432,25 +532,58 @@ def critical_speeds_many(space: ParameterSpace, changes: dict[str, np.ndarray], 
         Number of crossings found (may exceed ``max_crossings``).
     stable_at_start : ndarray of bool, shape (n,)
         Verdict just above ``lo``.
+    status : ndarray of int8, shape (n,), only with ``return_status``
 
     Raises
     ------
     ParameterError
-        If a name is tied or not settable, a point has invalid parameters, or
-        its silent motion is not trivial (``mu1 h10 != mu2 h20``, eq. 49).
+        If a name is tied or not settable, Ω is not a settable parameter, the
+        range is not ``0 < lo < hi``, or a point has invalid parameters.
     """
-    from .equilibrium import parameter_vector
+    from .points import _is_trivial, _Model, valid_points
 
-    Axis("Omega", lo, hi, 2, True)
+    name = omega_name(space)
+    Axis(name, lo, hi, 2, True)
     names = list(changes)
     for n in names:
         space.check_axis(n)
     n_pts = np.broadcast(*changes.values()).size if changes else 1
     cols = {k: np.broadcast_to(np.asarray(v, dtype=float), (n_pts,)) for k, v in changes.items()}
-    P = np.empty((n_pts, 17))
-    for i in range(n_pts):
-        prm = space.resolve({k: float(v[i]) for k, v in cols.items()})
-        if not prm.trivial_silent_motion():
-            raise ParameterError("critical_speeds_many needs a trivial silent motion (mu1*h10 = mu2*h20, eq. 49)")
-        P[i] = parameter_vector(prm)
-    return critical_speeds_batch(P, lo, hi, max_crossings)  # type: ignore[return-value]
+    if cols:
+        arr = space.arrays(cols)
+        valid = np.broadcast_to(valid_points(space, arr), (n_pts,))
+        if not valid.all():
+            i = int(np.flatnonzero(~valid)[0])
+            space.resolve({k: float(v[i]) for k, v in cols.items()})  # raises the one-line message
+            raise ParameterError(f"invalid parameters at point {i} of critical_speeds_many")
+    else:
+        space.resolve({})
+        arr = space.arrays({})
+    vecs = space.vectors(arr)
+    P = np.stack([np.broadcast_to(np.asarray(v, dtype=float), (n_pts,)) for v in vecs], axis=1)
+    roots = np.full((n_pts, max_crossings), np.nan)
+    dirs = np.zeros((n_pts, max_crossings), dtype=np.int8)
+    counts = np.zeros(n_pts, dtype=np.int64)
+    start = np.zeros(n_pts, dtype=bool)
+    status = np.zeros(n_pts, dtype=np.int8)
+    fast = np.zeros(n_pts, dtype=bool)
+    if omega_kernel_available(space.model) and not any(name in names_in(e) for e in space.tied.values()):
+        fast = _is_trivial(_Model.of(space.model), P)
+    ix = np.flatnonzero(fast)
+    if ix.size:
+        r, d, c, s0, st = critical_speeds_batch(P[ix], lo, hi, max_crossings, return_status=True, spec=space.model)
+        roots[ix], dirs[ix], counts[ix], start[ix] = r, d, c, s0
+        status[ix] = np.where(st != 0, int(PointStatus.UNDECIDED), int(PointStatus.OK))
+    for i in np.flatnonzero(~fast):
+        sub = space.with_values({k: float(v[i]) for k, v in cols.items()})
+        res = critical_speeds(sub, lo, hi)
+        found = list(res.crossings)  # type: ignore[attr-defined]
+        for k, (v, dd) in enumerate(found[:max_crossings]):
+            roots[i, k] = v
+            dirs[i, k] = 1 if dd == "stabilizing" else -1
+        counts[i] = len(found)
+        start[i] = bool(res.stable_at_start)  # type: ignore[attr-defined]
+        status[i] = int(PointStatus.OK) if res.complete else int(PointStatus.UNDECIDED)  # type: ignore[attr-defined]
+    if return_status:
+        return roots, dirs, counts, start, status
+    return roots, dirs, counts, start

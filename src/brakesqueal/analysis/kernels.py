@@ -20,9 +20,17 @@ recomputes it by a robust route (:mod:`.robust`).
 
 Generated / compiled pieces:
 
-* :func:`quartic_numerators` — the closed form (``closed_form("general")``,
-  trivial silent motion) specialised to a parameter space with some axes
-  symbolic; entries are converted to elements of a rational function field
+* :func:`model_form` — the closed form of any model with two coordinates and
+  rate-free pads (:func:`~brakesqueal.symbolic.linearize.model_closed_form`,
+  tangential stiffnesses as compliance symbols, packing order
+  ``spec.parameters``); for the paper's model it equals
+  ``closed_form("general")``.  Everything generated from it is keyed by the
+  model's :func:`~brakesqueal.codegen.model_key` (and the parameter space's
+  :meth:`~brakesqueal.model.parameters.ParameterSpace.key`).
+* :func:`quartic_numerators` — the closed form (trivial silent motion)
+  specialised to a parameter space with some axes symbolic, after checking
+  that every zero-state residual of the model vanishes identically under the
+  space's ties (the silent motion is trivial on the whole grid); entries are converted to elements of a rational function field
   (``sympy.polys.fields``, exact rational arithmetic with cancellation), so
   ``a_i = N_i / Den`` with small, exact numerator polynomials.  Constants such
   as π are extra generators.
@@ -46,17 +54,18 @@ from __future__ import annotations
 import hashlib
 import math
 from dataclasses import dataclass
-from functools import lru_cache
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
-from .space import VECTOR_NAMES, ParameterSpace
+if TYPE_CHECKING:
+    from ..model.parameters import ParameterSpace
 
 __all__ = [
-    "quartic_coefficients", "hurwitz_h3", "hurwitz_stable", "QuarticNumerators", "quartic_numerators",
-    "GridKernel", "grid_kernel", "MapKernel", "map_kernel", "classify_numpy", "real_roots", "trivial_entries",
-    "omega_entries", "omega_coefficients", "critical_speeds_batch", "omega_subranges",
+    "quartic_coefficients", "hurwitz_h3", "hurwitz_stable", "ModelForm", "model_form", "QuarticNumerators",
+    "quartic_numerators", "GridKernel", "grid_kernel", "MapKernel", "map_kernel", "classify_numpy", "real_roots",
+    "trivial_entries", "omega_entries", "omega_coefficients", "omega_kernel_available", "critical_speeds_batch",
+    "omega_subranges", "inner_exponent", "kernel_segments", "run_classify", "kernel_scaling",
 ]
 
 _U = 2.0 ** -53
@@ -100,33 +109,164 @@ def hurwitz_stable(a0: Any, a1: Any, a2: Any, a3: Any, a4: Any) -> Any:
     return (a0 > 0) & (a1 > 0) & (a2 > 0) & (a3 > 0) & (a4 > 0) & (hurwitz_h3(a0, a1, a2, a3, a4) > 0)
 
 
-# ---------------------------------------------------------------- symbolic helpers
-@lru_cache(maxsize=1)
-def _closed_form_compliance() -> tuple[Any, Any, Any, dict[str, Any]]:
-    """General closed form (trivial silent motion) with ``k_ip1, k_ip2`` replaced by compliances."""
+# ---------------------------------------------------------------- model closed forms
+@dataclass(frozen=True, eq=False)
+class ModelForm:
+    """Closed-form ``M, D, K`` of a 2-DOF model about its zero state, in packing symbols.
+
+    Built by :func:`model_form` from :func:`~brakesqueal.symbolic.linearize.model_closed_form`.
+
+    Attributes
+    ----------
+    key : str
+        :func:`~brakesqueal.codegen.model_key` of the model.
+    names : tuple of str
+        Model parameters in packing order (``spec.parameters``).
+    symbols : tuple
+        SymPy symbol of every packing slot: the parameter itself, or its
+        compliance ``c = 1/k`` for a tangential stiffness (named like the
+        generated code's parameters, e.g. ``c_ip1``).
+    compliance : tuple of bool
+        Whether a slot holds a compliance.
+    M, D, K : sympy.Matrix
+        ``2 x 2`` matrices of eq. (47) in :attr:`symbols`.
+    model_symbols : dict
+        Model parameter name -> the SymPy symbol used in :attr:`residuals`
+        (positive, ``h`` names real, as in ``model_closed_form``).
+    residuals : tuple
+        The residuals ``R, G`` at the zero state in :attr:`model_symbols`
+        (non-zero ones only): the silent motion is the zero state exactly
+        where they vanish.
+    omega : str or None
+        Name of the disk's spin parameter (``None`` when the spin is a number).
+    omega_free : bool
+        Whether :attr:`residuals` do not depend on the spin (then the silent
+        motion is trivial for every spin when it is for one).
+    """
+
+    key: str
+    names: tuple[str, ...]
+    symbols: tuple[Any, ...]
+    compliance: tuple[bool, ...]
+    M: Any
+    D: Any
+    K: Any
+    model_symbols: dict[str, Any]
+    residuals: tuple[Any, ...]
+    omega: str | None
+    omega_free: bool
+
+    @property
+    def by_name(self) -> dict[str, Any]:
+        """Packing symbol by model parameter name."""
+        return dict(zip(self.names, self.symbols))
+
+
+_MEMO: dict[Any, Any] = {}
+_MEMO_MAX = 256
+
+
+def _memo(key: Any, build: Callable[[], Any]) -> Any:
+    """Process-wide memo of generated objects keyed by model key and space key (bounded, FIFO)."""
+    if key in _MEMO:
+        return _MEMO[key]
+    value = build()
+    if len(_MEMO) >= _MEMO_MAX:
+        _MEMO.pop(next(iter(_MEMO)))
+    _MEMO[key] = value
+    return value
+
+
+def _key(spec: Any) -> str:
+    from ..codegen import model_key
+
+    return model_key(spec)
+
+
+def model_form(spec: Any) -> ModelForm | None:
+    """The closed form of a model for the generated kernels, or ``None`` where it does not apply.
+
+    It applies to models with two coordinates whose pads are all rate-free at
+    the zero state (:attr:`CompiledModel.rate_free_at_zero
+    <brakesqueal.codegen.compiled.CompiledModel.rate_free_at_zero>`) and whose
+    pads are, provably from the parameter roles, in sliding contact there
+    (normal force and sliding speed positive); the others use the per-point
+    routes of :mod:`.points`.
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+
+    Returns
+    -------
+    ModelForm or None
+        Memoized by :func:`~brakesqueal.codegen.model_key`.
+    """
+    return _memo(("form", _key(spec)), lambda: _build_form(spec))
+
+
+def _build_form(spec: Any) -> ModelForm | None:
     import sympy as sp
 
-    from ..symbolic.linearize import closed_form
+    from ..codegen import compile_model
+    from ..symbolic.assemble import build_equations
+    from ..symbolic.linearize import model_closed_form
 
-    cf = closed_form("general")
+    cm = compile_model(spec)
+    if cm.n != 2 or not all(cm.rate_free_at_zero):
+        return None
+    cf = model_closed_form(spec)
+    if cf.rate_blocks:
+        return None
     S = cf.symbols
-    c1, c2 = sp.Symbol("c_ip1", nonnegative=True), sp.Symbol("c_ip2", nonnegative=True)
-    rep = {S["k_ip1"]: 1 / c1, S["k_ip2"]: 1 / c2}
+    kip = set(spec.stiffness_names())
+    names = tuple(spec.parameters)
+    comp = tuple(n in kip for n in names)
+    syms = tuple(sp.Symbol(pn, nonnegative=True) if c else S[n] for n, pn, c in zip(names, cm.param_names, comp))
+    rep = {S[n]: 1 / s for n, s, c in zip(names, syms, comp) if c}
 
     def conv(m: Any) -> Any:
         return m.xreplace(rep).applyfunc(sp.cancel)
 
-    syms = {n: (c1 if n == "c_ip1" else c2 if n == "c_ip2" else S[n]) for n in VECTOR_NAMES}
-    return conv(cf.M), conv(cf.D), conv(cf.K), syms
+    # zero-state residuals and contact in the model's (positive) symbols: sqrt(Omega^2 r^2) -> Omega r
+    eq = build_equations(spec, "symengine")
+    back = {sp.Symbol(pn): (1 / S[n] if c else S[n]) for n, pn, c in zip(names, eq.param_names, comp)}
+    zero = {s: 0 for s in eq.x}
+
+    def at_zero(e: Any) -> Any:
+        return sp.factor_terms(sp.cancel(sp.sympify(e.subs(zero)).xreplace(back)))
+
+    rows = list(eq.R) + (list(eq.G) if eq.G is not None else [])
+    residuals = tuple(r for r in (at_zero(e) for e in rows) if r != 0)
+    for c in eq.pads:
+        fn = at_zero(c.F_n)
+        speed2 = at_zero(sum((v * v for v in c.v_r), 0))
+        if not (fn.is_positive and speed2.is_positive):
+            return None
+    M, D, K = conv(cf.M), conv(cf.D), conv(cf.K)
+    try:
+        for X in (M, D, K):
+            for e in X:
+                _terms(e, list(syms))
+    except NotImplementedError:  # not a Laurent polynomial in the parameters: no generated kernels
+        return None
+    omega = spec.disk.Omega if isinstance(spec.disk.Omega, str) else None
+    omega_free = omega is None or all(S[omega] not in r.free_symbols for r in residuals)
+    return ModelForm(key=_key(spec), names=names, symbols=syms, compliance=comp, M=M, D=D,
+                     K=K, model_symbols=dict(S), residuals=residuals, omega=omega, omega_free=omega_free)
 
 
-def _specialise(space: ParameterSpace, axes: dict[str, Any]) -> tuple[Any, Any, Any, Any]:
-    """Closed-form matrices with the space's values (axes symbolic) and ``mu1 h10 - mu2 h20``."""
-    M, D, K, syms = _closed_form_compliance()
+def _specialise(space: ParameterSpace, axes: dict[str, Any]) -> tuple[Any, Any, Any, list[Any]] | None:
+    """Closed-form matrices with the space's values (axes symbolic) and the zero-state residuals."""
+    form = model_form(space.model)
+    if form is None:
+        return None
     vals = space.symbolic(axes)
-    sub = {syms[n]: vals[n] for n in VECTOR_NAMES}
-    moment = vals["mu1"] * vals["h10"] - vals["mu2"] * vals["h20"]
-    return M.xreplace(sub), D.xreplace(sub), K.xreplace(sub), moment
+    sub = {s: (1 / vals[n] if c else vals[n]) for n, s, c in zip(form.names, form.symbols, form.compliance)}
+    msub = {form.model_symbols[n]: vals[n] for n in form.names}
+    res = [r.xreplace(msub) for r in form.residuals]
+    return form.M.xreplace(sub), form.D.xreplace(sub), form.K.xreplace(sub), res
 
 
 def _exact_floats(e: Any) -> Any:
@@ -207,27 +347,53 @@ def _quartic_field(entries: list[Any], symbols: list[Any]) -> tuple[tuple[Any, .
     return N, den, tuple(consts)
 
 
-@lru_cache(maxsize=64)
 def quartic_numerators(space: ParameterSpace, names: tuple[str, ...]) -> QuarticNumerators | None:
     """Exact numerators of ``a0..a4`` with the axes ``names`` symbolic (trivial silent motion).
 
-    Returns ``None`` when the silent motion is not identically trivial on the
-    axes (``mu1 h10 ≠ mu2 h20`` somewhere, eq. 49) or the dependence on an
-    axis is not rational.
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space (any model).
+    names : tuple of str
+        Settable names of ``space`` kept symbolic.
+
+    Returns
+    -------
+    QuarticNumerators or None
+        ``None`` when the model has no closed form (:func:`model_form`), the
+        silent motion is not identically trivial on the axes (a zero-state
+        residual of the model does not vanish identically under the space's
+        ties, e.g. ``mu1 h10 != mu2 h20`` somewhere for the paper's model, eq.
+        49) or the dependence on an axis is not rational.  Memoized by model
+        key, space key and ``names``.
     """
+    names = tuple(names)
+    return _memo(("qn", _key(space.model), space.key(), names), lambda: _quartic_numerators(space, names))
+
+
+def _vanishes(expr: Any, syms: list[Any]) -> bool:
+    """Whether an expression is identically zero (exact rational-function test, else ``simplify``)."""
     import sympy as sp
     from sympy.polys.fields import field
 
-    syms = [sp.Symbol(f"X{i}", real=True) for i in range(len(names))]
-    M, D, K, moment = _specialise(space, dict(zip(names, syms)))
-    moment = _exact_floats(moment)
+    e = _exact_floats(expr)
     try:
-        Fm, *_ = field(syms + _constants([moment]), sp.QQ)
-        if Fm.from_expr(moment) != 0:
-            return None
-    except Exception:
-        if sp.simplify(moment) != 0:
-            return None
+        Fm, *_ = field(list(syms) + _constants([e]), sp.QQ)
+        return bool(Fm.from_expr(e) == 0)
+    except Exception:  # non-rational dependence
+        return bool(sp.simplify(e) == 0)
+
+
+def _quartic_numerators(space: ParameterSpace, names: tuple[str, ...]) -> QuarticNumerators | None:
+    import sympy as sp
+
+    syms = [sp.Symbol(f"X{i}", real=True) for i in range(len(names))]
+    spec_ = _specialise(space, dict(zip(names, syms)))
+    if spec_ is None:
+        return None
+    M, D, K, residuals = spec_
+    if not all(_vanishes(r, syms) for r in residuals):
+        return None
     res = _quartic_field(list(M) + list(D) + list(K), syms)
     if res is None:
         return None
@@ -390,7 +556,7 @@ def _kernel_source(degrees: tuple[int, ...]) -> str:
             "ng = sg & ((d0 < -E0) | (d1 < -E1) | (d2 < -E2) | (d3 < -E3) | (h < -ehb))")
     # pass 1: d_k / E_k > 1 for all k <=> certified stable, < -1 for one k <=> certified unstable; the
     # reciprocals are rounded down by 4.5e-16 so that fl(d_k r_k) > 1 implies d_k > E_k (no NaN can occur:
-    # finite tables, |t|^deg < 2^300, see maps._kernel_usable and GridKernel.row_coefficients)
+    # finite tables, |t|^deg < 2^300, see kernel_scaling and GridKernel.row_coefficients)
     fast = ("s = math.copysign(1.0, a4)\n"
             "d0 = s * a0\nd1 = s * a1\nd2 = s * a2\nd3 = s * a3\n"
             "h = d1 * (d3 * d2 - abs(a4) * d1) - d3 * d3 * d0\n"
@@ -474,16 +640,32 @@ MAX_INNER_DEGREE = 12
 MAX_OUTER_DEGREE = 40
 
 
-@lru_cache(maxsize=32)
 def grid_kernel(space: ParameterSpace, names: tuple[str, ...]) -> GridKernel | None:
     """Build (or fetch) the certified classifier for a grid over ``names``.
 
-    Returns ``None`` when no closed-form kernel applies: non-trivial silent
-    motion somewhere on the grid, non-rational dependence, or degrees above
-    :data:`MAX_INNER_DEGREE` / :data:`MAX_OUTER_DEGREE` (callers then use the
-    per-point route of :mod:`.robust`, which is always correct but slower).
-    Nothing is assumed about the signs of the axes.
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space (any model).
+    names : tuple of str
+        The grid's axes (settable names of ``space``).
+
+    Returns
+    -------
+    GridKernel or None
+        ``None`` when no closed-form kernel applies: no closed form for the
+        model (:func:`model_form`), a non-trivial silent motion somewhere on
+        the grid, non-rational dependence, or degrees above
+        :data:`MAX_INNER_DEGREE` / :data:`MAX_OUTER_DEGREE` (callers then use
+        the per-point routes of :mod:`.points`, which are always correct but
+        slower).  Nothing is assumed about the signs of the axes.  Memoized
+        by model key, space key and ``names``.
     """
+    names = tuple(names)
+    return _memo(("grid", _key(space.model), space.key(), names), lambda: _grid_kernel(space, names))
+
+
+def _grid_kernel(space: ParameterSpace, names: tuple[str, ...]) -> GridKernel | None:
     qn = quartic_numerators(space, tuple(names))
     if qn is None:
         return None
@@ -523,6 +705,34 @@ def grid_kernel(space: ParameterSpace, names: tuple[str, ...]) -> GridKernel | N
                       ipow=np.array(rows_k, dtype=np.int64), slot=np.array(rows_s, dtype=np.int64),
                       mant=np.array(rows_m), e2=np.array(rows_x, dtype=np.int64), nops=nops,
                       classify=mod.classify, coefficients=mod.coefficients, source=source)
+
+
+def kernel_scaling(kern: GridKernel | MapKernel | None, inner_values: np.ndarray) -> tuple[int, np.ndarray] | None:
+    """Inner-axis scaling ``(e, t)`` if the kernel's Horner evaluation stays in range for these values.
+
+    Parameters
+    ----------
+    kern : GridKernel or MapKernel or None
+        The kernel (``None`` gives ``None``).
+    inner_values : ndarray
+        Values of the kernel's inner axis.
+
+    Returns
+    -------
+    tuple or None
+        ``(e, t)`` with ``t = inner_values / 2^e`` (see :func:`inner_exponent`),
+        or ``None`` when ``|t|^degree`` could reach ``2^300`` (the kernel then
+        does not apply; no overflow, no NaN in the compiled loop).
+    """
+    if kern is None:
+        return None
+    e = inner_exponent(inner_values)
+    t = np.ldexp(np.asarray(inner_values, dtype=float), -e)
+    deg = max(kern.degrees)
+    tmax = float(np.max(np.abs(t))) if t.size else 0.0
+    if not (np.all(np.isfinite(t)) and (tmax <= 1 or deg * math.log2(tmax) < 300)):
+        return None
+    return e, t
 
 
 def inner_exponent(values: np.ndarray) -> int:
@@ -761,7 +971,7 @@ def real_roots(coeffs: np.ndarray, lo: float, hi: float) -> np.ndarray:
 
 
 # ---------------------------------------------------------------- bounded closed-form entries (generated)
-def _bounded_source(fname: str, slots: list[list[tuple[Any, dict[int, int]]]], doc: str) -> str:
+def _bounded_source(fname: str, slots: list[list[tuple[Any, dict[int, int]]]], doc: str, nparams: int) -> str:
     """Numba source ``fname(P, V, R)``: ``V[n, s]`` = Σ terms of slot ``s``, ``R[n, s]`` its rounding bound."""
     import sympy as sp
 
@@ -769,8 +979,8 @@ def _bounded_source(fname: str, slots: list[list[tuple[Any, dict[int, int]]]], d
              '@numba.njit(cache=True, error_model="numpy")', f"def {fname}(P, V, R):",
              f'    """{doc}; R bounds the rounding error of V."""',
              "    for n in range(P.shape[0]):", "        p = P[n]"]
-    lines.append("        " + ", ".join(f"x{i}" for i in range(17)) + " = "
-                 + ", ".join(f"p[{i}]" for i in range(17)))
+    lines.append("        " + ", ".join(f"x{i}" for i in range(nparams)) + " = "
+                 + ", ".join(f"p[{i}]" for i in range(nparams)))
     for s, terms in enumerate(slots):
         if not terms:
             lines.append(f"        V[n, {s}] = 0.0")
@@ -824,23 +1034,45 @@ def _terms(expr: Any, syms: list[Any]) -> list[tuple[Any, dict[int, int]]]:
     return out
 
 
-@lru_cache(maxsize=1)
-def _entries_generated() -> Any:
-    M, D, K, syms = _closed_form_compliance()
-    args = [syms[n] for n in VECTOR_NAMES]
-    slots = [_terms(X[i, j], args) for X in (M, D, K) for i in range(2) for j in range(2)]
-    return _load_generated(_bounded_source("entries_batch", slots, "Mbar, Dbar, Kbar entries (row-major)"),
-                           "entries")
+def _form(spec: Any) -> ModelForm:
+    form = model_form(spec)
+    if form is None:
+        from ..errors import ParameterError
+
+        raise ParameterError(f"model '{spec.name}' has no closed-form kernel (two coordinates and rate-free pads "
+                             "at the zero state are needed); use the per-point routes")
+    return form
 
 
-def trivial_entries(P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _paper() -> Any:
+    from ..model.library import get_model
+
+    return get_model("paper")
+
+
+def _entries_generated(spec: Any) -> Any:
+    form = _form(spec)
+
+    def build() -> Any:
+        args = list(form.symbols)
+        slots = [_terms(X[i, j], args) for X in (form.M, form.D, form.K) for i in range(2) for j in range(2)]
+        return _load_generated(_bounded_source("entries_batch", slots, "Mbar, Dbar, Kbar entries (row-major)",
+                                               len(args)), "entries")
+
+    return _memo(("entries", form.key), build)
+
+
+def trivial_entries(P: np.ndarray, spec: Any = None) -> tuple[np.ndarray, np.ndarray]:
     """``Mbar, Dbar, Kbar`` (trivial silent motion, closed form) with rigorous rounding bounds.
 
     Parameters
     ----------
-    P : ndarray, shape (n, 17)
-        Parameter vectors in :data:`~.space.VECTOR_NAMES` order (compliances
-        ``c_ip = 1/k_ip``).
+    P : ndarray, shape (n, n_parameters)
+        Parameter vectors in the model's packing order (``spec.parameters``,
+        compliances ``c = 1/k_ip`` for tangential stiffnesses, as
+        :meth:`Parameters.vector <brakesqueal.model.parameters.Parameters.vector>`).
+    spec : ModelSpec, optional
+        The model (default: the paper's); it needs a closed form (:func:`model_form`).
 
     Returns
     -------
@@ -848,58 +1080,102 @@ def trivial_entries(P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         Entries of ``M, D, K`` (row-major) and bounds on their rounding errors
         (exact for the given parameter vector).
     """
+    spec = spec if spec is not None else _paper()
     P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
     E = np.empty((P.shape[0], 12))
     R = np.empty((P.shape[0], 12))
     with np.errstate(all="ignore"):
-        _entries_generated().entries_batch(P, E, R)
+        _entries_generated(spec).entries_batch(P, E, R)
     return E, R
 
 
 # ---------------------------------------------------------------- Omega: Laurent coefficients
-@lru_cache(maxsize=1)
-def _omega_generated() -> Any:
+def omega_kernel_available(spec: Any) -> bool:
+    """Whether the critical-speed kernel applies to a model (closed form, spin a named parameter, Laurent form)."""
+    form = model_form(spec)
+    if form is None or form.omega is None or not form.omega_free:
+        return False
+    try:
+        return _omega_generated(spec) is not None
+    except NotImplementedError:
+        return False
+
+
+def _omega_generated(spec: Any) -> Any:
     """Generate and compile ``entries_batch(P, V, R)``: coefficients of ``Ω·entry`` in powers Ω^0..Ω^3 with bounds."""
-    import sympy as sp
+    form = _form(spec)
 
-    M, D, K, syms = _closed_form_compliance()
-    W = syms["Omega"]
-    args = [syms[n] for n in VECTOR_NAMES]
-    slots = []
-    for m in (M, D, K):
-        for i in range(2):
-            for j in range(2):
-                groups: list[list[tuple[Any, dict[int, int]]]] = [[], [], [], []]
-                iw = args.index(W)
-                for c, powers in _terms(m[i, j] * W, args):
-                    k = powers.pop(iw, 0)
-                    if not 0 <= k <= 3:
-                        raise NotImplementedError("closed form is not a Laurent polynomial in Omega of degree <= 2")
-                    groups[k].append((c, powers))
-                slots.extend(groups)
-    return _load_generated(_bounded_source("entries_batch", slots, "Laurent coefficients in Omega"), "omega")
+    def build() -> Any:
+        if form.omega is None:
+            raise NotImplementedError(f"model '{spec.name}': the disk's spin is a number, not a parameter")
+        args = list(form.symbols)
+        iw = form.names.index(form.omega)
+        W = args[iw]
+        slots = []
+        for m in (form.M, form.D, form.K):
+            for i in range(2):
+                for j in range(2):
+                    groups: list[list[tuple[Any, dict[int, int]]]] = [[], [], [], []]
+                    for c, powers in _terms(m[i, j] * W, args):
+                        k = powers.pop(iw, 0)
+                        if not 0 <= k <= 3:
+                            raise NotImplementedError("closed form is not a Laurent polynomial in Omega of "
+                                                      "degree <= 2")
+                        groups[k].append((c, powers))
+                    slots.extend(groups)
+        return _load_generated(_bounded_source("entries_batch", slots, "Laurent coefficients in Omega", len(args)),
+                               "omega")
+
+    try:
+        return _memo(("omega", form.key), build)
+    except NotImplementedError:
+        _MEMO[("omega", form.key)] = None
+        raise
 
 
-def omega_entries(P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def omega_entries(P: np.ndarray, spec: Any = None) -> tuple[np.ndarray, np.ndarray]:
     """Laurent coefficients in Ω of the 12 entries of ``Mbar, Dbar, Kbar``, with rounding bounds.
 
-    Returns ``E, R`` of shape ``(n, 12, 4)``: ``entry = Σ_k E[.., e, k] Ω^(k-1)``.
+    Parameters
+    ----------
+    P : ndarray, shape (n, n_parameters)
+        Parameter vectors in the model's packing order (Ω ignored).
+    spec : ModelSpec, optional
+        The model (default: the paper's).
+
+    Returns
+    -------
+    E, R : ndarray, shape (n, 12, 4)
+        ``entry = Σ_k E[.., e, k] Ω^(k-1)`` and the rounding bounds.
     """
+    spec = spec if spec is not None else _paper()
+    mod = _omega_generated(spec)
+    if mod is None:
+        raise NotImplementedError(f"model '{spec.name}' has no Laurent form in its spin")
     P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
     V = np.empty((P.shape[0], 48))
     R = np.empty((P.shape[0], 48))
     with np.errstate(all="ignore"):
-        _omega_generated().entries_batch(P, V, R)
+        mod.entries_batch(P, V, R)
     return V.reshape(-1, 12, 4), R.reshape(-1, 12, 4)
 
 
-def omega_coefficients(p: np.ndarray) -> np.ndarray:
+def omega_coefficients(p: np.ndarray, spec: Any = None) -> np.ndarray:
     """Laurent coefficients in Ω of the 12 entries of ``Mbar, Dbar, Kbar`` at parameter vector ``p``.
 
-    ``p`` is in :data:`~.space.VECTOR_NAMES` order (compliances); returns
-    ``(12, 4)``: ``entry = Σ_k out[e, k] Ω^(k-1)``.
+    Parameters
+    ----------
+    p : ndarray
+        Parameter vector in the model's packing order (compliances).
+    spec : ModelSpec, optional
+        The model (default: the paper's).
+
+    Returns
+    -------
+    ndarray, shape (12, 4)
+        ``entry = Σ_k out[e, k] Ω^(k-1)``.
     """
-    return omega_entries(np.atleast_2d(p))[0][0]
+    return omega_entries(np.atleast_2d(p), spec)[0][0]
 
 
 def omega_subranges(lo: float, hi: float, decades: float = 6.0) -> np.ndarray:
@@ -916,7 +1192,7 @@ def omega_subranges(lo: float, hi: float, decades: float = 6.0) -> np.ndarray:
 
 
 def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossings: int = 8, *,
-                          return_status: bool = False) -> tuple[np.ndarray, ...]:
+                          return_status: bool = False, spec: Any = None) -> tuple[np.ndarray, ...]:
     """All stability changes along Ω in ``(lo, hi)`` for many parameter vectors (trivial silent motion).
 
     Each set is first handled by the certified compiled kernel
@@ -929,15 +1205,18 @@ def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossing
 
     Parameters
     ----------
-    params : ndarray, shape (n, 17)
-        Parameter vectors in :data:`~.space.VECTOR_NAMES` order (Ω ignored);
-        every row must satisfy ``mu1 h10 = mu2 h20``.
+    params : ndarray, shape (n, n_parameters)
+        Parameter vectors in the model's packing order (Ω ignored); the
+        silent motion of every row must be trivial (for the paper's model
+        ``mu1 h10 = mu2 h20``, eq. 49).
     lo, hi : float
         The Ω range [rad/s], ``0 < lo < hi``; any width (split internally).
     max_crossings : int
         Columns of the outputs.
     return_status : bool
         Also return the per-set status (0 complete, 5 undecided somewhere in the range).
+    spec : ModelSpec, optional
+        The model (default: the paper's); it needs :func:`omega_kernel_available`.
 
     Returns
     -------
@@ -963,12 +1242,12 @@ def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossing
     start = np.zeros(n, dtype=np.bool_)
     flags = np.zeros(n, dtype=np.uint8)
     status = np.zeros(n, dtype=np.int8)
-    E, R = omega_entries(P)
+    E, R = omega_entries(P, spec)
     critical_batch(E, R, bounds, roots, dirs, counts, start, flags)
     for i in np.flatnonzero(flags):
         from .crossings import exact_omega_crossings
 
-        st, found, undecided = exact_omega_crossings(P[i], float(lo), float(hi))
+        st, found, undecided = exact_omega_crossings(P[i], float(lo), float(hi), spec)
         roots[i] = np.nan
         dirs[i] = 0
         for k, (v, d) in enumerate(found[:max_crossings]):

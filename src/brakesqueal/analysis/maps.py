@@ -1,17 +1,29 @@
-"""Stability maps over two parameters of a preset (chunked, bounded memory).
+"""Stability maps over two settable parameters of any model (chunked, bounded memory).
 
-For 2-DOF models whose silent motion is trivial on the whole map the verdict
-comes from the certified compiled kernel of :mod:`.kernels` (stable /
-unstable / uncertain per point, with rigorous floating-point error bounds);
-uncertain points, and maps without a kernel, use the per-point robust route
-:func:`~.robust.trivial_verdicts` (bounded closed-form matrices → interval
-quartic → certified Routh → exact rational evaluation).  ``max_real`` and
-``frequency`` come from the roots of the quartic and are reconciled with the
-verdict (:func:`~.robust.reconcile`).  Points with a non-trivial silent motion
-use the numeric linearization point by point (:func:`~.robust.matrix_verdicts`);
-points where it does not exist, a pad loses contact, the parameters are
-invalid or the verdict cannot be decided are flagged in ``status`` and never
-marked stable.  No verdict depends on where an axis starts or on its sign.
+The route is chosen by what the model allows (:mod:`.points`) and recorded in
+the map's ``method``:
+
+* **closed form** — models with two coordinates and rate-free pads whose
+  silent motion is identically trivial on the map (every zero-state residual
+  vanishes under the space's ties, e.g. ``mu1 h10 = mu2 h20`` for the paper's
+  model, eq. 49): the certified compiled Hurwitz kernel of :mod:`.kernels`
+  generated from the model's closed form (stable / unstable / uncertain per
+  point, rigorous floating-point error bounds); uncertain points, and
+  ``max_real`` / ``frequency``, come from the per-point closed-form route
+  :func:`~.robust.trivial_verdicts` (bounded entries → interval quartic →
+  certified Routh → exact rational evaluation), reconciled with the verdict;
+* **per point** — every other model or map: :func:`~.points.evaluate_arrays`
+  (trivial silent motions batched at the zero state with certified
+  eigenvalue verdicts, non-trivial ones linearized point by point with the
+  pads' states kept).
+
+Points where the silent motion does not exist, a pad loses contact or does not
+slide, the parameters are invalid or the verdict cannot be decided are flagged
+in ``status`` (:class:`~brakesqueal.status.PointStatus`) and never marked
+stable.  No verdict depends on where an axis starts or on its sign.  Memory is
+bounded: the results of a map are held in memory, so maps whose results
+exceed :data:`MAX_MAP_BYTES` are refused (use a sweep, which writes chunks to
+a store); the temporary memory per chunk is bounded by ``chunk_points``.
 """
 
 from __future__ import annotations
@@ -22,20 +34,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError, SilentMotionError
-from ..parameters import _BOUNDS, PARAMETER_NAMES
-from .kernels import inner_exponent, kernel_segments, map_kernel, quartic_coefficients
-from .robust import STABLE, STATUS_UNDECIDED, UNDECIDED, matrix_verdicts, trivial_verdicts
-from .space import VECTOR_NAMES, ParameterSpace
+from ..errors import ParameterError
+from ..status import PointStatus
+from .kernels import kernel_scaling, kernel_segments, map_kernel
+from .points import ROUTES, closed_form_route, evaluate_arrays, valid_points
 
-__all__ = ["Axis", "parse_axis", "stability_map", "classify_grid", "STATUS", "MAX_POINTS", "point_verdicts"]
+__all__ = ["Axis", "parse_axis", "stability_map", "classify_grid", "STATUS", "MAX_POINTS", "MAX_MAP_BYTES",
+           "map_bytes"]
 
-#: Meaning of the ``status`` codes of a map.
-STATUS = {0: "ok", 1: "ok_nontrivial_silent_motion", 2: "no_silent_motion", 3: "pad_loses_contact",
-          4: "invalid_parameters", 5: "undecided"}
+#: Meaning of the ``status`` codes of a map (:class:`~brakesqueal.status.PointStatus`).
+STATUS = {int(s): s.meaning for s in PointStatus}
 #: Maps larger than this need ``force=True`` (``--force``).
 MAX_POINTS = 10**9
-_BATCH = 1 << 16
+#: Largest memory [bytes] the results of one map may take (they are held in memory; use a sweep beyond).
+MAX_MAP_BYTES = 2 * 2**30
+#: Maps with more points than this store ``max_real`` and ``frequency`` as float32.
+_FLOAT32_ABOVE = 2 * 10**7
 
 
 @dataclass(frozen=True)
@@ -46,7 +60,7 @@ class Axis:
     ----------
     name : str
         The parameter the axis varies: a settable name of the
-        :class:`~brakesqueal.analysis.space.ParameterSpace` (a model parameter such as ``Omega`` or
+                :class:`~brakesqueal.model.parameters.ParameterSpace` (a model parameter such as ``Omega`` or
         a preset's auxiliary name such as ``mu`` or ``k_ip``).
     start, stop : float
         Range of the axis in the SI unit of ``name`` (e.g. rad/s for
@@ -99,7 +113,7 @@ class Axis:
 
 def parse_axis(text: str, *, with_num: bool = True) -> Axis:
     """Parse ``NAME=START:STOP:N[:log]`` (or ``NAME=START:STOP[:log]`` with ``with_num=False``)."""
-    from ..expressions import evaluate
+    from ..model.expressions import evaluate
 
     name, sep, spec = text.partition("=")
     name = name.strip()
@@ -124,141 +138,89 @@ def parse_axis(text: str, *, with_num: bool = True) -> Axis:
     return Axis(name, start, stop, num, log_flag)
 
 
-def _check_axes(space: ParameterSpace, axes: list[Axis], force: bool) -> None:
+def map_bytes(points: int, eigen: bool) -> int:
+    """Memory [bytes] of the result arrays of a map with ``points`` points.
+
+    Parameters
+    ----------
+    points : int
+        Number of grid points.
+    eigen : bool
+        Whether ``max_real`` and ``frequency`` are stored.
+
+    Returns
+    -------
+    int
+        ``stable`` and ``status`` (1 byte each) plus two float arrays (8
+        bytes each, 4 above 2e7 points).
+    """
+    per = 2 + (2 * (4 if points > _FLOAT32_ABOVE else 8) if eigen else 0)
+    return per * points
+
+
+def _check_axes(space: object, axes: list[Axis], force: bool, eigen: bool) -> None:
     for ax in axes:
-        space.check_axis(ax.name)
+        space.check_axis(ax.name)  # type: ignore[attr-defined]
     if len(axes) == 2 and axes[0].name == axes[1].name:
         raise ParameterError(f"both axes vary '{axes[0].name}'; choose two different parameters")
     n = math.prod(ax.num for ax in axes)
     if n > MAX_POINTS and not force:
         raise ParameterError(f"the map has {n:.3g} points (> {MAX_POINTS:.0e}); pass --force to compute it anyway")
+    need = map_bytes(n, eigen)
+    if need > MAX_MAP_BYTES:
+        raise ParameterError(f"the map has {n:.3g} points: its results would take {need / 2**30:.3g} GiB of memory "
+                             f"(limit {MAX_MAP_BYTES / 2**30:g} GiB{'; --no-eigen stores 2 bytes per point' if eigen else ''}"
+                             "); use fewer points or a sweep (brakesqueal sweep), which writes chunks to a store")
 
 
-def _valid(arr: dict[str, np.ndarray]) -> np.ndarray:
-    """Points whose 17 model parameters satisfy the bounds of :class:`~brakesqueal.parameters.Parameters`."""
-    ok = np.ones(np.shape(next(iter(arr.values()))), dtype=bool)
-    with np.errstate(all="ignore"):
-        for name, vname in zip(PARAMETER_NAMES, VECTOR_NAMES):
-            v = arr[vname]
-            if vname != name:  # compliance in [0, inf)
-                ok &= (v >= 0) & np.isfinite(v)
-                continue
-            low, high, low_open, high_open = _BOUNDS[name]
-            ok &= (v > low if low_open else v >= low) & (v < high if high_open else v <= high)
-        ok &= arr["h10"] + arr["h20"] > 0
-    return ok
-
-
-def _trivial(arr: dict[str, np.ndarray]) -> np.ndarray:
-    with np.errstate(all="ignore"):
-        a, b = arr["mu1"] * arr["h10"], arr["mu2"] * arr["h20"]
-        return np.abs(a - b) <= 1e-12 * np.maximum(np.abs(a), np.abs(b))
-
-
-def _roots_summary(a: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray]:
-    """max Re λ and |Im λ|/2π of the least-stable root of the quartics (flattened inputs, floating point)."""
-    from .robust import roots_summary
-
-    A = np.stack([np.asarray(x, dtype=float).ravel() for x in a], axis=1)
-    return roots_summary(A)
-
-
-def _numeric_point(space: ParameterSpace, values: dict[str, float]) -> tuple[int, tuple[float, ...] | None]:
-    """Status and quartic coefficients at one point via the numeric linearization."""
-    code, c, _ = _numeric_linear(space, values)
-    return code, c
-
-
-def _numeric_linear(space: ParameterSpace, values: dict[str, float]) -> tuple[int, tuple[float, ...] | None, object]:
-    from .linear import linearize
-
-    try:
-        lm = linearize(space.resolve(values))
-    except ParameterError:
-        return 4, None, None
-    except SilentMotionError as exc:
-        return (3 if "loses contact" in str(exc) else 2), None, None
-    return (0 if lm.silent.trivial else 1), quartic_coefficients(lm.M, lm.D, lm.K), lm
-
-
-def numeric_point_verdict(space: ParameterSpace, values: dict[str, float]) -> tuple[int, bool, float, float]:
-    """``(status, stable, max_real, frequency)`` at one point via the numeric linearization (robust verdict).
-
-    Used where the silent motion is not trivial; the verdict comes from
-    :func:`~.robust.matrix_verdicts` (status 5 when undecided).
-    """
-    code, _, lm = _numeric_linear(space, values)
-    if lm is None:
-        return code, False, math.nan, math.nan
-    c, mr, fr = matrix_verdicts(lm.M, lm.D, lm.K)  # type: ignore[attr-defined]
-    if c[0] == UNDECIDED:
-        return STATUS_UNDECIDED, False, float(mr[0]), float(fr[0])
-    return code, bool(c[0] == STABLE), float(mr[0]), float(fr[0])
-
-
-def point_verdicts(P: np.ndarray, *, eigen: bool, codes: np.ndarray | None = None
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Robust verdicts of 2-DOF parameter vectors at the trivial silent motion, in bounded batches.
-
-    ``codes`` (optional) are verdicts already certified by a kernel (2 =
-    uncertain: recomputed).  Returns ``(codes, max_real, frequency)``; see
-    :func:`~.robust.trivial_verdicts`.
-    """
-    n = P.shape[0]
-    out = np.empty(n, dtype=np.uint8)
-    mr = np.full(n, np.nan)
-    fr = np.full(n, np.nan)
-    for b0 in range(0, n, _BATCH):
-        sl = slice(b0, min(n, b0 + _BATCH))
-        c, m, f = trivial_verdicts(P[sl], eigen=eigen, codes=None if codes is None else codes[sl])
-        out[sl], mr[sl], fr[sl] = c, m, f
-    return out, mr, fr
-
-
-def classify_grid(space: ParameterSpace, x: Axis, y: Axis) -> tuple[np.ndarray, str, str]:
+def classify_grid(space: object, x: Axis, y: Axis) -> tuple[np.ndarray, str, str]:
     """Only the certified kernel's codes on the full grid (benchmarks, large maps).
 
-    Returns ``(codes[outer, inner] uint8, outer_name, inner_name)`` with
-    codes 0 unstable, 1 stable, 2 uncertain (recomputed per point by
-    :func:`stability_map`); raises ParameterError if no compiled kernel applies.
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space.
+    x, y : Axis
+        The axes.
+
+    Returns
+    -------
+    codes, outer, inner : ndarray, str, str
+        ``codes[outer, inner]`` (uint8: 0 unstable, 1 stable, 2 uncertain,
+        recomputed per point by :func:`stability_map`) and the axis names.
+
+    Raises
+    ------
+    ParameterError
+        If no compiled kernel applies (the closed-form route does not).
     """
-    kern = map_kernel(space, x.name, y.name)
+    kern = map_kernel(space, x.name, y.name)  # type: ignore[arg-type]
     if kern is None:
-        raise ParameterError("no compiled kernel for this map (non-trivial silent motion or non-rational dependence)")
+        raise ParameterError("no compiled kernel for this map (no closed form for the model, a non-trivial silent "
+                             "motion or non-rational dependence)")
     ax = {x.name: x, y.name: y}
     outer, inner = ax[kern.outer], ax[kern.inner]
     return kern.verdicts(outer.values(), inner.values()), kern.outer, kern.inner
 
 
-def _kernel_usable(kern: object, iv: np.ndarray) -> tuple[int, np.ndarray] | None:
-    """Inner scaling ``(e, t)`` if the kernel's Horner evaluation stays in range for these inner values."""
-    if kern is None:
-        return None
-    e = inner_exponent(iv)
-    t = np.ldexp(np.asarray(iv, dtype=float), -e)
-    deg = max(kern.degrees)  # type: ignore[attr-defined]
-    tmax = float(np.max(np.abs(t))) if t.size else 0.0
-    if not (np.all(np.isfinite(t)) and (tmax <= 1 or deg * math.log2(tmax) < 300)):
-        return None  # |a_k| < 2^300 keeps H3 finite in the kernel (no overflow, no NaN)
-    return e, t
-
-
-def stability_map(space: ParameterSpace, x: Axis, y: Axis, *, force: bool = False, eigen: bool = True,
+def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen: bool = True,
                   chunk_points: int = 1 << 20, progress: Callable[[float], None] | None = None) -> object:
     """Compute a stability map over two settable parameters of ``space``.
 
     Parameters
     ----------
     space : ParameterSpace
-        The preset / parameter set; tied names follow the axes.
+        The model, preset and overrides (:func:`brakesqueal.model.resolve_space`);
+        tied names follow the axes.
     x, y : Axis
         The two axes (any ranges and signs; points with invalid parameters
-        get status 4).
+        get status ``INVALID``).
     force : bool
-        Allow more than :data:`MAX_POINTS` points.
+        Allow more than :data:`MAX_POINTS` points (the memory limit
+        :data:`MAX_MAP_BYTES` still holds).
     eigen : bool
-        Compute ``max_real`` and ``frequency`` (quartic roots, ~2e5 points/s);
-        ``False`` leaves them NaN and only classifies (~1e9 points/s).
+        Compute ``max_real`` and ``frequency``; ``False`` only classifies
+        and leaves both variables out of the result.
     chunk_points : int
         Points per chunk (bounds the temporary memory).
     progress : callable, optional
@@ -267,64 +229,57 @@ def stability_map(space: ParameterSpace, x: Axis, y: Axis, *, force: bool = Fals
     Returns
     -------
     StabilityMap
-        See :class:`brakesqueal.results.StabilityMap`; ``stable`` is certified,
-        ``status`` 5 marks points whose verdict could not be decided (exactly
-        on a stability boundary); for status 0/1 ``stable`` ⇔ ``max_real < 0``.
+        See :class:`brakesqueal.results.StabilityMap`; ``stable`` is
+        certified, ``status`` holds :class:`~brakesqueal.status.PointStatus`
+        codes (``UNDECIDED`` marks points whose verdict could not be decided,
+        e.g. exactly on a stability boundary); for ``OK``/``OK_NONTRIVIAL``
+        points ``stable`` ⇔ ``max_real < 0``.  ``method`` names the route.
+
+    Raises
+    ------
+    ParameterError
+        Unknown, tied or equal axes, more than :data:`MAX_POINTS` points
+        without ``force``, or results above :data:`MAX_MAP_BYTES`.
     """
     from ..results import StabilityMap
 
-    _check_axes(space, [x, y], force)
-    space.resolve({})
-    kern = map_kernel(space, x.name, y.name)
+    _check_axes(space, [x, y], force, eigen)
+    space.resolve({})  # type: ignore[attr-defined]
+    closed = closed_form_route(space, (x.name, y.name))
+    kern = map_kernel(space, x.name, y.name) if closed else None  # type: ignore[arg-type]
     ax = {x.name: x, y.name: y}
     outer, inner = (ax[kern.outer], ax[kern.inner]) if kern else (y, x)
     ov, iv = outer.values(), inner.values()
     n_o, n_i = ov.size, iv.size
-    scaled = _kernel_usable(kern, iv)
+    scaled = kernel_scaling(kern, iv)
     seg_T = kernel_segments(scaled[1]) if scaled is not None else None
-    big = n_o * n_i > 2 * 10**7
-    ftype = np.float32 if big else np.float64
+    ftype = np.float32 if n_o * n_i > _FLOAT32_ABOVE else np.float64
     stable = np.zeros((n_o, n_i), dtype=bool)
     status = np.zeros((n_o, n_i), dtype=np.int8)
-    max_real = np.full((n_o, n_i), np.nan, dtype=ftype)
-    freq = np.full((n_o, n_i), np.nan, dtype=ftype)
+    max_real = np.full((n_o, n_i), np.nan, dtype=ftype) if eigen else None
+    freq = np.full((n_o, n_i), np.nan, dtype=ftype) if eigen else None
     rows = max(1, chunk_points // n_i)
     buf = np.empty((rows, n_i), dtype=np.uint8)
     for r0 in range(0, n_o, rows):
         r1 = min(n_o, r0 + rows)
-        arr = space.arrays({outer.name: ov[r0:r1, None], inner.name: iv[None, :]})
-        valid = _valid(arr)
-        triv = valid & _trivial(arr)
-        st = status[r0:r1]
-        st[~valid] = 4
-        codes = buf[: r1 - r0]
-        if scaled is not None and seg_T is not None:
-            C, EC = kern.row_coefficients(ov[r0:r1], scaled[0])  # type: ignore[union-attr]
-            kern.classify(C, EC, scaled[1], seg_T[0], seg_T[1], codes)  # type: ignore[union-attr]
-        else:
-            codes[...] = UNDECIDED
-        flat = np.flatnonzero(triv) if eigen else np.flatnonzero(triv & (codes == UNDECIDED))
-        sure = triv & (codes != UNDECIDED)
-        if not eigen:
-            stable[r0:r1][sure] = codes[sure] == STABLE
-        if flat.size:
-            ix = np.unravel_index(flat, triv.shape)
-            P = np.stack([np.broadcast_to(arr[n], triv.shape)[ix] for n in VECTOR_NAMES], axis=1)
-            c, mr, fr = point_verdicts(P, eigen=eigen, codes=codes[ix])
-            stable[r0:r1][ix] = c == STABLE
-            st[ix] = np.where(c == UNDECIDED, STATUS_UNDECIDED, st[ix])
-            if eigen:
-                max_real[r0:r1][ix] = mr
-                freq[r0:r1][ix] = fr
-        for i, j in np.argwhere(valid & ~triv):
-            code, sb, mr1, fr1 = numeric_point_verdict(space, {outer.name: float(ov[r0 + i]), inner.name: float(iv[j])})
-            st[i, j] = code
-            stable[r0 + i, j] = sb
-            if eigen:
-                max_real[r0 + i, j], freq[r0 + i, j] = mr1, fr1
+        arr = space.arrays({outer.name: ov[r0:r1, None], inner.name: iv[None, :]})  # type: ignore[attr-defined]
+        codes = None
+        if kern is not None and scaled is not None and seg_T is not None:
+            codes = buf[: r1 - r0]
+            C, EC = kern.row_coefficients(ov[r0:r1], scaled[0])
+            kern.classify(C, EC, scaled[1], seg_T[0], seg_T[1], codes)
+        res = evaluate_arrays(space, arr, eigen=eigen, codes=codes, closed=closed, valid=valid_points(space, arr))
+        stable[r0:r1] = res.stable
+        status[r0:r1] = res.status
+        if max_real is not None and freq is not None:
+            max_real[r0:r1] = res.max_real
+            freq[r0:r1] = res.frequency
         if progress is not None:
             progress(r1 / n_o)
-    method = "certified compiled Hurwitz kernel + robust per-point route" if scaled is not None \
-        else "robust per-point route (bounded closed form, certified Routh, exact fallback)"
+    if closed:
+        method = ("closed form: certified compiled Hurwitz kernel of the exact quartic + robust per-point route"
+                  if scaled is not None else ROUTES["closed"])
+    else:
+        method = ROUTES["points"]
     return StabilityMap.from_arrays(space, outer, inner, stable=stable, status=status, max_real=max_real,
                                     frequency=freq, method=method)

@@ -32,9 +32,12 @@ ascending coefficients):
 
 Matrices (any ``n``):
 
-* :func:`eigen_verdicts` — eigenvalues of the ``2n × 2n`` state matrix with a
-  first-order condition-number bound ``|δλ_k| <= 10 κ_k η ‖A‖_F`` (η: input
-  perturbation plus backward error of the QR algorithm).
+* :func:`state_verdicts` — eigenvalues of any (power-of-two balanced) state
+  matrix with a first-order condition-number bound ``|δλ_k| <= 10 κ_k η ‖B‖_F``
+  (η: input perturbation plus backward error of the QR algorithm);
+  :func:`eigen_verdicts` applies it to the ``2n × 2n`` state matrix of
+  eq. (47), :func:`descriptor_verdicts` to ``E^-1 A`` of a descriptor system
+  (massless pads kept as first-order states: every eigenvalue counts).
 * :func:`charpoly_exact` — exact rational ``det(λ²M + λD + K)`` of float
   matrices (fraction-free, SymPy Berkowitz) for :func:`routh_exact`.
 
@@ -58,7 +61,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from fractions import Fraction
-from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -67,7 +69,7 @@ __all__ = [
     "UNSTABLE", "STABLE", "UNDECIDED", "STATUS_UNDECIDED", "INPUT_REL", "routh_verdicts", "routh_exact",
     "horner_bound", "isolate_real_roots", "isolate_real_roots_float", "quartic_interval", "eigen_verdicts",
     "charpoly_exact", "mp_roots_summary", "roots_summary", "trivial_verdicts", "matrix_verdicts", "reconcile",
-    "exact_trivial_entries",
+    "exact_trivial_entries", "balance", "state_verdicts", "descriptor_verdicts",
 ]
 
 UNSTABLE, STABLE, UNDECIDED = 0, 1, 2
@@ -314,9 +316,125 @@ def _state(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
     return A
 
 
+def balance(S: np.ndarray, iterations: int = 12) -> np.ndarray:
+    """Power-of-two diagonal similarity ``B = T^-1 S T`` of a batch of square matrices (exact, same eigenvalues).
+
+    Parameters
+    ----------
+    S : ndarray, shape (N, m, m)
+        Matrices (finite).
+    iterations : int
+        Sweeps of simultaneous row/column equilibration (like LAPACK's
+        ``gebal`` without permutations).
+
+    Returns
+    -------
+    ndarray, shape (N, m, m)
+        The balanced matrices; off-diagonal row and column norms within a
+        factor of about 2 of each other.
+    """
+    B = np.array(S, dtype=float, copy=True)
+    m = B.shape[-1]
+    off = ~np.eye(m, dtype=bool)
+    with np.errstate(all="ignore"):
+        for _ in range(iterations):
+            A = np.abs(B) * off
+            c = A.sum(axis=-2)
+            r = A.sum(axis=-1)
+            ok = (c > 0) & (r > 0) & np.isfinite(c) & np.isfinite(r)
+            e = np.where(ok, np.round(0.5 * np.log2(np.where(ok, r / np.where(ok, c, 1.0), 1.0))), 0.0)
+            if not np.any(e):
+                break
+            f = np.ldexp(1.0, e.astype(int))
+            B *= f[..., None, :] / f[..., :, None]
+    return B
+
+
+def state_verdicts(S: np.ndarray, *, rel_input: float = INPUT_REL) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Verdicts from the eigenvalues of first-order state matrices with a condition-number error bound.
+
+    Parameters
+    ----------
+    S : ndarray, shape (N, m, m)
+        State matrices of ``xi' = S xi`` (any size; e.g. ``2n`` for eq. 47, or
+        ``2n + k`` with ``k`` pad states kept, ``E^-1 A`` of a descriptor system).
+    rel_input : float
+        Assumed relative (norm-wise) error of the balanced state matrix from its inputs.
+
+    Returns
+    -------
+    codes : ndarray of uint8, shape (N,)
+        :data:`STABLE` if ``Re λ_k + b_k < 0`` for every eigenvalue,
+        :data:`UNSTABLE` if ``Re λ_k - b_k > 0`` for one, else
+        :data:`UNDECIDED` (also for non-finite input); ``b_k = 10 κ_k
+        (rel_input + 4 m u) ‖B‖_F`` with ``B`` the balanced matrix
+        (:func:`balance`) and the eigenvalue condition number ``κ_k =
+        ‖x_k‖ ‖y_k‖ / |y_k^H x_k|`` (first-order perturbation bound; infinite
+        for defective eigenvalues).
+    max_real, frequency : ndarray, shape (N,)
+        Largest real part [1/s] of the computed eigenvalues and ``|Im λ| / 2π``
+        [Hz] of that eigenvalue (NaN for non-finite input).  By construction
+        ``max_real < 0`` where the code is stable and ``max_real > 0`` where it
+        is unstable.
+    """
+    S = np.asarray(S, dtype=float)
+    N = S.shape[0]
+    codes = np.full(N, UNDECIDED, dtype=np.uint8)
+    mr = np.full(N, np.nan)
+    fr = np.full(N, np.nan)
+    if N == 0:
+        return codes, mr, fr
+    with np.errstate(all="ignore"):
+        good = np.all(np.isfinite(S), axis=(1, 2))
+        idx = np.flatnonzero(good)
+        if idx.size == 0:
+            return codes, mr, fr
+        B = balance(S[idx])
+        good2 = np.all(np.isfinite(B), axis=(1, 2))
+        B[~good2] = 0.0
+        lam, kappa = _eig_kappa(B)
+        good2 &= np.all(np.isfinite(lam), axis=1)
+        lam = np.where(np.isfinite(lam), lam, 0.0)
+        m = B.shape[-1]
+        eta = rel_input + 4.0 * m * 2.0 ** -53
+        b = 10.0 * kappa * eta * np.linalg.norm(B, axis=(1, 2))[:, None]
+        hi = np.max(lam.real + b, axis=1)
+        lo = np.max(lam.real - b, axis=1)
+        k = np.argmax(lam.real, axis=1)
+        top = lam[np.arange(idx.size), k]
+        c = np.where(hi < 0, STABLE, np.where(lo > 0, UNSTABLE, UNDECIDED)).astype(np.uint8)
+        c[~good2] = UNDECIDED
+        codes[idx] = c
+        mr[idx] = np.where(good2, top.real, np.nan)
+        fr[idx] = np.where(good2, np.abs(top.imag) / (2 * np.pi), np.nan)
+    return codes, mr, fr
+
+
+def _eig_kappa(B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues and their condition numbers ``‖x‖ ‖y‖ / |y^H x|`` (batched; per matrix where LAPACK fails)."""
+    try:
+        lam, V = np.linalg.eig(B)
+    except np.linalg.LinAlgError:
+        if B.shape[0] == 1:
+            return np.full(B.shape[:2], np.nan + 0j), np.full(B.shape[:2], np.inf)
+        out = [_eig_kappa(B[i:i + 1]) for i in range(B.shape[0])]
+        return np.concatenate([o[0] for o in out]), np.concatenate([o[1] for o in out])
+    try:
+        W = np.linalg.inv(V)
+        kappa = np.linalg.norm(V, axis=1) * np.linalg.norm(W, axis=2)
+    except np.linalg.LinAlgError:
+        if B.shape[0] == 1:
+            kappa = np.full(lam.shape, np.inf)
+        else:
+            kappa = np.concatenate([_eig_kappa(B[i:i + 1])[1] for i in range(B.shape[0])])
+    except ValueError:
+        kappa = np.full(lam.shape, np.inf)
+    return lam, np.where(np.isfinite(kappa), kappa, np.inf)
+
+
 def eigen_verdicts(M: np.ndarray, D: np.ndarray, K: np.ndarray, *, rel_input: float = INPUT_REL
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Verdicts from the eigenvalues of the state matrix with a condition-number error bound.
+    """Verdicts from the eigenvalues of the state matrix of eq. (47) with a condition-number error bound.
 
     Parameters
     ----------
@@ -327,14 +445,10 @@ def eigen_verdicts(M: np.ndarray, D: np.ndarray, K: np.ndarray, *, rel_input: fl
 
     Returns
     -------
-    codes : ndarray of uint8, shape (N,)
-        :data:`STABLE` if ``Re λ_k + b_k < 0`` for every eigenvalue,
-        :data:`UNSTABLE` if ``Re λ_k - b_k > 0`` for one, else :data:`UNDECIDED`;
-        ``b_k = 10 κ_k (rel_input + 4 (2n) u) ‖A‖_F`` with the eigenvalue
-        condition number ``κ_k = ‖x_k‖ ‖y_k‖ / |y_k^H x_k|`` (first-order
-        perturbation bound; infinite for defective eigenvalues).
-    max_real, frequency : ndarray, shape (N,)
-        Largest real part [1/s] and ``|Im λ| / 2π`` [Hz] of that eigenvalue.
+    codes, max_real, frequency : ndarray, shape (N,)
+        See :func:`state_verdicts` (applied to the ``2n x 2n`` state matrices
+        ``[[0, w I], [-M^-1 K / w, -M^-1 D]]``); singular or non-finite ``M``
+        gives :data:`UNDECIDED`.
     """
     M, D, K = (np.asarray(X, dtype=float) for X in (M, D, K))
     N = M.shape[0]
@@ -351,29 +465,57 @@ def eigen_verdicts(M: np.ndarray, D: np.ndarray, K: np.ndarray, *, rel_input: fl
         idx = np.flatnonzero(good)
         if idx.size == 0:
             return codes, mr, fr
-        A = _state(M[idx], D[idx], K[idx])
-        good2 = np.all(np.isfinite(A), axis=(1, 2))
-        A[~good2] = 0.0
-        lam, V = np.linalg.eig(A)
-        try:
-            W = np.linalg.inv(V)
-            kappa = np.linalg.norm(V, axis=1) * np.linalg.norm(W, axis=2)
-        except np.linalg.LinAlgError:
-            kappa = np.full(lam.shape, np.inf)
-        kappa = np.where(np.isfinite(kappa), kappa, np.inf)
-        n2 = A.shape[-1]
-        eta = rel_input + 4.0 * n2 * 2.0 ** -53
-        b = 10.0 * kappa * eta * np.linalg.norm(A, axis=(1, 2))[:, None]
-        hi = np.max(lam.real + b, axis=1)
-        lo = np.max(lam.real - b, axis=1)
-        k = np.argmax(lam.real, axis=1)
-        top = lam[np.arange(idx.size), k]
-        c = np.where(hi < 0, STABLE, np.where(lo > 0, UNSTABLE, UNDECIDED)).astype(np.uint8)
-        c[~good2] = UNDECIDED
-        codes[idx] = c
-        mr[idx] = np.where(good2, top.real, np.nan)
-        fr[idx] = np.where(good2, np.abs(top.imag) / (2 * np.pi), np.nan)
+        codes[idx], mr[idx], fr[idx] = state_verdicts(_state(M[idx], D[idx], K[idx]), rel_input=rel_input)
     return codes, mr, fr
+
+
+def descriptor_verdicts(E: np.ndarray, A: np.ndarray, *, rel_input: float = INPUT_REL
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Verdicts of descriptor systems ``E xi' = A xi`` (pads kept as first-order states) from every eigenvalue.
+
+    Parameters
+    ----------
+    E, A : ndarray, shape (N, m, m)
+        Batched descriptor matrices (e.g.
+        :attr:`LinearModel.descriptor <brakesqueal.analysis.linear.LinearModel.descriptor>`).
+    rel_input : float
+        Assumed relative (norm-wise) error of the balanced state matrix ``E^-1 A``.
+
+    Returns
+    -------
+    codes, max_real, frequency : ndarray, shape (N,)
+        :func:`state_verdicts` of ``E^-1 A`` (LU with partial pivoting): every
+        finite eigenvalue of the pencil, the pads' own modes included
+        (e.g. ``lambda = -G_L/G_dL`` of a massless pad).  A singular ``E``
+        (an infinite eigenvalue) gives :data:`UNDECIDED`.
+    """
+    E, A = np.asarray(E, dtype=float), np.asarray(A, dtype=float)
+    N = E.shape[0]
+    codes = np.full(N, UNDECIDED, dtype=np.uint8)
+    mr = np.full(N, np.nan)
+    fr = np.full(N, np.nan)
+    if N == 0:
+        return codes, mr, fr
+    with np.errstate(all="ignore"):
+        good = np.all(np.isfinite(E), axis=(1, 2)) & np.all(np.isfinite(A), axis=(1, 2))
+        eye = np.eye(E.shape[-1])
+        good &= np.abs(np.linalg.det(np.where(good[:, None, None], E, eye))) > 0
+        idx = np.flatnonzero(good)
+        if idx.size == 0:
+            return codes, mr, fr
+        try:
+            S = np.linalg.solve(E[idx], A[idx])
+        except np.linalg.LinAlgError:
+            S = np.stack([_solve_or_nan(E[i], A[i]) for i in idx])
+        codes[idx], mr[idx], fr[idx] = state_verdicts(S, rel_input=rel_input)
+    return codes, mr, fr
+
+
+def _solve_or_nan(E: np.ndarray, A: np.ndarray) -> np.ndarray:
+    try:
+        return np.linalg.solve(E, A)
+    except np.linalg.LinAlgError:
+        return np.full(A.shape, np.nan)
 
 
 def charpoly_exact(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> list[Fraction]:
@@ -466,38 +608,54 @@ def reconcile(codes: np.ndarray, max_real: np.ndarray, recompute: Callable[[int]
 
 
 # ---------------------------------------------------------------- 2-DOF closed form, exact
-@lru_cache(maxsize=1)
-def _exact_entries_fn() -> Callable[[Sequence[Fraction]], list[Fraction]]:
-    """Python function evaluating the 12 closed-form entries with Fraction arithmetic (generated)."""
-    from .kernels import _closed_form_compliance, _terms
-    from .space import VECTOR_NAMES
+def _exact_entries_fn(spec: Any) -> Callable[[Sequence[Fraction]], list[Fraction]]:
+    """Python function evaluating the 12 closed-form entries of a model with Fraction arithmetic (generated)."""
+    from .kernels import _form, _memo, _terms
 
-    M, D, K, syms = _closed_form_compliance()
-    args = [syms[n] for n in VECTOR_NAMES]
-    lines = ["def f(x):", "    F = Fraction", "    out = []"]
-    for X in (M, D, K):
-        for i in range(2):
-            for j in range(2):
-                terms = []
-                for c, powers in _terms(X[i, j], args):
-                    cq = _to_fraction(c)
-                    fac = [f"F({cq.numerator}, {cq.denominator})"]
-                    fac += [f"x[{k}] ** {p}" if p != 1 else f"x[{k}]" for k, p in sorted(powers.items())]
-                    terms.append(" * ".join(fac))
-                lines.append(f"    out.append({' + '.join(terms) if terms else 'F(0)'})")
-    lines.append("    return out")
-    ns: dict[str, Any] = {"Fraction": Fraction}
-    exec("\n".join(lines), ns)
-    return ns["f"]  # type: ignore[no-any-return]
+    form = _form(spec)
+
+    def build() -> Callable[[Sequence[Fraction]], list[Fraction]]:
+        args = list(form.symbols)
+        lines = ["def f(x):", "    F = Fraction", "    out = []"]
+        for X in (form.M, form.D, form.K):
+            for i in range(2):
+                for j in range(2):
+                    terms = []
+                    for c, powers in _terms(X[i, j], args):
+                        cq = _to_fraction(c)
+                        fac = [f"F({cq.numerator}, {cq.denominator})"]
+                        fac += [f"x[{k}] ** {p}" if p != 1 else f"x[{k}]" for k, p in sorted(powers.items())]
+                        terms.append(" * ".join(fac))
+                    lines.append(f"    out.append({' + '.join(terms) if terms else 'F(0)'})")
+        lines.append("    return out")
+        ns: dict[str, Any] = {"Fraction": Fraction}
+        exec("\n".join(lines), ns)
+        return ns["f"]  # type: ignore[no-any-return]
+
+    return _memo(("exact-entries", form.key), build)  # type: ignore[no-any-return]
 
 
-def exact_trivial_entries(p: Sequence[float]) -> list[Fraction]:
+def exact_trivial_entries(p: Sequence[float], spec: Any = None) -> list[Fraction]:
     """The 12 closed-form entries of ``M, D, K`` (trivial silent motion) evaluated exactly at parameter vector ``p``.
 
-    ``p`` is in :data:`~.space.VECTOR_NAMES` order; each float is taken as the
-    exact rational it represents.
+    Parameters
+    ----------
+    p : sequence of float
+        Parameter vector in the model's packing order (compliances for
+        tangential stiffnesses); each float is taken as the exact rational it
+        represents.
+    spec : ModelSpec, optional
+        The model (default: the paper's); it needs a closed form
+        (:func:`~.kernels.model_form`).
+
+    Returns
+    -------
+    list of Fraction
+        ``M, D, K`` row-major.
     """
-    return _exact_entries_fn()([Fraction(float(v)) for v in p])
+    from .kernels import _paper
+
+    return _exact_entries_fn(spec if spec is not None else _paper())([Fraction(float(v)) for v in p])
 
 
 def _quartic_exact(e: Sequence[Fraction]) -> list[Fraction]:
@@ -509,9 +667,9 @@ def _quartic_exact(e: Sequence[Fraction]) -> list[Fraction]:
             m11 * m22 - m12 * m21]
 
 
-def _exact_point(p: Sequence[float], eigen: bool) -> tuple[int, float, float]:
+def _exact_point(p: Sequence[float], eigen: bool, spec: Any = None) -> tuple[int, float, float]:
     try:
-        q = _quartic_exact(exact_trivial_entries(p))
+        q = _quartic_exact(exact_trivial_entries(p, spec))
     except (ZeroDivisionError, OverflowError, ValueError):  # singular closed form (invalid parameters)
         return UNDECIDED, math.nan, math.nan
     code = routh_exact(q)
@@ -521,21 +679,24 @@ def _exact_point(p: Sequence[float], eigen: bool) -> tuple[int, float, float]:
     return code, mr, fr
 
 
-def trivial_verdicts(P: np.ndarray, *, eigen: bool = True, codes: np.ndarray | None = None
+def trivial_verdicts(P: np.ndarray, *, eigen: bool = True, codes: np.ndarray | None = None, spec: Any = None
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per-point robust route for 2-DOF parameter vectors at the trivial silent motion.
 
     Parameters
     ----------
-    P : ndarray, shape (n, 17)
-        Parameter vectors (:data:`~.space.VECTOR_NAMES` order, compliances),
-        valid and with ``mu1 h10 = mu2 h20``.
+    P : ndarray, shape (n, n_parameters)
+        Parameter vectors (the model's packing order, compliances), valid and
+        with a trivial silent motion (for the paper's model ``mu1 h10 = mu2 h20``).
     eigen : bool
         Also compute ``max_real`` and ``frequency`` (and reconcile them with
         the verdicts).
     codes : ndarray of uint8, optional
         Verdicts already certified elsewhere (e.g. by a compiled map kernel);
         only entries equal to :data:`UNDECIDED` are recomputed.
+    spec : ModelSpec, optional
+        The model (default: the paper's); it needs a closed form
+        (:func:`~.kernels.model_form`).
 
     Returns
     -------
@@ -565,17 +726,17 @@ def trivial_verdicts(P: np.ndarray, *, eigen: bool = True, codes: np.ndarray | N
     out = np.full(n, UNDECIDED, dtype=np.uint8) if codes is None else codes.astype(np.uint8).copy()
     A = RA = None
     if todo.any() or eigen:
-        E, R = trivial_entries(P)
+        E, R = trivial_entries(P, spec)
         A, RA = quartic_interval(E, R)
     if todo.any():
         ix = np.flatnonzero(todo)
         out[ix] = routh_verdicts(A[ix], RA[ix])
         for i in ix[out[ix] == UNDECIDED]:
             if np.all(np.isfinite(P[i])):
-                out[i] = _exact_point(P[i], False)[0]
+                out[i] = _exact_point(P[i], False, spec)[0]
     if eigen and A is not None:
         mr, fr = roots_summary(A)
-        reconcile(out, mr, lambda i: _exact_point(P[i], True), fr)
+        reconcile(out, mr, lambda i: _exact_point(P[i], True, spec), fr)
     return out, mr, fr
 
 

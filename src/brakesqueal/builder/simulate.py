@@ -19,7 +19,6 @@ import numpy as np
 
 from ..errors import ParameterError
 from .components import ModelSpec
-from .numeric import _pvec, compile_model, linearize_model
 
 __all__ = ["BuiltTrajectory", "simulate_model"]
 
@@ -131,26 +130,33 @@ def simulate_model(
     from ..simulation.estimate import linear_modes
     from ..simulation.trajectory import _STAGES, integration_error_bound
 
-    lm = linearize_model(spec, overrides)
+    from ..analysis.linear import linearize
+    from ..codegen import compile_model
+
+    params = spec.get_preset(None).resolve(dict(overrides or {}))
+    lm = linearize(params, pad_rates="quasi-static")  # as integrated below (tangential rates neglected)
+    Q0 = lm.silent.q0
     modes = linear_modes(lm.A)
     if sample_rate is None:
         sample_rate = max(20000.0, estimation_rate(modes, t_end))
     cm = compile_model(spec)
     n, m = cm.n, cm.m
+    nx = cm.nx
     pert = np.zeros(2 * n)
     if len(perturbation) > 2 * n or not all(math.isfinite(v) for v in perturbation):
         raise ParameterError(f"the perturbation must be at most {2 * n} finite numbers; got {list(perturbation)}")
     pert[: len(perturbation)] = perturbation
-    p = _pvec(cm, lm.values)
-    L = lm.L0.copy()
+    p = [float(v) for v in params.vector()]
+    L = lm.silent.l0.copy()
     zeros = [0.0] * n
+    rates = [0.0] * m  # the pads' tangential rates are neglected here (quasi-static pads)
 
     def solve_L(Q: np.ndarray, dQ: np.ndarray) -> np.ndarray:
         nonlocal L
         for _ in range(20):
-            x = list(Q) + list(dQ) + zeros + list(L)
+            x = list(Q) + list(dQ) + zeros + list(L) + rates
             g = np.asarray(cm.residuals(x, p)[n:])
-            GL = np.asarray(cm.jacobians(x, p)).reshape(n + m, 3 * n + m)[n:, 3 * n:]
+            GL = np.asarray(cm.jacobians(x, p)).reshape(n + m, nx)[n:, 3 * n:3 * n + m]
             step = np.linalg.solve(GL, -g)
             L = L + step
             if np.all(np.abs(step) <= 1e-14 * (np.abs(L) + 1e-12)):
@@ -160,22 +166,22 @@ def simulate_model(
     def rhs(t: float, y: np.ndarray) -> np.ndarray:
         Q, dQ = y[:n], y[n:]
         Lv = solve_L(Q, dQ) if m else L
-        x = list(Q) + list(dQ) + zeros + list(Lv)
+        x = list(Q) + list(dQ) + zeros + list(Lv) + rates
         R0 = np.asarray(cm.residuals(x, p)[:n])
-        M = np.asarray(cm.jacobians(x, p)).reshape(n + m, 3 * n + m)[:n, 2 * n:3 * n]
+        M = np.asarray(cm.jacobians(x, p)).reshape(n + m, nx)[:n, 2 * n:3 * n]
         return np.concatenate([dQ, -np.linalg.solve(M, R0)])
 
     def contact(y: np.ndarray) -> np.ndarray:
         Q, dQ = y[:n], y[n:]
         Lv = solve_L(Q, dQ) if m else L
-        return np.asarray(cm.contact(list(Q) + list(dQ) + zeros + list(Lv), p)).reshape(-1, 2)[:, 0]
+        return cm.contact_table(list(Q) + list(dQ) + zeros + list(Lv) + rates, p)[:, 0]
 
     def lift(t: float, y: np.ndarray) -> float:
         return float(contact(y).min())
 
     lift.terminal = True  # type: ignore[attr-defined]
     lift.direction = -1  # type: ignore[attr-defined]
-    y0 = np.concatenate([lm.Q0, np.zeros(n)]) + pert
+    y0 = np.concatenate([Q0, np.zeros(n)]) + pert
     if lift(0.0, y0) <= 0:
         raise ParameterError("the initial state has a pad out of contact (normal force <= 0)")
     t_eval = np.arange(0.0, t_end, 1.0 / sample_rate)
@@ -192,6 +198,6 @@ def simulate_model(
         status, msg = "failed", f"solver failed: {sol.message}"
     ie = 0.0
     if Y.shape[0] > 1:
-        y_s = np.concatenate([lm.Q0, np.zeros(n)])
+        y_s = np.concatenate([Q0, np.zeros(n)])
         ie = integration_error_bound(Y - y_s, Y, rtol, atol, sol.nfev / _STAGES.get(method, 1), float(sol.t[-1]))
-    return BuiltTrajectory(status, msg, sol.t, Y[:, :n], Y[:, n:], fn, cm.coords, lm.Q0, modes, ie)
+    return BuiltTrajectory(status, msg, sol.t, Y[:, :n], Y[:, n:], fn, cm.coords, Q0, modes, ie)

@@ -24,6 +24,7 @@ from typing import Any, TextIO
 import numpy as np
 
 from ..errors import ParameterError
+from ..status import PointStatus
 from .compute import FLOAT_QUANTITIES, ChunkSpec, compute_chunk
 from .lock import StoreLock, lock_holder
 from .store import (StoreError, _NotWritable, check_location, check_skeleton, check_writable,
@@ -444,7 +445,8 @@ def _in_memory(st: Study, spec: ChunkSpec, workers: Any, scheduler: Any, client:
         raise ParameterError(f"study '{st.source}' has no store, so its results are kept in memory: "
                              f"{st.n_points} points need {per_point * st.n_points / 1e9:.3g} GB, more than the "
                              f"limit of {_MAX_IN_MEMORY / 1e9:g} GB; give a store (store= or [output] store)")
-    data: dict[str, np.ndarray] = {"stable": np.zeros(st.shape, bool), "status": np.full(st.shape, -1, np.int8)}
+    data: dict[str, np.ndarray] = {"stable": np.zeros(st.shape, bool),
+                                   "status": np.full(st.shape, int(PointStatus.NOT_COMPUTED), np.int8)}
     data.update({q: np.full(st.shape, np.nan) for q in FLOAT_QUANTITIES if q in st.quantities})
     todo = list(range(st.n_chunks))
     with _client(workers, scheduler, client, timeout) as cl:
@@ -456,20 +458,20 @@ def _in_memory(st: Study, spec: ChunkSpec, workers: Any, scheduler: Any, client:
     va = variable_attrs(st)
     dims = st.dims
     if st.kind == "grid":
-        coords: dict[str, Any] = {a.name: xr.Variable((a.name,), a.values, {"units": _units(a.name),
+        coords: dict[str, Any] = {a.name: xr.Variable((a.name,), a.values, {"units": _units(a.name, st),
                                                                              "scale": a.scale}) for a in st.axes}
     else:
         coords = {"sample": np.arange(st.n_samples)}
-        coords.update({n: ("sample", v, {"units": _units(n)}) for n, v in st.samples().items()})
+        coords.update({n: ("sample", v, {"units": _units(n, st)}) for n, v in st.samples().items()})
     ds = xr.Dataset({k: (dims, v, {a: b for a, b in va[k].items() if a != "coordinates"})
                      for k, v in data.items()}, coords=coords, attrs=study_attrs(st))
     return ds
 
 
-def _units(name: str) -> str:
+def _units(name: str, study: Any = None) -> str:
     from ..results import _units as u
 
-    return u(name)
+    return u(name, study.space() if study is not None else None)
 
 
 def open_sweep(store: str | Path, *, verify: bool = True) -> Any:

@@ -52,6 +52,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import BrakesquealError, ParameterError
+from ..status import STATUS_MEANINGS, PointStatus
 from .compute import FLOAT_QUANTITIES
 
 __all__ = ["StoreError", "MARKERS", "MANIFEST", "study_attrs", "variable_attrs", "coordinates", "create_store",
@@ -62,8 +63,8 @@ __all__ = ["StoreError", "MARKERS", "MANIFEST", "study_attrs", "variable_attrs",
 MARKERS = "_sweep_chunks"
 MANIFEST = f"{MARKERS}/_creation.json"
 _FORMAT = "brakesqueal-sweep-store/1"
-_STATUS_MEANINGS = ("not_computed ok ok_nontrivial_silent_motion no_silent_motion pad_loses_contact invalid_parameters"
-                    " undecided")
+#: ``status`` codes (:class:`~brakesqueal.status.PointStatus`); chunks not yet written read as ``NOT_COMPUTED``.
+_STATUS_FILL = int(PointStatus.NOT_COMPUTED)
 
 
 class StoreError(BrakesquealError):
@@ -74,10 +75,10 @@ class _NotWritable(StoreError):
     """The store's location cannot be written (a complete store may still be read)."""
 
 
-def _units(name: str) -> str:
+def _units(name: str, study: Any = None) -> str:
     from ..results import _units as u
 
-    return u(name)
+    return u(name, study.space() if study is not None else None)
 
 
 def checksum(a: np.ndarray) -> str:
@@ -205,7 +206,8 @@ def study_attrs(study: Any) -> dict[str, Any]:
         "space": space.label,
         "settings": json.dumps({k: str(v) for k, v in space.definitions().items()}),
         "tied": json.dumps(dict(space.tied)),
-        "criterion": "Lienard-Chipart on det(lambda^2 M + lambda D + K) (exact sign test)",
+        "criterion": "certified verdict from every eigenvalue of the linear model about the silent motion "
+                     "(Lienard-Chipart on the exact quartic where the closed form applies)",
         "chunk_shape": list(study.chunks),
         "n_chunks": study.n_chunks,
     }
@@ -215,7 +217,8 @@ def variable_attrs(study: Any) -> dict[str, dict[str, Any]]:
     """Attributes of every data variable."""
     extra = {"coordinates": " ".join(study.sample_names)} if study.kind == "samples" else {}
     out = {"stable": {"long_name": "silent motion asymptotically stable (Hurwitz)", **extra},
-           "status": {"flag_values": list(range(-1, 6)), "flag_meanings": _STATUS_MEANINGS, **extra}}
+           "status": {"flag_values": [int(c) for c in PointStatus], "flag_meanings": STATUS_MEANINGS,
+                      **extra}}
     for q, qa in FLOAT_QUANTITIES.items():
         if q in study.quantities:
             out[q] = {**qa, **extra}
@@ -241,7 +244,7 @@ def _build_skeleton(root: Path, study: Any, attrs: dict[str, Any], *, write_coor
     if study.kind == "grid":
         for ax in study.axes:
             a = g.create_array(ax.name, shape=(ax.size,), dtype="f8", chunks=(ax.size,), dimension_names=(ax.name,),
-                               attributes={"units": _units(ax.name), "scale": ax.scale})
+                               attributes={"units": _units(ax.name, study), "scale": ax.scale})
             if write_coordinates:
                 a[:] = coords[ax.name]
     else:
@@ -252,7 +255,7 @@ def _build_skeleton(root: Path, study: Any, attrs: dict[str, Any], *, write_coor
             a[:] = coords["sample"]
         for r in study.ranges:
             a = g.create_array(r.name, shape=(n,), dtype="f8", chunks=(chunks[0],), dimension_names=("sample",),
-                               attributes={"units": _units(r.name), "scale": "log" if r.log else "linear",
+                               attributes={"units": _units(r.name, study), "scale": "log" if r.log else "linear",
                                            "sampling": f"{study.method} seed={study.seed}"})
             if write_coordinates:
                 a[:] = coords[r.name]
@@ -260,7 +263,7 @@ def _build_skeleton(root: Path, study: Any, attrs: dict[str, Any], *, write_coor
     comp = _compressor()
     g.create_array("stable", shape=shape, dtype="bool", chunks=chunks, dimension_names=dims, fill_value=False,
                    compressors=comp, attributes=va["stable"])
-    g.create_array("status", shape=shape, dtype="i1", chunks=chunks, dimension_names=dims, fill_value=-1,
+    g.create_array("status", shape=shape, dtype="i1", chunks=chunks, dimension_names=dims, fill_value=_STATUS_FILL,
                    compressors=comp, attributes=va["status"])
     for q in FLOAT_QUANTITIES:
         if q in study.quantities:

@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..parameters import Value
+from ..model.parameters import Value
 
 __all__ = ["Study", "GridAxis", "SampleRange", "load_study", "QUANTITIES", "DEFAULT_QUANTITIES", "MAX_AXIS_POINTS",
            "MAX_POINTS", "MAX_CHUNKS", "MAX_CHUNK_POINTS"]
@@ -237,12 +237,10 @@ class Study:
         return self.__dict__["_hash"]
 
     def space(self) -> Any:
-        """The :class:`~brakesqueal.analysis.space.ParameterSpace` of the study (cached per process)."""
-        from .compute import build_space, model_space
+        """The :class:`~brakesqueal.model.parameters.ParameterSpace` of the study (cached per process)."""
+        from .compute import build_space
 
-        if self.model is not None:
-            return model_space(self.model, tuple(self.values.items()))
-        return build_space(self.preset, tuple(self.values.items()), tuple(self.tied.items()))
+        return build_space(self.preset, tuple(self.values.items()), tuple(self.tied.items()), self.model)
 
 
 # ---------------------------------------------------------------- parsing helpers
@@ -438,33 +436,40 @@ def load_study(study: Any) -> Study:
 
 
 def _preset_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str | None, dict[str, Value],
-                                                                        dict[str, Any], Any]:
-    """The preset / parameter-file / [parameters] / [tied] part of a study: (preset, values, tied, space)."""
-    from ..parameters import PARAMETER_NAMES, get_preset, load_parameters
+                                                                        dict[str, Any], Any, str | None]:
+    """The preset / parameter-file / [parameters] / [tied] part of a study: (preset, values, tied, space, model)."""
+    from ..model.io import load_parameter_file, spec_to_dict
+    from ..model.library import get_model, get_preset, resolve_model
 
+    paper_names = tuple(get_model("paper").parameters)
     preset_name = data.get("preset")
     if preset_name is not None and not isinstance(preset_name, str):
         raise ctx.err("preset", f"must be a string; got {preset_name!r}")
     values: dict[str, Value] = {}
+    model_json = None
+    spec = None
     if "params" in data:
         pfile = data["params"]
         if not isinstance(pfile, str):
             raise ctx.err("params", f"must be a file name; got {pfile!r}")
         path = pfile if Path(pfile).is_absolute() else str(base / pfile)
         try:
-            file_preset, entries = load_parameters(path)
+            f_model, f_preset, entries = load_parameter_file(path)
+            spec = resolve_model(f_model) if f_model is not None else None
         except ParameterError as exc:
             raise ctx.err("params", str(exc)) from None
-        if preset_name is not None and file_preset is not None and file_preset.name != preset_name:
-            raise ctx.err("preset", f"'{preset_name}' conflicts with preset '{file_preset.name}' of '{pfile}'")
-        preset_name = preset_name or (file_preset.name if file_preset else None)
+        if preset_name is not None and f_preset is not None and f_preset != preset_name:
+            raise ctx.err("preset", f"'{preset_name}' conflicts with preset '{f_preset}' of '{pfile}'")
+        preset_name = preset_name or f_preset
         values.update(entries)
+        if spec is not None:
+            model_json = json.dumps(spec_to_dict(spec), sort_keys=True)
     elif preset_name is None and not data.get("parameters"):
         raise ctx.err("preset", "missing: name a preset (e.g. preset = \"paper-fig2\"), a parameter file "
                                 "(params = \"file.toml\") or all 17 model parameters in [parameters]")
     if preset_name is not None:
         try:
-            get_preset(preset_name)
+            spec.get_preset(preset_name) if spec is not None else get_preset(preset_name)
         except ParameterError as exc:
             raise ctx.err("preset", str(exc)) from None
     params_tab = ctx.table(data.get("parameters", {}), "parameters")
@@ -472,11 +477,11 @@ def _preset_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str | No
         if not (_is_num(v) or isinstance(v, str)):
             raise ctx.err(f"parameters.{k}", f"must be a number or an expression string; got {v!r}")
         values[k] = v
-    if preset_name is None and set(values) != set(PARAMETER_NAMES):
-        missing = [n for n in PARAMETER_NAMES if n not in values]
-        unknown = [n for n in values if n not in PARAMETER_NAMES]
+    if preset_name is None and spec is None and set(values) != set(paper_names):
+        missing = [n for n in paper_names if n not in values]
+        unknown = [n for n in values if n not in paper_names]
         if unknown:
-            raise ctx.err(f"parameters.{unknown[0]}", "unknown parameter; valid names: " + ", ".join(PARAMETER_NAMES))
+            raise ctx.err(f"parameters.{unknown[0]}", "unknown parameter; valid names: " + ", ".join(paper_names))
         raise ctx.err("parameters", "missing " + ", ".join(missing) + " (no preset: give all 17 model parameters)")
     tied_tab = ctx.table(data.get("tied", {}), "tied")
     for k, v in tied_tab.items():
@@ -487,18 +492,19 @@ def _preset_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str | No
     from .compute import build_space
 
     try:
-        space = build_space(preset_name, tuple(values.items()), tuple(tied_tab.items()))
+        space = build_space(preset_name, tuple(values.items()), tuple(tied_tab.items()), model_json)
     except ParameterError as exc:
         bad = next((f"parameters.{k}" for k in values if f"'{k}'" in str(exc)), None)
         bad = bad or next((f"tied.{k}" for k in tied_tab if f"'{k}'" in str(exc)), "parameters")
         raise ctx.err(bad, str(exc)) from None
 
-    return preset_name, values, tied_tab, space
+    return preset_name, values, tied_tab, space, model_json
 
 
 def _model_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str, dict[str, Value], Any]:
     """The ``model = ...`` part of a study: (canonical model JSON, parameter overrides, space)."""
-    from ..builder import resolve_model, spec_to_dict
+    from ..model.io import spec_to_dict
+    from ..model.library import resolve_model
 
     for key in ("preset", "params", "tied"):
         if key in data:
@@ -517,10 +523,10 @@ def _model_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str, dict
             raise ctx.err(f"parameters.{k}", f"must be a number or an expression string; got {v!r}")
         values[k] = v
     model_json = json.dumps(spec_to_dict(spec), sort_keys=True)
-    from .compute import model_space
+    from .compute import build_space
 
     try:
-        space = model_space(model_json, tuple(values.items()))
+        space = build_space(None, tuple(values.items()), (), model_json)
     except ParameterError as exc:
         bad = next((f"parameters.{k}" for k in values if f"'{k}'" in str(exc)), "parameters")
         raise ctx.err(bad, str(exc)) from None
@@ -538,7 +544,7 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
         model_json, values, space = _model_space(ctx, data, base)
         preset_name, tied_tab = None, {}
     else:
-        preset_name, values, tied_tab, space = _preset_space(ctx, data, base)
+        preset_name, values, tied_tab, space, model_json = _preset_space(ctx, data, base)
 
     # ---- axes / samples
     if ("axes" in data) == ("samples" in data):
@@ -607,16 +613,20 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
                 ctx.number(cr[1], "compute.critical_speed_range[1]"))
         if not 0 < crit[0] < crit[1]:
             raise ctx.err("compute.critical_speed_range", f"needs 0 < LO < HI; got {cr!r}")
-    if "critical_speed" in quant and model_json is not None:
-        raise ctx.err("compute.quantities", "'critical_speed' is not available for built models in sweeps; "
-                                            "use brakesqueal critical-speed --model")
     if "critical_speed" in quant:
-        from ..expressions import names_in
+        from ..analysis.kernels import omega_kernel_available
+        from ..model.expressions import names_in
 
-        if "Omega" in names:
-            raise ctx.err("compute.quantities", "'critical_speed' searches along Omega; Omega cannot also be swept")
-        if "Omega" not in space.settable() or any("Omega" in names_in(e) for e in space.tied.values()):
-            raise ctx.err("compute.quantities", "'critical_speed' needs Omega to be a settable parameter that no "
+        spin = space.model.disk.Omega
+        if not isinstance(spin, str) or not omega_kernel_available(space.model):
+            raise ctx.err("compute.quantities", f"'critical_speed' in sweeps needs the certified critical-speed "
+                                                f"kernel (models with two coordinates, rate-free pads and the spin "
+                                                f"as a parameter); model '{space.model.name}' has none: use "
+                                                f"brakesqueal critical-speed --model {space.model.name}")
+        if spin in names:
+            raise ctx.err("compute.quantities", f"'critical_speed' searches along {spin}; {spin} cannot also be swept")
+        if spin not in space.settable() or any(spin in names_in(e) for e in space.tied.values()):
+            raise ctx.err("compute.quantities", f"'critical_speed' needs {spin} to be a settable parameter that no "
                                                 "tie expression uses")
 
     # ---- execution / output

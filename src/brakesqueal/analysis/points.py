@@ -1,0 +1,562 @@
+r"""The one per-point evaluator: status, verdict, max Re λ and frequency of any model at parameter points.
+
+Maps, sweeps, the numeric routes of crossings and critical speeds and the
+plots all classify parameter points through this module, so a point gets the
+same status, verdict and eigenvalue summary wherever it is computed.
+
+Routes, chosen per point by what the model allows:
+
+* **Invalid parameters** (:meth:`ParameterSpace.valid
+  <brakesqueal.model.parameters.ParameterSpace.valid>`, the one table of
+  roles): :attr:`~brakesqueal.status.PointStatus.INVALID`.
+* **Trivial silent motion** — the zero-state residuals vanish to rounding
+  (:func:`~.equilibrium.is_trivial`, the criterion of
+  :func:`~.equilibrium.silent_motion`), or identically on the axes (the
+  closed-form route, decided symbolically by
+  :func:`~.kernels.quartic_numerators`):
+
+  - models with a closed form (:func:`~.kernels.model_form`: two
+    coordinates, rate-free pads): bounded closed-form entries → interval
+    quartic → certified Routh → exact rational Routh
+    (:func:`~.robust.trivial_verdicts`);
+  - otherwise, with every pad rate-free at the zero state, batched ``M, D, K``
+    (:meth:`CompiledModel.zero_linear
+    <brakesqueal.codegen.compiled.CompiledModel.zero_linear>`) and certified
+    eigenvalue verdicts (:func:`~.robust.eigen_verdicts`; for two
+    coordinates first the interval quartic, :func:`~.robust.matrix_verdicts`);
+  - with pads that keep first-order dynamics (rate-dependent friction),
+    batched descriptor blocks at the zero state and the verdict of every
+    eigenvalue of ``E^-1 A`` (:func:`~.robust.descriptor_verdicts`).
+
+  Every pad must touch and slide at the zero state (checked with the
+  generated contact function; :attr:`~brakesqueal.status.PointStatus.CONTACT_LOSS`,
+  :attr:`~brakesqueal.status.PointStatus.NO_SLIDING`).
+* **Non-trivial silent motion** — point by point,
+  :func:`~.linear.linearize` (the full :class:`~.linear.LinearModel`, pad
+  states included) and :func:`linear_verdict` on every eigenvalue; a failure
+  of the silent motion gives the status of its type
+  (:func:`~brakesqueal.status.status_of_error`).
+
+Consistency by construction: a point with status ``OK`` or ``OK_NONTRIVIAL``
+carries a certified verdict and ``stable`` ⇔ ``max_real < 0``
+(:func:`~.robust.reconcile`); a verdict that cannot be certified gives
+``UNDECIDED``; every other status is never stable.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError, SilentMotionError
+from ..status import PointStatus, status_of_error
+from .robust import (
+    STABLE, UNDECIDED, descriptor_verdicts, eigen_verdicts, matrix_verdicts, trivial_verdicts,
+)
+
+__all__ = ["PointVerdict", "Points", "evaluate", "evaluate_arrays", "evaluate_point", "linear_verdict",
+           "eliminate_algebraic",
+           "closed_form_route", "compact", "valid_points", "ROUTES"]
+
+#: Method strings of the routes (recorded in the results' ``method``).
+ROUTES = {
+    "closed": "closed form: certified Hurwitz test of the exact quartic (generated kernels; exact rational fallback)",
+    "points": "per point: certified eigenvalue verdicts (trivial silent motions batched at the zero state, "
+              "non-trivial ones linearized one by one with the pads' states kept)",
+}
+
+_BATCH_CLOSED = 1 << 16
+_BATCH_EIGEN = 1 << 12
+
+
+@dataclass(frozen=True)
+class PointVerdict:
+    """Status and verdict of one parameter point.
+
+    Attributes
+    ----------
+    status : PointStatus
+        How the point was decided (or why not).
+    stable : bool
+        Asymptotically stable silent motion (certified); ``False`` unless
+        ``status`` is ``OK`` or ``OK_NONTRIVIAL``.
+    max_real : float
+        Largest real part of the eigenvalues [1/s] (NaN where none was computed).
+    frequency : float
+        ``|Im λ| / 2π`` of that eigenvalue [Hz].
+    """
+
+    status: PointStatus
+    stable: bool
+    max_real: float
+    frequency: float
+
+    @property
+    def decided(self) -> bool:
+        """Whether the verdict is established (status ``OK`` or ``OK_NONTRIVIAL``)."""
+        return self.status in (PointStatus.OK, PointStatus.OK_NONTRIVIAL)
+
+
+@dataclass(frozen=True)
+class Points:
+    """Statuses and verdicts of many points (arrays of one shape).
+
+    Attributes
+    ----------
+    status : ndarray of int8
+        :class:`~brakesqueal.status.PointStatus` codes.
+    stable : ndarray of bool
+        Certified verdicts (never true unless the status is ``OK``/``OK_NONTRIVIAL``).
+    max_real, frequency : ndarray of float
+        Least-stable eigenvalue summary (NaN where not computed).
+    """
+
+    status: np.ndarray
+    stable: np.ndarray
+    max_real: np.ndarray
+    frequency: np.ndarray
+
+
+def compact(a: Any) -> np.ndarray:
+    """The smallest broadcastable array equal to a broadcast view (stride-0 axes reduced to length 1).
+
+    Parameters
+    ----------
+    a : array_like
+        Typically a view returned by :func:`numpy.broadcast_to`.
+
+    Returns
+    -------
+    ndarray
+        Same values, broadcastable to ``a.shape``.
+    """
+    a = np.asarray(a)
+    return a[tuple(slice(0, 1) if st == 0 and n > 1 else slice(None) for st, n in zip(a.strides, a.shape))]
+
+
+def valid_points(space: Any, arr: Mapping[str, Any]) -> np.ndarray:
+    """Validity of broadcast parameter arrays, evaluated on their compact forms (cheap for grids).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space.
+    arr : Mapping[str, ndarray]
+        Model parameter arrays (:meth:`ParameterSpace.arrays`).
+
+    Returns
+    -------
+    ndarray of bool
+        Broadcastable to the arrays' shape.
+    """
+    return np.asarray(space.valid({k: compact(v) for k, v in arr.items()}))
+
+
+def closed_form_route(space: Any, names: tuple[str, ...]) -> bool:
+    """Whether the closed-form route applies to every point of a grid over ``names``.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space.
+    names : tuple of str
+        The axes.
+
+    Returns
+    -------
+    bool
+        The model has a closed form (:func:`~.kernels.model_form`) and the
+        silent motion is identically trivial on the axes (every zero-state
+        residual vanishes under the space's ties).
+    """
+    from .kernels import quartic_numerators
+
+    return quartic_numerators(space, tuple(names)) is not None
+
+
+class _Model:
+    """What the routes need of a model (compiled code, closed form), built once per model."""
+
+    _cache: dict[str, _Model] = {}
+
+    def __init__(self, spec: Any) -> None:
+        from ..codegen import compile_model
+        from .kernels import model_form
+
+        self.spec = spec
+        self.cm = compile_model(spec)
+        self.form = model_form(spec)
+        self.rate_free = all(self.cm.rate_free_at_zero)
+
+    @classmethod
+    def of(cls, spec: Any) -> _Model:
+        from ..codegen import model_key
+
+        key = model_key(spec)
+        if key not in cls._cache:
+            cls._cache[key] = cls(spec)
+        m = cls._cache[key]
+        if m.spec is not spec:
+            m = cls.__new__(cls)
+            m.__dict__.update(cls._cache[key].__dict__)
+            m.spec = spec
+        return m
+
+
+def linear_verdict(lm: Any) -> tuple[int, float, float]:
+    """Certified verdict of a linear model from every one of its eigenvalues.
+
+    Parameters
+    ----------
+    lm : LinearModel
+        From :func:`~.linear.linearize` (pads kept as states where they matter).
+
+    Returns
+    -------
+    code, max_real, frequency : int, float, float
+        :data:`~.robust.STABLE`, :data:`~.robust.UNSTABLE` or
+        :data:`~.robust.UNDECIDED`; the least-stable eigenvalue's real part
+        [1/s] and frequency [Hz].  With pad states the descriptor
+        ``E xi' = A xi`` is used (:func:`~.robust.descriptor_verdicts`), so
+        the pads' own modes count.
+    """
+    if lm.pad_states:
+        E, A = eliminate_algebraic(*lm.descriptor, len(lm.pad_states))
+        c, mr, fr = descriptor_verdicts(E[None], A[None])
+    elif lm.n == 2:
+        c, mr, fr = matrix_verdicts(lm.M, lm.D, lm.K)
+    else:
+        c, mr, fr = eigen_verdicts(lm.M[None], lm.D[None], lm.K[None])
+    return int(c[0]), float(mr[0]), float(fr[0])
+
+
+def eliminate_algebraic(E: np.ndarray, A: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Eliminate the algebraic pad equations of a descriptor system (rows of ``E`` that are exactly zero).
+
+    A kept pad whose tangential balance has no rate term at this point
+    (e.g. a rigid support, ``1/k_ip = 0``: its row of ``E`` vanishes exactly)
+    is an algebraic relation ``A_r xi = 0``; its deformation ``l_a`` is
+    solved from it and substituted (with its derivative) into the other
+    rows: ``E' = E_rest - E_la A_r,la^-1 A_r,rest``, ``A' = A_rest - A_la
+    A_r,la^-1 A_r,rest``.  The finite eigenvalues are unchanged (the pencil
+    loses exactly its infinite ones), so ``E'`` is regular where the reduced
+    system is.
+
+    Parameters
+    ----------
+    E, A : ndarray, shape (m, m)
+        The descriptor (:attr:`LinearModel.descriptor
+        <brakesqueal.analysis.linear.LinearModel.descriptor>`).
+    k : int
+        Number of pad states (the trailing ``k`` unknowns; only these are eliminated).
+
+    Returns
+    -------
+    E, A : ndarray
+        The reduced descriptor (unchanged when no row of ``E`` vanishes, or
+        when the algebraic rows cannot be solved for pad states: the
+        verdict is then undecided).
+    """
+    E, A = np.array(E, dtype=float), np.array(A, dtype=float)
+    m = E.shape[0]
+    rows = np.flatnonzero(np.all(E == 0.0, axis=1))
+    if rows.size == 0 or rows.size > k:
+        return E, A
+    pads = np.arange(m - k, m)
+    # pick as many pad unknowns as algebraic rows: the best-conditioned columns of A[rows, pads]
+    import scipy.linalg
+
+    _, _, piv = scipy.linalg.qr(A[np.ix_(rows, pads)], pivoting=True)
+    cols = pads[np.sort(piv[:rows.size])]
+    keep_r = np.setdiff1d(np.arange(m), rows)
+    keep_c = np.setdiff1d(np.arange(m), cols)
+    Arl = A[np.ix_(rows, cols)]
+    try:
+        X = np.linalg.solve(Arl, A[np.ix_(rows, keep_c)])  # l_a = -X xi_rest
+    except np.linalg.LinAlgError:
+        return E, A
+    if not np.all(np.isfinite(X)):
+        return E, A
+    E2 = E[np.ix_(keep_r, keep_c)] - E[np.ix_(keep_r, cols)] @ X
+    A2 = A[np.ix_(keep_r, keep_c)] - A[np.ix_(keep_r, cols)] @ X
+    return E2, A2
+
+
+def _nontrivial_point(model: _Model, values: dict[str, float]) -> tuple[int, bool, float, float]:
+    """``(status, stable, max_real, frequency)`` of one point through the numeric linearization."""
+    from ..model.parameters import Parameters
+    from .linear import linearize
+
+    try:
+        lm = linearize(Parameters(model.spec, values), model=model.cm)
+    except (SilentMotionError, ParameterError) as exc:
+        return int(status_of_error(exc)), False, math.nan, math.nan
+    except np.linalg.LinAlgError:
+        return int(PointStatus.SOLVER_FAILED), False, math.nan, math.nan
+    code, mr, fr = linear_verdict(lm)
+    ok = PointStatus.OK if lm.silent.trivial else PointStatus.OK_NONTRIVIAL
+    if code == UNDECIDED:
+        return int(PointStatus.UNDECIDED), False, mr, fr
+    return int(ok), code == STABLE, mr, fr
+
+
+def _zero_descriptor(cm: Any, cols: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Batched descriptor ``(E, A)`` at the zero state with the rate-free pads eliminated.
+
+    Mirrors :func:`~.linear.linearize` (quasi-static pads: ``L`` eliminated
+    through ``G = 0``; the others kept as states).  Returns ``(E, A, usable)``
+    where ``usable`` is false for points at which a kept pad's rate blocks
+    vanish (:func:`~.linear.linearize` would eliminate it there; such points
+    go through the per-point route).
+    """
+    n, m, nx = cm.n, cm.m, cm.nx
+    vals = cm.zero_jacobians(cols)
+    N = cols[0].shape[0] if cols else 1
+    J = np.stack([np.broadcast_to(np.asarray(v, dtype=float), (N,)) for v in vals], axis=-1).reshape(N, n + m, nx)
+    dyn = ~np.array(cm.rate_free_at_zero, dtype=bool)
+    qs = ~dyn
+    M, D, K = J[:, :n, 2 * n:3 * n], J[:, :n, n:2 * n], J[:, :n, :n]
+    G_Q, G_dQ, G_ddQ = J[:, n:, :n], J[:, n:, n:2 * n], J[:, n:, 2 * n:3 * n]
+    G_L, G_dL = J[:, n:, 3 * n:3 * n + m], J[:, n:, 3 * n + m:]
+    R_L, R_dL = J[:, :n, 3 * n:3 * n + m], J[:, :n, 3 * n + m:]
+    with np.errstate(all="ignore"):
+        rates = np.concatenate([R_dL[:, :, dyn], np.swapaxes(G_dL[:, :, dyn], 1, 2), G_dL[:, dyn, :]], axis=2)
+        usable = np.all(np.any(rates != 0.0, axis=2), axis=1)
+        if qs.any():
+            Gss = G_L[:, qs][:, :, qs]
+            P = np.swapaxes(np.linalg.solve(np.swapaxes(Gss, 1, 2), np.swapaxes(R_L[:, :, qs], 1, 2)), 1, 2)
+            Pd = np.swapaxes(np.linalg.solve(np.swapaxes(Gss, 1, 2), np.swapaxes(G_L[:, dyn][:, :, qs], 1, 2)), 1, 2)
+            M = M - P @ G_ddQ[:, qs]
+            D = D - P @ G_dQ[:, qs]
+            K = K - P @ G_Q[:, qs]
+            RL = R_L[:, :, dyn] - P @ G_L[:, qs][:, :, dyn]
+            GQ = G_Q[:, dyn] - Pd @ G_Q[:, qs]
+            GdQ = G_dQ[:, dyn] - Pd @ G_dQ[:, qs]
+            GddQ = G_ddQ[:, dyn] - Pd @ G_ddQ[:, qs]
+            GL = G_L[:, dyn][:, :, dyn] - Pd @ G_L[:, qs][:, :, dyn]
+        else:
+            RL, GQ, GdQ, GddQ, GL = R_L, G_Q, G_dQ, G_ddQ, G_L
+        RdL, GdL = R_dL[:, :, dyn], G_dL[:, dyn][:, :, dyn]
+    k = int(dyn.sum())
+    I, Z = np.broadcast_to(np.eye(n), (N, n, n)), np.zeros((N, n, n))
+    Znk, Zkn = np.zeros((N, n, k)), np.zeros((N, k, n))
+    E = np.concatenate([np.concatenate([I, Z, Znk], 2), np.concatenate([Z, M, RdL], 2),
+                        np.concatenate([Zkn, GddQ, GdL], 2)], 1)
+    A = np.concatenate([np.concatenate([Z, I, Znk], 2), np.concatenate([-K, -D, -RL], 2),
+                        np.concatenate([-GQ, -GdQ, -GL], 2)], 1)
+    return E, A, usable
+
+
+def _zero_contact(cm: Any, cols: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Per point: every pad touches (``F_n > 0``) and slides (``|v_r| > 0``) at the zero state."""
+    from ..codegen.compiled import CONTACT_FIELDS
+
+    N = cols[0].shape[0] if cols else 1
+    x0 = [0.0] * cm.nx
+    with np.errstate(all="ignore"):
+        c = [np.broadcast_to(np.asarray(v, dtype=float), (N,)) for v in cm.vectorized.contact(x0, cols)]
+    nf = len(CONTACT_FIELDS)
+    touch = np.ones(N, dtype=bool)
+    slide = np.ones(N, dtype=bool)
+    for j in range(len(cm.spec.pads)):
+        fn = c[nf * j]
+        v2 = c[nf * j + 1] ** 2 + c[nf * j + 2] ** 2 + c[nf * j + 3] ** 2
+        touch &= np.isfinite(fn) & (fn > 0)
+        slide &= v2 > 0
+    return touch, slide
+
+
+def _trivial_batch(model: _Model, P: np.ndarray, eigen: bool, codes: np.ndarray | None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(status, codes, max_real, frequency)`` of points with a trivial silent motion (rows of ``P``)."""
+    N = P.shape[0]
+    status = np.full(N, int(PointStatus.OK), dtype=np.int8)
+    out = np.full(N, UNDECIDED, dtype=np.uint8)
+    mr = np.full(N, np.nan)
+    fr = np.full(N, np.nan)
+    if N == 0:
+        return status, out, mr, fr
+    if model.form is not None:
+        for b0 in range(0, N, _BATCH_CLOSED):
+            sl = slice(b0, min(N, b0 + _BATCH_CLOSED))
+            c, m, f = trivial_verdicts(P[sl], eigen=eigen, codes=None if codes is None else codes[sl],
+                                       spec=model.spec)
+            out[sl], mr[sl], fr[sl] = c, m, f
+    else:
+        cm = model.cm
+        for b0 in range(0, N, _BATCH_EIGEN):
+            sl = slice(b0, min(N, b0 + _BATCH_EIGEN))
+            cols = [np.ascontiguousarray(P[sl, k]) for k in range(P.shape[1])]
+            touch, slide = _zero_contact(cm, cols)
+            st = np.where(~touch, int(PointStatus.CONTACT_LOSS),
+                          np.where(~slide, int(PointStatus.NO_SLIDING), int(PointStatus.OK))).astype(np.int8)
+            if model.rate_free:
+                M, D, K = cm.zero_linear(cols)
+                c, m, f = (matrix_verdicts(M, D, K) if cm.n == 2 else eigen_verdicts(M, D, K))
+            else:
+                E, A, usable = _zero_descriptor(cm, cols)
+                c, m, f = descriptor_verdicts(E, A)
+                st = np.where(usable | (st != int(PointStatus.OK)), st, -1).astype(np.int8)  # -1: per point
+            ok = st == int(PointStatus.OK)
+            out[sl] = np.where(ok, c, UNDECIDED)
+            mr[sl] = np.where(ok, m, np.nan)
+            fr[sl] = np.where(ok, f, np.nan)
+            status[sl] = st
+    und = (status == int(PointStatus.OK)) & (out == UNDECIDED)
+    status[und] = int(PointStatus.UNDECIDED)
+    return status, out, mr, fr
+
+
+def evaluate_arrays(space: Any, arr: Mapping[str, Any], *, eigen: bool = True, codes: np.ndarray | None = None,
+                    closed: bool = False, valid: np.ndarray | None = None) -> Points:
+    """Statuses and verdicts of every point of broadcast parameter arrays.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space (any model).
+    arr : Mapping[str, ndarray]
+        Every model parameter as arrays broadcastable to one shape
+        (:meth:`ParameterSpace.arrays`).
+    eigen : bool
+        Also compute ``max_real`` and ``frequency`` where a cheaper certified
+        verdict exists (the closed-form route with ``codes``); the
+        eigenvalue routes always compute them.
+    codes : ndarray of uint8, optional
+        Verdicts already certified by a generated kernel at every point
+        (closed-form route; 2 = recompute).
+    closed : bool
+        The closed-form route applies to every valid point
+        (:func:`closed_form_route`): no residual check.
+    valid : ndarray of bool, optional
+        Validity mask (default :func:`valid_points`).
+
+    Returns
+    -------
+    Points
+        Arrays of the broadcast shape.
+    """
+    shape = np.broadcast_shapes(*(np.shape(v) for v in arr.values()))
+    model = _Model.of(space.model)
+    status = np.full(shape, int(PointStatus.INVALID), dtype=np.int8)
+    stable = np.zeros(shape, dtype=bool)
+    mr = np.full(shape, np.nan)
+    fr = np.full(shape, np.nan)
+    ok = np.broadcast_to(valid_points(space, arr) if valid is None else valid, shape)
+    if closed and model.form is not None and codes is not None and not eigen:
+        # verdict-only closed-form route: the kernel's certified codes; recompute only its uncertain points
+        kc = np.broadcast_to(codes, shape)
+        status[ok] = int(PointStatus.OK)
+        np.logical_and(ok, kc == STABLE, out=stable)
+        flat = np.flatnonzero(ok & (kc == UNDECIDED))
+        if flat.size:
+            ix = np.unravel_index(flat, shape)
+            vecs = space.vectors({k: compact(v) for k, v in arr.items()})
+            P = np.stack([np.broadcast_to(v, shape)[ix] for v in vecs], axis=1)
+            st, c, m, f = _trivial_batch(model, P, False, None)
+            status[ix] = st
+            stable[ix] = (c == STABLE) & (st == int(PointStatus.OK))
+        return Points(status, stable, mr, fr)
+    flat = np.flatnonzero(ok)
+    if flat.size == 0:
+        return Points(status, stable, mr, fr)
+    ix = np.unravel_index(flat, shape)
+    vecs = space.vectors({k: compact(v) for k, v in arr.items()})
+    P = np.stack([np.broadcast_to(v, shape)[ix] for v in vecs], axis=1) if vecs else np.zeros((flat.size, 0))
+    if closed and model.form is not None:
+        triv = np.ones(flat.size, dtype=bool)
+    else:
+        triv = _is_trivial(model, P)
+    kc = None if codes is None else np.broadcast_to(codes, shape)[ix]
+    t = np.flatnonzero(triv)
+    if t.size:
+        if kc is not None and not eigen:
+            sure = kc[t] != UNDECIDED
+            tix = tuple(a[t[sure]] for a in ix)
+            status[tix] = int(PointStatus.OK)
+            stable[tix] = kc[t[sure]] == STABLE
+            t = t[~sure]
+        st, c, m, f = _trivial_batch(model, P[t], eigen, None if kc is None else kc[t])
+        tix = tuple(a[t] for a in ix)
+        status[tix] = st
+        stable[tix] = (c == STABLE) & (st == int(PointStatus.OK))
+        mr[tix], fr[tix] = m, f
+        back = np.flatnonzero(st == -1)
+        triv[t[back]] = False  # kept pads without rate blocks here: per-point route
+    names = list(space.model.parameters)
+    for j in np.flatnonzero(~triv):
+        i = flat[j]
+        pi = np.unravel_index(i, shape)
+        values = {n: float(np.broadcast_to(arr[n], shape)[pi]) for n in names}
+        s, sb, m1, f1 = _nontrivial_point(model, values)
+        status[pi], stable[pi], mr[pi], fr[pi] = s, sb, m1, f1
+    return Points(status, stable, mr, fr)
+
+
+def _is_trivial(model: _Model, P: np.ndarray) -> np.ndarray:
+    """Zero-state residuals vanish to rounding (the criterion of ``silent_motion``), per row of ``P``."""
+    from .equilibrium import is_trivial
+
+    cm = model.cm
+    N = P.shape[0]
+    cols = [np.ascontiguousarray(P[:, k]) for k in range(P.shape[1])]
+    with np.errstate(all="ignore"):
+        F = np.stack([np.broadcast_to(np.asarray(v, dtype=float), (N,)) for v in cm.zero_residuals(cols)])
+        S = np.stack([np.broadcast_to(np.asarray(v, dtype=float), (N,)) for v in cm.zero_residual_scale(cols)])
+        return np.asarray(is_trivial(F, S), dtype=bool) & np.all(np.isfinite(F), axis=0)
+
+
+def evaluate(space: Any, values: Mapping[str, Any], *, eigen: bool = True) -> Points:
+    """Statuses and verdicts at points given by settable names of a parameter space.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space (any model); tied names follow the values.
+    values : Mapping[str, array_like]
+        Settable names → values (broadcastable arrays; SI units).
+    eigen : bool
+        See :func:`evaluate_arrays`.
+
+    Returns
+    -------
+    Points
+        Arrays of the broadcast shape.
+
+    Raises
+    ------
+    ParameterError
+        A name that is not settable in ``space``.
+    """
+    names = tuple(values)
+    arr = space.arrays({k: np.asarray(v, dtype=float) for k, v in values.items()})
+    closed = closed_form_route(space, names)
+    return evaluate_arrays(space, arr, eigen=eigen, closed=closed)
+
+
+def evaluate_point(space: Any, values: Mapping[str, float] | None = None) -> PointVerdict:
+    """Status and verdict of one point of a parameter space.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space.
+    values : Mapping[str, float], optional
+        Settable names → values (default: the space's current point).
+
+    Returns
+    -------
+    PointVerdict
+    """
+    vals = {k: np.array([float(v)]) for k, v in (values or {}).items()}
+    if not vals:
+        name = space.settable()[0]
+        vals = {name: np.array([space.value(name)])}
+    r = evaluate(space, vals)
+    return PointVerdict(PointStatus(int(r.status[0])), bool(r.stable[0]), float(r.max_real[0]),
+                        float(r.frequency[0]))
+
