@@ -204,7 +204,7 @@ def _bench_cmd(
         float, typer.Option("--baseline-t", help="Simulated time of the (slow) lambdify baseline run [s].")
     ] = 0.002,
 ) -> None:
-    """1 s of simulated squeal (paper-fig2) vs. sympy lambdify + solve_ivp RK45 at the same tolerances."""
+    """1 s of simulated squeal: paper-fig2 vs. lambdify + solve_ivp RK45; eight-dof vs. the former built-model path."""
     from .bench import report
     from .simulation.bench import bench_simulate
 

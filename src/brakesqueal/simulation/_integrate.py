@@ -25,6 +25,8 @@ POINTS_PER_PERIOD = 20
 START_AMPLITUDE = 1e-5
 #: Wall time [s] of one call of the compiled integrator (between calls progress is reported and Ctrl-C acts).
 CHUNK_SECONDS = 0.1
+#: Output samples post-processed per compiled call (about 0.1 s).
+_POST_BLOCK = 65536
 EventMode = Literal["stop", "continue", "off"]
 _EPS = float(np.finfo(float).eps)
 
@@ -42,7 +44,9 @@ class SilentState:
     vr0 : ndarray, shape (3 n_pads,)
         Sliding velocity of every pad at the silent motion (reference of the sliding-reversal events).
     ztol : ndarray, shape (m,)
-        Absolute Newton tolerance of every pad unknown (its rounding level).
+        Absolute Newton tolerance of every pad unknown: its rounding level
+        ``64 eps S_j / |dG_j/dz_j|`` with ``S_j`` the size of the terms of ``G_j``
+        at the silent motion (generated ``pad_scale``).
     silent : SilentMotion
         The silent motion (:func:`~brakesqueal.analysis.equilibrium.silent_motion`).
     """
@@ -111,6 +115,12 @@ class SimulationModel:
         return tuple(self.kernels.META["pads"])
 
     @property
+    def unknown_pads(self) -> tuple[str, ...]:
+        """The pad of every entry of :attr:`pad_unknowns`."""
+        return tuple(p.name for p in self.spec.pads if "tangential" not in p.dofs
+                     and (isinstance(p.k_ip, str) or math.isfinite(p.k_ip)))
+
+    @property
     def n(self) -> int:
         """Number of coordinates."""
         return len(self.coords)
@@ -166,12 +176,13 @@ class SimulationModel:
         dl = np.zeros(m)
         ztol = np.zeros(m)
         if m:
-            S = np.broadcast_to(np.asarray(cm.zero_residual_scale(list(p)), dtype=float), (n + m,))[n:]
+            S = np.empty(m)
+            self.kernels.pad_scale(y, l, dl, p, S)
             J = cm.jacobian_matrix(sm.state(), list(p))
             for j, kind in enumerate(self.pad_kinds):
                 G_l, G_dl = J[n + j, 3 * n + j], J[n + j, 3 * n + m + j]
                 d = G_l if kind == "quasi-static" else G_dl
-                pad = self.pad_unknowns[j]
+                pad = f"pad '{self.unknown_pads[j]}'"
                 if not (math.isfinite(d) and d != 0.0):
                     raise ParameterError(
                         f"{pad}: the tangential balance does not determine the pad's "
@@ -345,18 +356,26 @@ def _value(params: Any, v: Any) -> float:
     return float(params[v]) if isinstance(v, str) else float(v)
 
 
+def _scales(model: SimulationModel, params: Any) -> np.ndarray:
+    """Scale of every coordinate and pad state ``(Q, L_dynamic)``: 1 rad for a tilt, the largest pad radius [m]
+    for a length."""
+    length = max(abs(_value(params, p.radius)) for p in model.spec.pads) or 1.0
+    q = [1.0 if c in ("q1", "q2") and model.tilting else length for c in model.coords]
+    return np.array(q + [length] * len(model.dynamic))
+
+
 def _default_atol(model: SimulationModel, params: Any, rtol: float, modes: LinearModes | None) -> np.ndarray:
-    """``1e-6 rtol`` times a scale per state component: 1 rad (tilts), the largest pad radius (lengths), times
-    ``w = sqrt(k_t/Theta)`` (a non-tilting disk: the largest ``|lambda|``) for the rates."""
+    """``1e-6 rtol`` times the scale of every component (:func:`_scales`), the rates' scale times
+    ``w = sqrt(k_t/Theta)`` (a non-tilting disk: the largest ``|lambda|``)."""
     spec = model.spec
-    length = max(abs(_value(params, p.radius)) for p in spec.pads) or 1.0
     if model.tilting:
         w = math.sqrt(max(_value(params, spec.disk.k_t), 1.0) / _value(params, spec.disk.Theta))
     else:
         w = float(np.abs(modes.eigenvalues).max()) if modes is not None else 1.0
         w = w if math.isfinite(w) and w > 0 else 1.0
-    q = np.array([1.0 if c in ("q1", "q2") else length for c in model.coords])
-    return rtol * 1e-6 * np.concatenate([q, q * w, np.full(len(model.dynamic), length)])
+    s = _scales(model, params)
+    n = model.n
+    return rtol * 1e-6 * np.concatenate([s[:n], s[:n] * w, s[n:]])
 
 
 def _check_tolerances(rtol: float, atol: Any, default: np.ndarray) -> np.ndarray:
@@ -373,19 +392,17 @@ def _check_tolerances(rtol: float, atol: Any, default: np.ndarray) -> np.ndarray
     return a
 
 
-def _start_vector(model: SimulationModel, modes: LinearModes) -> np.ndarray:
-    """``START_AMPLITUDE Re(v_0)``, scaled so that its largest tilt (or coordinate) is ``START_AMPLITUDE``."""
+def _start_vector(model: SimulationModel, modes: LinearModes, scales: np.ndarray) -> np.ndarray:
+    """``Re(v_0)`` scaled so that its largest coordinate or pad state relative to its scale is ``START_AMPLITUDE``."""
     v = np.real(modes.right[:, 0])
     n = model.n
-    ref = v[:2] if model.tilting else v[:n]
+    ref = np.concatenate([v[:n], v[2 * n:]]) / scales
     s = float(np.abs(ref).max())
-    if not s > 0:
-        s = float(np.abs(v[:n]).max()) or 1.0
-    return START_AMPLITUDE * v / s
+    return START_AMPLITUDE * v / (s if s > 0 else 1.0)
 
 
 def _initial_state(model: SimulationModel, x0: Any, perturbation: Any, y_s: np.ndarray,
-                   modes: LinearModes | None) -> tuple[np.ndarray, str]:
+                   modes: LinearModes | None, scales: np.ndarray) -> tuple[np.ndarray, str]:
     """Initial state and a description of it (``start`` of the trajectory)."""
     n, N = model.n, y_s.size
     names = model.state_names
@@ -399,14 +416,19 @@ def _initial_state(model: SimulationModel, x0: Any, perturbation: Any, y_s: np.n
                                  f"{', ' + ', '.join(names[2 * n:]) if N > 2 * n else ''}); got {v.size}")
         y0, start = np.concatenate([v, y_s[v.size:]]), "x0 (absolute state)"
     elif perturbation is None and modes is not None:
-        y0 = y_s + _start_vector(model, modes)
-        what = "tilt" if model.tilting else "coordinate"
-        start = f"leading mode, real part of its eigenvector, max {what} deviation {START_AMPLITUDE:g}"
-        start += " rad" if model.tilting else ""
+        y0 = y_s + _start_vector(model, modes, scales)
+        start = "leading mode, real part of its eigenvector, "
+        if model.tilting and model.n == 2 and not model.dynamic:
+            start += f"max tilt deviation {START_AMPLITUDE:g} rad"
+        else:
+            length = float(max(v for v, c in zip(scales, (*model.coords, *model.dynamic))
+                               if c not in ("q1", "q2") or not model.tilting))
+            start += (f"max deviation {START_AMPLITUDE:g} of a coordinate or pad state relative to its scale "
+                      f"(tilts 1 rad, lengths {length:g} m)")
     else:
         if perturbation is None:
             d = np.zeros(n)
-            d[0] = START_AMPLITUDE
+            d[0] = START_AMPLITUDE * scales[0]
         else:
             d = np.asarray(perturbation, dtype=float).ravel()
         if d.size not in (n, 2 * n, N):
@@ -466,9 +488,11 @@ def simulate(
     perturbation : array_like, shape (n,), (2n,) or (2n + k,), optional
         Initial deviation from the silent motion (rates zero if ``n`` values).
         Default when neither is given: along the leading mode of the
-        linearization, ``x(0) = a Re(v_0)`` with ``v_0`` its right eigenvector
-        scaled so that the largest tilt component (a non-tilting disk: the
-        largest coordinate) is 1 and ``a = START_AMPLITUDE = 1e-5``.
+        linearization, ``x(0) = Re(v_0)`` with ``v_0`` its right eigenvector
+        scaled so that its largest coordinate or pad state, in units of 1 rad
+        for a tilt and of the largest pad radius for a length, is
+        ``START_AMPLITUDE = 1e-5`` (the paper's model: the largest tilt
+        deviation is 1e-5 rad).
     method : str
         ``"DOP853-jit"`` (compiled Dormand–Prince 8(5,3), default) or one of
         SciPy's ``solve_ivp`` methods ``"DOP853", "RK45", "RK23", "Radau",
@@ -571,7 +595,7 @@ def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sampl
         raise type(exc)(f"cannot simulate: {exc}") from None
     modes = model.linear_modes(params)
     check_interrupt()
-    y0, start = _initial_state(model, x0, perturbation, st.y, modes)
+    y0, start = _initial_state(model, x0, perturbation, st.y, modes, _scales(model, params))
     atol_v = _check_tolerances(rtol, atol, _default_atol(model, params, rtol, modes))
     k = model.kernels
     npad = len(model.pads)
@@ -602,9 +626,11 @@ def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sampl
     m = st.l.size
     L, dL = np.full((n, m), np.nan), np.full((n, m), np.nan)
     C, E = np.full((n, 7 * npad), np.nan), np.full((n, 5), np.nan)
-    if n:
-        k.post_process(Y, n, st.l.copy(), st.dl.copy(), p, st.ztol, L, dL, C, E)
-    check_interrupt()
+    lw, dlw = st.l.copy(), st.dl.copy()  # warm starts carried from block to block
+    for a in range(0, n, _POST_BLOCK):  # blocks of bounded wall time: Ctrl-C acts between them
+        b = min(a + _POST_BLOCK, n)
+        k.post_process(Y[a:b], b - a, lw, dlw, p, st.ztol, L[a:b], dL[a:b], C[a:b], E[a:b])
+        check_interrupt()
     return Trajectory(
         status=res["status"], message=res["message"], t=t_out[:n], y=Y, l=L, contact=C.reshape(n, npad, 7),
         energy_terms=E, params=params, q0=np.asarray(st.silent.q0, dtype=float).copy(), method=method, rtol=rtol,

@@ -17,9 +17,10 @@ interpreter runs.  Two places where that bytecode is not ours made
 
 :func:`interrupt_guard` installs (in the main thread, when the default
 handler is active) a handler that records the interrupt *and* raises it, and
-an unraisable hook that keeps such swallowed interrupts quiet; the simulation
-calls :func:`check_interrupt` at safe points, so an interrupt that was
-swallowed still stops the run there.
+an unraisable hook that keeps such swallowed interrupts quiet and delivers
+them again (so they are raised as soon as the interpreter runs its own code,
+e.g. numba's compiler); the simulation also calls :func:`check_interrupt` at
+safe points.
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ from typing import Any
 
 __all__ = ["interrupt_guard", "check_interrupt"]
 
-_state = {"depth": 0, "flag": False}
+_state = {"depth": 0, "flag": False, "redeliver": 0}
 
 
 def _handler(signum: int, frame: Any) -> None:
@@ -43,8 +44,15 @@ def _handler(signum: int, frame: Any) -> None:
 
 def _unraisable(hook: Any) -> Any:
     def quiet(unraisable: Any) -> None:
-        if isinstance(unraisable.exc_value, KeyboardInterrupt):  # recorded in the flag; raised at a safe point
+        if isinstance(unraisable.exc_value, KeyboardInterrupt):
+            # swallowed by a callback: recorded, and delivered again so that it is raised as soon as the
+            # interpreter runs code of its own (a bounded number of times; check_interrupt catches the rest)
             _state["flag"] = True
+            _state["redeliver"] += 1
+            if _state["redeliver"] <= 100:
+                import _thread
+
+                _thread.interrupt_main()
             return
         hook(unraisable)
 
@@ -68,6 +76,7 @@ def interrupt_guard() -> Iterator[None]:
     installed = hook = None
     if _state["depth"] == 0:
         _state["flag"] = False
+        _state["redeliver"] = 0
         if threading.current_thread() is threading.main_thread() \
                 and signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # fmt: skip
             installed = signal.signal(signal.SIGINT, _handler)

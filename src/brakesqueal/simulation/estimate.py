@@ -402,11 +402,17 @@ def modal_coordinate(x: np.ndarray, modes: LinearModes, index: int = 0) -> np.nd
 
 
 def _share(x: np.ndarray, part: np.ndarray, coordinates: int | None = None) -> float:
-    """RMS of ``part`` over RMS of ``x`` (coordinates only, last tenth of the samples)."""
+    """RMS of ``part`` over RMS of ``x`` (last tenth of the samples) over the displacement-like components.
+
+    Those are the first ``n`` columns (coordinates; default ``n`` = half of
+    them) and, when ``coordinates`` is given, the columns after ``2n`` (first-order
+    pad states), not the rates.
+    """
     n = coordinates if coordinates else max(x.shape[1] // 2, 1)
+    cols = np.r_[0:n, 2 * n:x.shape[1]] if coordinates else np.arange(n)
     k = max(x.shape[0] // 10, 1)
-    den = float(np.sqrt((x[-k:, :n] ** 2).sum()))
-    return float(np.sqrt((part[-k:, :n] ** 2).sum())) / den if den > 0 else math.nan
+    den = float(np.sqrt((x[-k:][:, cols] ** 2).sum()))
+    return float(np.sqrt((part[-k:][:, cols] ** 2).sum())) / den if den > 0 else math.nan
 
 
 def modal_projection(t: np.ndarray, x: np.ndarray, modes: LinearModes, index: int = 0, *,
@@ -424,8 +430,9 @@ def modal_projection(t: np.ndarray, x: np.ndarray, modes: LinearModes, index: in
     index : int, optional
         Mode (default 0, the leading mode).
     coordinates : int, optional
-        Number of coordinates among the components of ``x`` (default half of
-        them), for the mode's share of the motion.
+        Number of coordinates ``n`` among the components of ``x`` (default
+        half of them), for the mode's share of the motion; components after
+        the ``2n`` coordinates and rates (first-order pad states) count too.
 
     Returns
     -------
@@ -659,8 +666,8 @@ def dominant_mode(
         Report the pole nearest this eigenvalue [1/s] instead of the dominant
         one (e.g. to cross-check a modal projection).
     coordinates : int, optional
-        Number of coordinates among the columns of ``x`` (default half of
-        them), for the mode's share.
+        Number of coordinates ``n`` among the columns of ``x`` (default half
+        of them), for the mode's share (as in :func:`modal_projection`).
 
     Returns
     -------
