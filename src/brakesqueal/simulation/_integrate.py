@@ -449,7 +449,19 @@ def estimation_rate(modes: LinearModes | None, duration: float) -> float:
 
     The "frequency" of a mode is ``|lambda| / 2 pi`` (so that a real, fast
     eigenvalue is resolved too); at least 64 samples cover ``duration``.
-    Without a linear model the rate is 64 samples over the run.
+
+    Parameters
+    ----------
+    modes : LinearModes or None
+        Linear modes of the silent motion; without them the rate is 64
+        samples over the run.
+    duration : float
+        Duration of the run [s].
+
+    Returns
+    -------
+    float
+        The rate [Hz].
     """
     fmax = float(np.abs(modes.eigenvalues).max()) / (2 * math.pi) if modes is not None else 0.0
     return max(POINTS_PER_PERIOD * fmax, 64.0 / duration)
