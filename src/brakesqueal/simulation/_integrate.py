@@ -740,6 +740,7 @@ class _Run:
         ev_t = np.zeros(10000)
         ev_k = np.zeros(10000, dtype=np.int64)
         y, f, l, dl, ev_old = self.y0.copy(), self.f0.copy(), self.l0.copy(), self.dl0.copy(), self.ev0.copy()
+        ev_prev = np.full(ev_old.size, np.inf)
         stats = np.zeros(3, dtype=np.int64)
         y_event = np.full(N, np.nan)
         h = min(1e-7, (self.t1 - self.t0) / 10)
@@ -753,7 +754,7 @@ class _Run:
                 break
             w0 = time.perf_counter()
             status, t, h, i_out, i_est, n_ev, k_event, t_event = k.dop853(
-                y, f, l, dl, ev_old, self.p, st.ztol, st.vr0, t, self.t1, h, self.rtol, self.atol, self.max_step,
+                y, f, l, dl, ev_old, ev_prev, self.p, st.ztol, st.vr0, t, self.t1, h, self.rtol, self.atol, self.max_step,
                 self.t_out, i_out, Y, est.t0, est.dt, i_est, est.buf, mode, ev_t, ev_k, n_ev, chunk, stats,
                 y_event, *tables)  # fmt: skip
             dt = time.perf_counter() - w0

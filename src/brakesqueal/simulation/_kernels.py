@@ -413,12 +413,70 @@ def _error_norm(K, E5, E3, h, scale):
 
 
 @njit(cache=True)
-def dop853(y, f, l, dl, ev_old, p, ztol, vr0, t, t1, h_abs, rtol, atol, max_step, t_out, i_out, Y, te0, dte,
+def _event_at(k, x, F, y, l, dl, p, ztol, vr0, g, cb, ev, yint):
+    """Event function k at normalized time x of the step (pad unknowns solved from l, dl, updated)."""
+    dense_eval(F, y, x, yint)
+    solve_pads(yint, l, dl, p, ztol, g)
+    event_values(yint, l, dl, p, vr0, cb, ev)
+    return ev[k]
+
+
+@njit(cache=True)
+def _bisect(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb):
+    """First x in [a, b] with event k <= 0, given event k > 0 at a and <= 0 at b (60 halvings; returns the <= 0 end)."""
+    lb[:] = l0
+    dlb[:] = dl0
+    for _ in range(60):
+        c = 0.5 * (a + b)
+        if _event_at(k, c, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint) > 0.0:
+            a = c
+        else:
+            b = c
+    return b
+
+
+@njit(cache=True)
+def _golden(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb):
+    """Minimum of event k on [a, b] (golden-section search, 48 steps): returns (x, value); stops early at a value <= 0."""
+    lb[:] = l0
+    dlb[:] = dl0
+    r = 0.6180339887498949
+    c = b - r * (b - a)
+    d = a + r * (b - a)
+    fc = _event_at(k, c, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint)
+    fd = _event_at(k, d, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint)
+    for _ in range(48):
+        if fc <= 0.0:
+            return c, fc
+        if fd <= 0.0:
+            return d, fd
+        if fc < fd:
+            b = d
+            d = c
+            fd = fc
+            c = b - r * (b - a)
+            fc = _event_at(k, c, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint)
+        else:
+            a = c
+            c = d
+            fc = fd
+            d = a + r * (b - a)
+            fd = _event_at(k, d, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint)
+    if fc < fd:
+        return c, fc
+    return d, fd
+
+
+@njit(cache=True)
+def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol, max_step, t_out, i_out, Y, te0, dte,
            i_est, Yest, event_mode, ev_t, ev_k, n_ev, budget, stats, y_event, A, B, C, E3, E5, D):
     """Adaptive DOP853 from t towards t1 (SciPy's algorithm), at most ``budget`` accepted steps per call.
 
     Integrator state, updated in place: y (state), f (its derivative), l, dl (pad unknowns, solved at y),
-    ev_old (event values at y); stats (int64) accumulates nfev, accepted steps, rejected steps.
+    ev_old (event values at y), ev_prev (at the previous step's last inner point; inf at the start); stats
+    (int64) accumulates nfev, accepted steps, rejected steps.  Events: sign changes between NSUB + 1 points
+    per step are bisected; a sampled minimum within twice the second difference of zero (a grazing dip) is
+    located by golden-section search and, if it is <= 0, the crossing before it is bisected.
     Dense output at t_out[i_out:] goes into Y; at te0 + i dte (i = i_est, ...) into the ring buffer Yest
     (row i % Yest.shape[0]).  event_mode: 0 = none, 1 = stop at the first event, 2 = record and continue.
     Returns (status, t, h_abs, i_out, i_est, n_ev, k_event, t_event): status 0 = reached t1,
@@ -443,7 +501,9 @@ def dop853(y, f, l, dl, ev_old, p, ztol, vr0, t, t1, h_abs, rtol, atol, max_step
     cb = np.empty(7 * _NPAD)
     ev_new = np.empty(_NEV)
     ev_mid = np.empty(_NEV)
-    ev_a = np.empty(_NEV)
+    evs = np.empty((NSUB + 1, _NEV))
+    Ls = np.empty((NSUB + 1, _M))
+    dLs = np.empty((NSUB + 1, _M))
     lnew = l.copy()
     dlnew = dl.copy()
     lsave = l.copy()
@@ -545,59 +605,75 @@ def dop853(y, f, l, dl, ev_old, p, ztol, vr0, t, t1, h_abs, rtol, atol, max_step
         t_stop = t_new
         stop = False
         if event_mode > 0:
-            # sign changes are looked for at NSUB points per step (dense output), then bisected
-            first = -1
-            tf = t_new
-            xa = 0.0
+            # event values at NSUB + 1 points of the step (dense output; the end with the saved pad unknowns)
             for k in range(_NEV):
-                ev_a[k] = ev_old[k]
+                evs[0, k] = ev_old[k]
+            Ls[0, :] = l
+            dLs[0, :] = dl
             lint[:] = l
             dlint[:] = dl
             for sub in range(1, NSUB + 1):
-                xb = sub / NSUB
                 if sub == NSUB:
                     event_values(ynew, lsave, dlsave, p, vr0, cb, ev_new)
+                    Ls[sub, :] = lsave
+                    dLs[sub, :] = dlsave
                 else:
-                    dense_eval(F, y, xb, yint)
+                    dense_eval(F, y, sub / NSUB, yint)
                     solve_pads(yint, lint, dlint, p, ztol, g)
                     event_values(yint, lint, dlint, p, vr0, cb, ev_new)
+                    Ls[sub, :] = lint
+                    dLs[sub, :] = dlint
                 for k in range(_NEV):
-                    if ev_a[k] > 0.0 and ev_new[k] <= 0.0:
-                        a = xa
-                        b = xb
-                        lb[:] = lint
-                        dlb[:] = dlint
-                        for _ in range(60):
-                            c = 0.5 * (a + b)
-                            dense_eval(F, y, c, yint)
-                            solve_pads(yint, lb, dlb, p, ztol, g)
-                            event_values(yint, lb, dlb, p, vr0, cb, ev_mid)
-                            if ev_mid[k] > 0.0:
-                                a = c
-                            else:
-                                b = c
-                        tk = t + b * h
+                    evs[sub, k] = ev_new[k]
+            first = -1
+            tf = t_new
+            for k in range(_NEV):
+                # in time order: a sign change between two points (bisected), or a sampled minimum close to zero
+                # (a grazing dip: the minimum is located by golden-section search, and a crossing before it bisected)
+                i = 0
+                while i <= NSUB:
+                    xc = -1.0
+                    nxt = i + 1
+                    if i >= 1 and evs[i - 1, k] > 0.0 and evs[i, k] <= 0.0:
+                        xc = _bisect(k, (i - 1) / NSUB, i / NSUB, F, y, Ls[i - 1], dLs[i - 1], p, ztol, vr0, g, cb,
+                                     ev_mid, yint, lb, dlb)
+                    elif evs[i, k] > 0.0:
+                        left = evs[i - 1, k] if i >= 1 else ev_prev[k]
+                        right = evs[i + 1, k] if i < NSUB else math.inf
+                        if left > evs[i, k] and right >= evs[i, k]:
+                            c = min(max(i, 1), NSUB - 1)
+                            trig = 2.0 * abs(evs[c - 1, k] - 2.0 * evs[c, k] + evs[c + 1, k])
+                            if evs[i, k] <= trig:
+                                lo = max(i - 1, 0)
+                                hi = min(i + 1, NSUB)
+                                xm, vm = _golden(k, lo / NSUB, hi / NSUB, F, y, Ls[i], dLs[i], p, ztol, vr0, g, cb,
+                                                 ev_mid, yint, lb, dlb)
+                                if vm <= 0.0:
+                                    xc = _bisect(k, lo / NSUB, xm, F, y, Ls[lo], dLs[lo], p, ztol, vr0, g, cb,
+                                                 ev_mid, yint, lb, dlb)
+                                    nxt = hi + 1
+                    if xc >= 0.0:
+                        tk = t + xc * h
                         if event_mode == 2:
                             if n_ev < ev_t.shape[0]:
                                 ev_t[n_ev] = tk
                                 ev_k[n_ev] = k
                             n_ev += 1
-                        elif tk < tf or first < 0:
-                            first = k
-                            tf = tk
-                            dense_eval(F, y, b, y_event)
-                if event_mode == 1 and first >= 0:
-                    break
-                for k in range(_NEV):
-                    ev_a[k] = ev_new[k]
-                xa = xb
+                        else:
+                            if first < 0 or tk < tf:
+                                first = k
+                                tf = tk
+                                dense_eval(F, y, xc, y_event)
+                            break
+                    i = nxt
             if event_mode == 1 and first >= 0:
                 stop = True
                 t_stop = tf
                 k_event = first
                 t_event = tf
             for k in range(_NEV):
-                ev_old[k] = ev_new[k]
+                ev_prev[k] = evs[NSUB - 1, k]
+                ev_old[k] = evs[NSUB, k]
         while i_out < t_out.shape[0] and t_out[i_out] <= t_stop:
             x = (t_out[i_out] - t) / h
             dense_eval(F, y, x, yint)
