@@ -293,6 +293,10 @@ def test_cli_model_run_equals_the_library_run(tmp_path, capsys):
     np.testing.assert_array_equal(ds["Q"].values, tr.Q)
     with wave.open(str(wav)) as w:
         assert w.getframerate() == 44100 and w.getnframes() > 2000
+    umask = os.umask(0o022)
+    os.umask(umask)
+    for f in (nc, wav):  # written through a temporary file, with the permissions of a plain open()
+        assert f.stat().st_mode & 0o777 == 0o666 & ~umask
 
 
 def test_cli_belt_audio_is_the_pad_velocity(tmp_path, capsys):

@@ -200,7 +200,7 @@ class SimulationModel:
         vr0 = np.concatenate([cb[7 * j + 1:7 * j + 4] for j in range(len(self.pads))])
         return SilentState(y=y, l=l, dl=dl, vr0=vr0, ztol=ztol, silent=sm)
 
-    def linear_matrix(self, params: Any, silent: SilentState | None = None) -> tuple[np.ndarray, Any]:
+    def linear_matrix(self, params: Any) -> tuple[np.ndarray, Any]:
         """First-order state matrix of the linearization that matches the simulated equations.
 
         Its state is the deviation ``(Q - Q0, Qdot, L_dynamic - L0)`` of the
