@@ -265,6 +265,32 @@ def test_contact_loss_of_one_of_four_pads():
     assert cont.event_times[first][0] == pytest.approx(tr.t_event, rel=1e-12)
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_first_contact_loss_is_not_missed(seed):
+    """Randomized starts near contact loss (paper's model, mu = 1, h = 0.05): the reported event is the first one.
+
+    Reference: an event-free run of the same equations sampled at 2 MHz: no pad's F_n is <= 0 before the event
+    (to the grid's resolution), the event pad's F_n is 0 at the located state and goes below zero right after.
+    """
+    from brakesqueal.parameters import get_preset
+
+    rng = np.random.default_rng(1000 + seed)
+    params = get_preset("paper-fig2").resolve({"mu": 1.0, "h": 0.05})
+    amp, phi = rng.uniform(1.5e-3, 2.5e-3), rng.uniform(0, TWO_PI)
+    pert = [amp * math.cos(phi), amp * math.sin(phi)]
+    m = simulation_model("paper")
+    tr = simulate(m, params, 1.0, perturbation=pert, sample_rate=5000)
+    assert tr.status == "contact-loss"
+    j = m.pads.index(tr.event_pad)
+    assert abs(m.contact_at(params, tr.y_event)[j, 0]) <= 1e-6 * params.N0
+    fine = simulate(m, params, tr.t_event + 2e-5, perturbation=pert, sample_rate=2e6, rtol=1e-11, events="off")
+    fn = fine.normal_forces
+    before = fine.t < tr.t_event - 1e-7
+    assert fn[before].min() > 0.0
+    after = (fine.t >= tr.t_event) & (fine.t <= tr.t_event + 2e-5)
+    assert fn[after, j].min() < 0.0
+
+
 def test_sliding_reversal_on_the_belt():
     m = simulation_model("belt")
     params = resolve_parameters("belt")
