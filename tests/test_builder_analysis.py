@@ -16,7 +16,6 @@ from brakesqueal.analysis.space import ParameterSpace
 from brakesqueal.analysis.crossings import critical_speeds
 from brakesqueal.builder import get_model, linearize_model
 from brakesqueal.builder.analysis import ModelSpace, model_critical_speeds, model_crossings, model_stability_map
-from brakesqueal.builder.simulate import simulate_model
 
 
 def test_built_model_critical_speeds_equal_the_exact_2dof_route():
@@ -52,8 +51,11 @@ def test_built_model_map_agrees_with_pointwise_linearization():
 
 
 def test_built_model_simulation_matches_the_linear_growth():
+    from brakesqueal.model.options import resolve_parameters
+    from brakesqueal.simulation import simulate
+
     lm = linearize_model(get_model("belt"), {"slope": 0.2})
-    tr = simulate_model(get_model("belt"), {"slope": 0.2}, 0.5, (1e-6,), rtol=1e-10)
+    tr = simulate("belt", resolve_parameters("belt", sets={"slope": 0.2}), 0.5, perturbation=[1e-6], rtol=1e-10)
     s = tr.summary
     assert tr.status == "finished"
     assert abs(s.growth_rate - lm.max_real) <= 0.02 * abs(lm.max_real)

@@ -126,6 +126,7 @@ def atomic_write(path: str | os.PathLike[str], *, what: str = "output file") -> 
     os.umask(umask)
     os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the file the usual permissions
     try:
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; the result gets the permissions of a plain open()
         yield tmp
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())
@@ -149,6 +150,12 @@ def write_with(path: str | os.PathLike[str], writer: Callable[[Path], Any], *, w
     with atomic_write(path, what=what) as tmp:
         out = writer(tmp)
     return out
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def _remove(p: Path) -> None:
