@@ -62,6 +62,8 @@ def check_output(path: str | os.PathLike[str], *, what: str = "output file",
     p = Path(os.fspath(path))
     if not p.name:
         raise OutputError(f"{what}: '{path}' is not a file name")
+    if p.is_dir():
+        raise OutputError(f"{what}: cannot write '{path}': it is a directory")
     if suffixes is not None and p.suffix.lower() not in suffixes:
         raise OutputError(f"{what}: '{path}' must end in {' or '.join(suffixes)}")
     parent = p.parent if str(p.parent) else Path(".")
