@@ -43,7 +43,8 @@ KINDS = {
     "numeric": (["linearize", "--format", "json"], f"*/{_key('paper')}/model.py"),
     "stability": (["map", "--x", "mu=0.1:0.8:12", "--y", "Omega=1:100:9", "--out", "m.nc", "--no-eigen"],
                   "*/stability-kernels/brakesqueal_kernel_map_*.py"),
-    "simulation": (["simulate", "--t-end", "0.01", "--format", "json", "--no-progress"], "*/simulate-rhs/kernels_*.py"),
+    "simulation": (["simulate", "--t-end", "0.01", "--format", "json", "--no-progress"],
+                   f"*/{_key('paper')}/simulate.py"),
     "built": (["linearize", "--model", "six-dof", "--format", "json"], f"*/{_key('six-dof')}/model.py"),
     "text": (["derive", "--case", "symmetric"], "*/closed-forms/symmetric.text"),
 }  # fmt: skip

@@ -79,15 +79,11 @@ def test_contact_loss_stops_with_partial_trajectory():
     fn = tr.normal_forces
     assert np.all(fn[:-1] > 0)
     if tr.status == "contact-loss":
-        from brakesqueal.analysis.equilibrium import parameter_vector
         from brakesqueal.simulation import default_model
 
-        k = default_model().kernels
-        p = np.asarray(parameter_vector(params))
-        lbuf = tr.l[-1].copy()
-        k.solve_l(tr.y_event, lbuf, p)
-        c = k.contact(tr.y_event, lbuf, p)
-        assert min(c[0], c[6]) == pytest.approx(0.0, abs=1e-6 * params.N0)
+        c = default_model().contact_at(params, tr.y_event)  # (pads, CONTACT_FIELDS)
+        assert c[:, 0].min() == pytest.approx(0.0, abs=1e-6 * params.N0)
+        assert tr.event_pad == ("1", "2")[int(np.argmin(c[:, 0]))]
 
 
 def test_scipy_event_agrees_with_compiled_event():

@@ -27,7 +27,40 @@ def _floats(text: str, what: str) -> list[float]:
     return vals
 
 
+_NETCDF_SUFFIXES = (".nc", ".nc4", ".cdf", ".netcdf")
+
+
+def _plot_suffixes() -> tuple[str, ...]:
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    return tuple(sorted("." + k for k in FigureCanvasBase.get_supported_filetypes()))
+
+
+def _check_outputs(out: str | None, plot: str | None, wav: str | None) -> None:
+    """Every output path is checked before anything is computed (one line, exit status 2)."""
+    from pathlib import Path
+
+    from .outputs import check_output
+
+    given = {opt: path for opt, path in (("--out", out), ("--plot", plot), ("--wav", wav)) if path}
+    if out:
+        check_output(out, what="--out", suffixes=_NETCDF_SUFFIXES)
+    if wav:
+        check_output(wav, what="--wav", suffixes=(".wav",))
+    if plot:
+        check_output(plot, what="--plot", suffixes=_plot_suffixes())
+    seen: dict[Path, str] = {}
+    for opt, path in given.items():
+        key = Path(path).resolve()
+        if key in seen:
+            raise ParameterError(f"the options {seen[key]} and {opt} name the same file '{path}'")
+        seen[key] = opt
+
+
 def _simulate_cmd(
+    model: Annotated[
+        Optional[str], typer.Option("--model", help="Model TOML file or built-in model (default: the paper's model).")
+    ] = None,
     preset: Annotated[Optional[str], typer.Option("--preset", help="Named parameter template (default paper-fig2).")] = None,
     params: Annotated[Optional[str], typer.Option("--params", help="TOML parameter file.")] = None,
     set_: Annotated[
@@ -38,12 +71,12 @@ def _simulate_cmd(
         Optional[str],
         typer.Option(
             "--q0",
-            help="Initial deviation from the silent motion: dq1,dq2[,dq1dot,dq2dot] [rad, rad/s] "
-            "(default: along the leading mode, 1e-5 rad).",
+            help="Initial deviation from the silent motion: one value per coordinate, optionally followed by "
+            "their rates (paper: dq1,dq2[,dq1dot,dq2dot] [rad, rad/s]; default: along the leading mode, 1e-5).",
         ),
     ] = None,
     x0: Annotated[
-        Optional[str], typer.Option("--x0", help="Absolute initial state q1,q2,dq1,dq2 (instead of --q0).")
+        Optional[str], typer.Option("--x0", help="Absolute initial state: coordinates and rates (instead of --q0).")
     ] = None,
     method: Annotated[str, typer.Option("--method", help="DOP853-jit (default) or a solve_ivp method.")] = "DOP853-jit",
     rtol: Annotated[float, typer.Option("--rtol", help="Relative tolerance, in [1e-13, 1e-2].")] = 1e-9,
@@ -52,59 +85,42 @@ def _simulate_cmd(
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Output samples per second [Hz].")] = 44100.0,
     out: Annotated[Optional[str], typer.Option("--out", help="Write the trajectory to this NetCDF file.")] = None,
     plot: Annotated[Optional[str], typer.Option("--plot", help="Write the plot (time history, phase, spectrum).")] = None,
-    wav: Annotated[Optional[str], typer.Option("--wav", help="Write the rim's normal velocity as 44.1 kHz audio.")] = None,
+    wav: Annotated[
+        Optional[str], typer.Option("--wav", help="Write the rim's normal velocity (a belt: the pad's) as 44.1 kHz audio.")
+    ] = None,
     fmt: Annotated[str, typer.Option("--format", help="Summary format: text | json.")] = "text",
     progress: Annotated[bool, typer.Option("--progress/--no-progress", help="Show a progress bar on stderr.")] = True,
     no_cache: Annotated[bool, typer.Option("--no-cache", help="Do not read or write the cache.")] = False,
-    model: Annotated[
-        Optional[str], typer.Option("--model", help="Model TOML file or built-in model (generic solve_ivp path).")
-    ] = None,
 ) -> None:
-    """Integrate the nonlinear equations (44) from a perturbed silent motion; write NetCDF, plot, audio."""
+    """Integrate the nonlinear equations (44) of any model from a perturbed silent motion; write NetCDF, plot, audio.
+
+    Every output path is checked first; files are written atomically (an
+    interrupted or failed write keeps an existing file).  Ctrl-C stops within
+    about 0.1 s (exit status 130).
+    """
     if fmt not in ("text", "json"):
         raise ParameterError(f"The option '--format' must be text or json; got {fmt!r}")
     if not (math.isfinite(t_end) and t_end > 0):
         raise ParameterError(f"The option '--t-end' must be a positive number of seconds; got {t_end!r}")
     if q0 is not None and x0 is not None:
         raise ParameterError("give either --q0 (deviation from the silent motion) or --x0 (absolute state), not both")
-    if model is not None:
-        _simulate_built(model, preset, params, set_, t_end, q0 if q0 is not None else "1e-5", x0, method, rtol, out,
-                        plot, wav, fmt)  # fmt: skip
-        return
-    from .parameters import resolve_parameters
-
-    p = resolve_parameters(preset, params, list(set_ or []))
     init: dict[str, Any] = {}
     if x0 is not None:
         init["x0"] = _floats(x0, "--x0")
     elif q0 is not None:
         init["perturbation"] = _floats(q0, "--q0")
-    from .simulation import default_model, simulate
+    _check_outputs(out, plot, wav)
+    from .model.options import resolve_space
+    from .simulation._interrupt import interrupt_guard
 
-    model = default_model(use_cache=not no_cache)
-    bar = _progress_bar() if progress and sys.stderr.isatty() else None
-    try:
-        tr = simulate(
-            model, p, t_end, method=method, rtol=rtol, atol=atol, events=events,  # type: ignore[arg-type]
-            sample_rate=sample_rate, progress=bar.update if bar else None, **init,
-        )  # fmt: skip
-    finally:
-        if bar:
-            bar.close()
-    if out:
-        tr.to_netcdf(out)
-    if plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        fig = tr.plot()
-        fig.savefig(plot, dpi=120)
-    if wav:
-        if tr.t.size < 2:
+    p = resolve_space(model, preset, params, list(set_ or [])).resolve({})
+    with interrupt_guard():
+        tr = _run(p, t_end, method, rtol, atol, events, sample_rate, progress, no_cache, init)
+        if wav and tr.t.size < 2:
             raise ParameterError("the trajectory has fewer than two samples; nothing to write to --wav")
-        tr.to_wav(wav)
+        _write(tr, out, plot, wav)
     summary = tr.summary
-    data = {**summary.to_dict(), "message": tr.message, "start": tr.start,
+    data = {**summary.to_dict(), "model": tr.model, "message": tr.message, "start": tr.start,
             "t_end_reached": float(tr.t[-1]) if tr.t.size else 0.0, "wall_s": tr.stats.get("wall_s")}  # fmt: skip
     if fmt == "json":
         sys.stdout.write(json.dumps(data, indent=2) + "\n")
@@ -119,36 +135,47 @@ def _simulate_cmd(
         raise SystemExit(1)
 
 
-def _simulate_built(model: str, preset: Any, params: Any, set_: Any, t_end: float, q0: str, x0: Any,
-                    method: str, rtol: float, out: Any, plot: Any, wav: Any, fmt: str) -> None:
-    """``simulate --model``: the generic built-model integrator (``builder.simulate``)."""
-    from .builder import resolve_model
-    from .builder.simulate import simulate_model
-    from .parameters import parse_sets
+def _run(p: Any, t_end: float, method: str, rtol: float, atol: Any, events: str, sample_rate: float,
+         progress: bool, no_cache: bool, init: dict[str, Any]) -> Any:
+    from .simulation import simulate, simulation_model
+    from .simulation._interrupt import check_interrupt
 
-    if preset or params or x0 is not None or wav:
-        raise ParameterError("--model cannot be combined with --preset, --params, --x0 or --wav")
-    sim_method = "DOP853" if method == "DOP853-jit" else method
-    tr = simulate_model(resolve_model(model), parse_sets(set_ or []), t_end,
-                        _floats(q0, "--q0"), method=sim_method, rtol=rtol)  # fmt: skip
+    sim = simulation_model(p.model, use_cache=not no_cache)
+    check_interrupt()
+    bar = _progress_bar() if progress and sys.stderr.isatty() else None
+    try:
+        return simulate(
+            sim, p, t_end, method=method, rtol=rtol, atol=atol, events=events,  # type: ignore[arg-type]
+            sample_rate=sample_rate, progress=bar.update if bar else None, **init,
+        )  # fmt: skip
+    finally:
+        if bar:
+            bar.close()
+
+
+def _write(tr: Any, out: str | None, plot: str | None, wav: str | None) -> None:
+    """Write the outputs atomically (each OSError: one line naming the option)."""
+    from .simulation._interrupt import check_interrupt
+
     if out:
-        tr.to_netcdf(out)
+        tr.to_netcdf(out, what="--out")
+        check_interrupt()
     if plot:
         import matplotlib
 
         matplotlib.use("Agg")
-        tr.plot().savefig(plot, dpi=120)
-    summary = tr.summary
-    data = {**summary.to_dict(), "message": tr.message}
-    if fmt == "json":
-        sys.stdout.write(json.dumps(data, indent=2) + "\n")
-    else:
-        sys.stdout.write("".join(f"{k:22s} {v}\n" for k, v in data.items()))
-    for w in summary.warnings:
-        sys.stderr.write(f"brakesqueal: warning: {w}\n")
-    if tr.status == "failed":
-        sys.stderr.write(f"brakesqueal: simulation failed: {tr.message}\n")
-        raise SystemExit(1)
+        import matplotlib.pyplot as plt
+
+        from .outputs import write_with
+
+        fig = tr.plot()
+        try:
+            write_with(plot, lambda tmp: fig.savefig(tmp, dpi=120), what="--plot")
+        finally:
+            plt.close(fig)
+        check_interrupt()
+    if wav:
+        tr.to_wav(wav, what="--wav")
 
 
 class _Bar:
@@ -177,7 +204,7 @@ def _bench_cmd(
         float, typer.Option("--baseline-t", help="Simulated time of the (slow) lambdify baseline run [s].")
     ] = 0.002,
 ) -> None:
-    """1 s of simulated squeal (paper-fig2) vs. sympy lambdify + solve_ivp RK45 at the same tolerances."""
+    """1 s of simulated squeal: paper-fig2 vs. lambdify + solve_ivp RK45; eight-dof vs. the former built-model path."""
     from .bench import report
     from .simulation.bench import bench_simulate
 

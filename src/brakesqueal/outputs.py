@@ -62,6 +62,8 @@ def check_output(path: str | os.PathLike[str], *, what: str = "output file",
     p = Path(os.fspath(path))
     if not p.name:
         raise OutputError(f"{what}: '{path}' is not a file name")
+    if p.is_dir():
+        raise OutputError(f"{what}: cannot write '{path}': it is a directory")
     if suffixes is not None and p.suffix.lower() not in suffixes:
         raise OutputError(f"{what}: '{path}' must end in {' or '.join(suffixes)}")
     parent = p.parent if str(p.parent) else Path(".")
@@ -126,6 +128,7 @@ def atomic_write(path: str | os.PathLike[str], *, what: str = "output file") -> 
     os.umask(umask)
     os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the file the usual permissions
     try:
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; the result gets the permissions of a plain open()
         yield tmp
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())
@@ -149,6 +152,12 @@ def write_with(path: str | os.PathLike[str], writer: Callable[[Path], Any], *, w
     with atomic_write(path, what=what) as tmp:
         out = writer(tmp)
     return out
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def _remove(p: Path) -> None:

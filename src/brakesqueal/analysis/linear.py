@@ -156,6 +156,8 @@ class LinearModel(ModalMixin):
         if k == 0:
             return np.block([[I, Z], [Z, self.M]]), np.block([[Z, I], [-self.K, -self.D]])
         Znk, Zkn = np.zeros((n, k)), np.zeros((k, n))
+        assert self.R_L is not None and self.R_dL is not None and self.G_Q is not None and self.G_dQ is not None
+        assert self.G_ddQ is not None and self.G_L is not None and self.G_dL is not None
         E = np.block([[I, Z, Znk], [Z, self.M, self.R_dL], [Zkn, self.G_ddQ, self.G_dL]])
         A = np.block([[Z, I, Znk], [-self.K, -self.D, -self.R_L], [-self.G_Q, -self.G_dQ, -self.G_L]])
         return E, A

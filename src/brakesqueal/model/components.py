@@ -28,9 +28,13 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Any, Literal, Union
+from typing import TYPE_CHECKING, Any, Literal, Union
 
 from ..errors import ParameterError
+
+if TYPE_CHECKING:
+    from .parameters import Preset
+    from .roles import ParameterRoles
 
 __all__ = ["Value", "FrictionLaw", "Disk", "Pad", "Caliper", "ModelSpec", "MAX_PADS", "MAX_COORDINATES"]
 
@@ -397,7 +401,7 @@ class ModelSpec:
     parameters: dict[str, float] = field(default_factory=dict)
     description: str = ""
     reference: str = ""
-    presets: tuple = ()
+    presets: tuple[Preset, ...] = ()
     descriptions: dict[str, str] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
@@ -425,7 +429,8 @@ class ModelSpec:
                 raise ParameterError(f"{where}: pads and calipers must be tables; got {comp!r}")
         self.disk.validate()
         names: set[str] = set()
-        for comp in (*self.pads, *self.calipers):
+        comps: tuple[Pad | Caliper, ...] = (*self.pads, *self.calipers)
+        for comp in comps:
             comp.validate()
             if comp.name in names:
                 raise ParameterError(f"{where}: duplicate component name '{comp.name}'")
@@ -469,7 +474,7 @@ class ModelSpec:
             seen.add(pr.name)
             pr.check(self)
 
-    def roles(self) -> "object":
+    def roles(self) -> ParameterRoles:
         """Roles (ranges, units, descriptions) of the named parameters (:func:`.roles.parameter_roles`)."""
         from .roles import parameter_roles
 
@@ -500,7 +505,7 @@ class ModelSpec:
         """Parameter names used as tangential stiffnesses ``k_ip`` (they may be ``inf``)."""
         return {p.k_ip for p in self.pads if isinstance(p.k_ip, str)}
 
-    def get_preset(self, name: str | None = None) -> "object":
+    def get_preset(self, name: str | None = None) -> Preset:
         """A preset of this model bound to it (``None`` or the model's name: every parameter free).
 
         Raises
@@ -527,8 +532,8 @@ class ModelSpec:
         """One-line description of a parameter (curated if given, else from its roles)."""
         if name in self.descriptions:
             return self.descriptions[name]
-        return self.roles().description(name)  # type: ignore[attr-defined]
+        return self.roles().description(name)
 
     def unit(self, name: str) -> str:
         """SI unit of a parameter (``""``: dimensionless)."""
-        return self.roles().unit(name)  # type: ignore[attr-defined]
+        return self.roles().unit(name)

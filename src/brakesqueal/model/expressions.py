@@ -22,6 +22,7 @@ from __future__ import annotations
 import ast
 import math
 from collections.abc import Callable, Mapping
+from typing import Any
 
 from brakesqueal.errors import ParameterError
 
@@ -243,7 +244,7 @@ def _compute(node: ast.AST, names: Mapping[str, float]) -> float:
     """Evaluate a tree that has already passed :func:`_check`."""
     if isinstance(node, ast.Constant):
         try:
-            value = float(node.value)
+            value = float(node.value)  # type: ignore[arg-type]  # checked: int or float
         except OverflowError:
             value = math.inf
         if math.isinf(value):
@@ -358,12 +359,12 @@ _NUMPY_FUNCTIONS = {"sqrt": "sqrt", "sin": "sin", "cos": "cos", "tan": "tan", "e
                     "abs": "abs"}
 
 
-def _compute_array(node: ast.AST, names: Mapping[str, object]) -> object:
+def _compute_array(node: ast.AST, names: Mapping[str, Any]) -> Any:
     """Vectorized evaluation of a checked tree with NumPy (no error checks; see :func:`evaluate_array`)."""
     import numpy as np
 
     if isinstance(node, ast.Constant):
-        return float(node.value)
+        return float(node.value)  # type: ignore[arg-type]  # checked: int or float
     if isinstance(node, ast.Name):
         return CONSTANTS[node.id] if node.id in CONSTANTS else names[node.id]
     if isinstance(node, ast.BinOp):
@@ -384,7 +385,7 @@ def _compute_array(node: ast.AST, names: Mapping[str, object]) -> object:
     return getattr(np, _NUMPY_FUNCTIONS[node.func.id])(_compute_array(node.args[0], names))
 
 
-def evaluate_array(expr: str, names: Mapping[str, object], *, what: str) -> object:
+def evaluate_array(expr: str, names: Mapping[str, Any], *, what: str) -> Any:
     """Evaluate an expression element-wise on NumPy arrays (same grammar as :func:`evaluate`).
 
     Parameters
@@ -424,7 +425,7 @@ def evaluate_array(expr: str, names: Mapping[str, object], *, what: str) -> obje
     return out[()] if isinstance(out, np.ndarray) and out.ndim == 0 else out
 
 
-def to_sympy(expr: str, symbols: Mapping[str, object], *, what: str = "expression") -> object:
+def to_sympy(expr: str, symbols: Mapping[str, Any], *, what: str = "expression") -> Any:
     """Convert an expression to SymPy with the same grammar (numbers become exact rationals).
 
     Parameters
@@ -455,7 +456,7 @@ def to_sympy(expr: str, symbols: Mapping[str, object], *, what: str = "expressio
     funcs = {"sqrt": sp.sqrt, "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "exp": sp.exp, "log": sp.log,
              "abs": sp.Abs}
 
-    def conv(node: ast.AST) -> object:
+    def conv(node: ast.AST) -> Any:
         if isinstance(node, ast.Constant):
             v = node.value
             return sp.Integer(v) if isinstance(v, int) else sp.Rational(v)

@@ -99,6 +99,8 @@ class Parameters(Mapping[str, float]):
     """
 
     __slots__ = ("_model", "_values")
+    _model: Any
+    _values: Mapping[str, float]
 
     def __init__(self, model: Any, values: Mapping[str, Value], *, source: str | None = None) -> None:
         from .roles import problems

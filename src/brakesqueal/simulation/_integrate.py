@@ -1,4 +1,4 @@
-r"""The simulation entry point :func:`simulate` and the model object it integrates."""
+r"""The simulation entry point :func:`simulate` and the compiled model it integrates (any model)."""
 
 from __future__ import annotations
 
@@ -11,144 +11,435 @@ from typing import Any, Callable, Literal, Sequence
 import numpy as np
 
 from ..errors import BrakesquealError, ParameterError, SilentMotionError
-from ..parameters import Parameters
 from .estimate import LinearModes, linear_modes
 from .trajectory import EstimationRecord, Trajectory
 
-__all__ = ["METHODS", "POINTS_PER_PERIOD", "START_AMPLITUDE", "SimulationModel", "default_model", "simulate"]
+__all__ = ["METHODS", "POINTS_PER_PERIOD", "START_AMPLITUDE", "SimulationModel", "SilentState", "default_model",
+           "simulation_model", "simulate", "estimation_rate"]
 
 #: Integration methods: the compiled DOP853 (default) and SciPy's ``solve_ivp`` methods.
 METHODS: tuple[str, ...] = ("DOP853-jit", "DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 #: Samples per period of the highest linear frequency in the estimation record (summary numbers).
 POINTS_PER_PERIOD = 20
-#: Largest tilt deviation [rad] of the default start (along the leading mode).
+#: Largest deviation of the default start along the leading mode: tilt [rad] (a non-tilting disk: coordinate [m]).
 START_AMPLITUDE = 1e-5
+#: Wall time [s] of one call of the compiled integrator (between calls progress is reported and Ctrl-C acts).
+CHUNK_SECONDS = 0.1
+#: Output samples post-processed per compiled call (about 0.1 s).
+_POST_BLOCK = 65536
 EventMode = Literal["stop", "continue", "off"]
-_EVENT_NAMES = ("contact-loss-pad1", "contact-loss-pad2", "sliding-reversal-pad1", "sliding-reversal-pad2")
+_EPS = float(np.finfo(float).eps)
 
 
 @dataclass(frozen=True)
-class SimulationModel:
-    """A model :func:`simulate` can integrate: the compiled 2-DOF wobbling-disk model.
+class SilentState:
+    """The silent motion in the integrator's variables.
 
     Attributes
     ----------
-    name : str
-        Identifier (``"general-2dof"``).
-    kernels : module
-        numba-compiled functions ``rhs(y, l, p, out)``, ``solve_l``,
-        ``event_values``, ``post_process`` and the integrator ``dop853``
-        (see :mod:`brakesqueal.simulation._kernels`).
-    state_names : tuple of str
-        ``("q1", "q2", "dq1", "dq2")`` [rad, rad/s].
-    use_cache : bool
-        Whether the silent motion may use the on-disk code cache.
+    y : ndarray, shape (2n + k,)
+        ``(Q0, 0, L0 of the dynamic pads)``.
+    l, dl : ndarray, shape (m,)
+        Pad deformations ``L0`` and their rates (zero).
+    vr0 : ndarray, shape (3 n_pads,)
+        Sliding velocity of every pad at the silent motion (reference of the sliding-reversal events).
+    ztol : ndarray, shape (m,)
+        Absolute Newton tolerance of every pad unknown: its rounding level
+        ``64 eps S_j / |dG_j/dz_j|`` with ``S_j`` the size of the terms of ``G_j``
+        at the silent motion (generated ``pad_scale``).
+    silent : SilentMotion
+        The silent motion (:func:`~brakesqueal.analysis.equilibrium.silent_motion`).
     """
 
-    name: str
+    y: np.ndarray
+    l: np.ndarray
+    dl: np.ndarray
+    vr0: np.ndarray
+    ztol: np.ndarray
+    silent: Any
+
+
+@dataclass(frozen=True, eq=False)
+class SimulationModel:
+    """A model :func:`simulate` integrates: its compiled equations and numba kernels.
+
+    Attributes
+    ----------
+    spec : ModelSpec
+        The model.
+    kernels : module
+        numba functions ``rhs``, ``solve_pads``, ``event_values``, ``contact``,
+        ``energy``, ``post_process`` and the integrator ``dop853``
+        (:mod:`brakesqueal.simulation._kernels`).
+    compiled : CompiledModel
+        The model's compiled residuals (:func:`~brakesqueal.codegen.compile_model`),
+        for the silent motion and the linearization.
+    use_cache : bool
+        Whether the on-disk code cache is used.
+    """
+
+    spec: Any
     kernels: ModuleType
-    state_names: tuple[str, ...] = ("q1", "q2", "dq1", "dq2")
+    compiled: Any
     use_cache: bool = True
 
-    def parameter_vector(self, params: Parameters) -> np.ndarray:
-        """Parameters in the kernels' order (compliances ``1/k_ip``)."""
-        from ..analysis.equilibrium import parameter_vector
+    # ---------------------------------------------------------------- structure
+    @property
+    def name(self) -> str:
+        """The model's name."""
+        return str(self.spec.name)
 
-        return np.asarray(parameter_vector(params), dtype=float)
+    @property
+    def coords(self) -> tuple[str, ...]:
+        """Coordinates ``Q`` (the names of :attr:`LinearModel.coords <brakesqueal.analysis.linear.LinearModel.coords>`)."""
+        return tuple(self.kernels.META["coords"])
 
-    def silent(self, params: Parameters) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(y_silent, l_silent, v_r_silent (6,))`` of the silent motion (eq. 46)."""
+    @property
+    def pad_unknowns(self) -> tuple[str, ...]:
+        """Pad deformations ``L`` (``l_<pad>``)."""
+        return tuple(self.kernels.META["algebraic"])
+
+    @property
+    def pad_kinds(self) -> tuple[str, ...]:
+        """Treatment of every entry of :attr:`pad_unknowns`: ``"quasi-static"`` or ``"dynamic"``."""
+        return tuple(self.kernels.META["kinds"])
+
+    @property
+    def dynamic(self) -> tuple[str, ...]:
+        """Pad deformations that are states (rate-dependent friction)."""
+        return tuple(n for n, k in zip(self.pad_unknowns, self.pad_kinds) if k == "dynamic")
+
+    @property
+    def pads(self) -> tuple[str, ...]:
+        """Pad names."""
+        return tuple(self.kernels.META["pads"])
+
+    @property
+    def unknown_pads(self) -> tuple[str, ...]:
+        """The pad of every entry of :attr:`pad_unknowns`."""
+        return tuple(p.name for p in self.spec.pads if "tangential" not in p.dofs
+                     and (isinstance(p.k_ip, str) or math.isfinite(p.k_ip)))
+
+    @property
+    def n(self) -> int:
+        """Number of coordinates."""
+        return len(self.coords)
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        """Names of the integrator state ``y = (Q, Qdot, L_dynamic)``."""
+        return (*self.coords, *(f"d{c}" for c in self.coords), *self.dynamic)
+
+    @property
+    def tilting(self) -> bool:
+        """Whether the disk tilts (``q1, q2`` are the first coordinates)."""
+        return bool(self.spec.disk.tilting)
+
+    # ---------------------------------------------------------------- numbers
+    def parameters(self, params: Any) -> Any:
+        """``params`` as :class:`~brakesqueal.model.parameters.Parameters` of this model (checked)."""
+        from ..analysis.equilibrium import as_parameters
+        from ..codegen.compiled import model_key
+
+        params = as_parameters(params)
+        if params.model is not self.spec and model_key(params.model) != model_key(self.spec):
+            raise ParameterError(f"the parameters are of model '{params.model.name}', the simulation model is "
+                                 f"'{self.name}'")
+        return params
+
+    def parameter_vector(self, params: Any) -> np.ndarray:
+        """Parameters in packing order (compliances ``1/k_ip``): the ``p`` of every kernel."""
+        return np.asarray(self.parameters(params).vector(), dtype=float)
+
+    def silent(self, params: Any) -> SilentState:
+        """The silent motion (eq. 46) in the integrator's variables.
+
+        Raises
+        ------
+        SilentMotionError
+            When there is no usable silent motion.
+        ParameterError
+            When a pad with rate-dependent friction has no determined
+            tangential rate at the silent motion (``dG/dldot = 0``, e.g. a
+            zero friction slope) or a pad mode too fast to integrate.
+        """
         from ..analysis.equilibrium import silent_motion
-        from ..numeric.compiled import compiled_model
 
-        sm = silent_motion(params, model=compiled_model(use_cache=self.use_cache))
-        y = np.array([sm.q_m0[0], sm.q_m0[1], 0.0, 0.0])
-        l = sm.l0.astype(float).copy()
-        c = np.asarray(self.kernels.contact(y, l, self.parameter_vector(params)))
-        return y, l, np.concatenate([c[1:4], c[7:10]])
+        params = self.parameters(params)
+        cm = self.compiled
+        sm = silent_motion(params, model=cm)
+        p = self.parameter_vector(params)
+        n, m = cm.n, cm.m
+        dyn = [j for j, k in enumerate(self.pad_kinds) if k == "dynamic"]
+        y = np.concatenate([sm.q0, np.zeros(n), sm.l0[dyn]]).astype(float)
+        l = np.array(sm.l0, dtype=float)
+        dl = np.zeros(m)
+        ztol = np.zeros(m)
+        if m:
+            S = np.empty(m)
+            self.kernels.pad_scale(y, l, dl, p, S)
+            J = cm.jacobian_matrix(sm.state(), list(p))
+            for j, kind in enumerate(self.pad_kinds):
+                G_l, G_dl = J[n + j, 3 * n + j], J[n + j, 3 * n + m + j]
+                d = G_l if kind == "quasi-static" else G_dl
+                pad = f"pad '{self.unknown_pads[j]}'"
+                if not (math.isfinite(d) and d != 0.0):
+                    raise ParameterError(
+                        f"{pad}: the tangential balance does not determine the pad's "
+                        f"{'deformation' if kind == 'quasi-static' else 'rate (a zero friction slope dmu/dv)'} "
+                        "at the silent motion; give the pad a rate-dependent friction law with a nonzero slope "
+                        "or a coulomb law")  # fmt: skip
+                if kind == "dynamic" and abs(G_l / G_dl) > 1e9:
+                    raise ParameterError(
+                        f"{pad}: its pad mode (lambda ~ {-G_l / G_dl:.3g} 1/s, from the friction slope) is too fast "
+                        "for the explicit integrator (|lambda| > 1e9 1/s); use a larger friction slope or a coulomb "
+                        "law for this pad")  # fmt: skip
+                ztol[j] = 64 * _EPS * float(S[j]) / abs(d) if math.isfinite(float(S[j])) else 0.0
+        cb = np.empty(7 * len(self.pads))
+        self.kernels.contact(y, l, dl, p, cb)
+        vr0 = np.concatenate([cb[7 * j + 1:7 * j + 4] for j in range(len(self.pads))])
+        return SilentState(y=y, l=l, dl=dl, vr0=vr0, ztol=ztol, silent=sm)
 
-    def linear_modes(self, params: Parameters) -> LinearModes:
-        """Eigenvalues and left/right eigenvectors of the linearization's state matrix (eq. 47).
+    def linear_matrix(self, params: Any) -> tuple[np.ndarray, Any]:
+        """First-order state matrix of the linearization that matches the simulated equations.
 
-        The state matrix acts on ``(q - q_m0, dq)``, the simulated state's
-        deviation from the silent motion.
+        Its state is the deviation ``(Q - Q0, Qdot, L_dynamic - L0)`` of the
+        integrator's state.  It is ``linearize(params, pad_rates="quasi-static").A``
+        when every pad is quasi-static, ``linearize(params).A`` when the pads
+        it keeps are exactly the dynamic pads, and otherwise the same
+        elimination made here with this model's pad treatment (quasi-static
+        pads: ``ldot := 0``; dynamic pads kept).
+
+        Returns
+        -------
+        A : ndarray, shape (2n + k, 2n + k)
+        linear : LinearModel or None
+            The :class:`~brakesqueal.analysis.linear.LinearModel` used (``None``
+            for the own elimination).
         """
         from ..analysis.linear import linearize
 
-        return linear_modes(linearize(params, pad_rates="quasi-static").A)  # the simulated pads are quasi-static
+        params = self.parameters(params)
+        dyn = self.dynamic
+        lm = linearize(params, model=self.compiled, pad_rates="kept" if dyn else "quasi-static")
+        if tuple(lm.pad_states) == dyn:
+            return np.asarray(lm.A, dtype=float), lm
+        return _own_linear_matrix(self, params, lm.silent), None
 
-    def rhs(self, params: Parameters) -> Callable[[float, np.ndarray], np.ndarray]:
-        """``f(t, y)`` for SciPy (solves the pad deformations on the way, warm-started)."""
+    def linear_modes(self, params: Any) -> LinearModes | None:
+        """Eigenvalues and left/right eigenvectors of :meth:`linear_matrix` (``None`` if unavailable)."""
+        try:
+            return linear_modes(self.linear_matrix(params)[0])
+        except (BrakesquealError, np.linalg.LinAlgError):
+            return None
+
+    def contact_at(self, params: Any, y: Sequence[float], silent: SilentState | None = None) -> np.ndarray:
+        """Contact quantities at an integrator state ``y`` (pad unknowns solved), shape ``(n_pads, 7)``.
+
+        Columns are :data:`~brakesqueal.codegen.compiled.CONTACT_FIELDS`.
+        """
+        st = silent or self.silent(params)
         p = self.parameter_vector(params)
-        lbuf = np.zeros(2)
+        yy = np.ascontiguousarray(y, dtype=float)
+        l, dl = st.l.copy(), st.dl.copy()
+        g = np.empty(2 * len(l) + 1)
+        if not self.kernels.solve_pads(yy, l, dl, p, st.ztol, g):
+            raise ParameterError("the pad equations cannot be solved at this state")
+        cb = np.empty(7 * len(self.pads))
+        self.kernels.contact(yy, l, dl, p, cb)
+        return cb.reshape(len(self.pads), 7)
+
+    def rhs(self, params: Any, silent: SilentState | None = None) -> Callable[[float, np.ndarray], np.ndarray]:
+        """``f(t, y)`` for SciPy (the pad unknowns are solved on the way, warm-started)."""
+        st = silent or self.silent(params)
+        p = self.parameter_vector(params)
         k = self.kernels
+        l, dl = st.l.copy(), st.dl.copy()
+        g, mw = np.empty(2 * len(l) + 1), np.empty(self.n * self.n + self.n)
+        ny = st.y.size
 
         def fun(t: float, y: np.ndarray) -> np.ndarray:
-            out = np.empty(4)
-            k.rhs(np.ascontiguousarray(y, dtype=float), lbuf, p, out)
+            out = np.empty(ny)
+            k.rhs(np.ascontiguousarray(y, dtype=float), l, dl, p, st.ztol, g, mw, out)
             return out
 
         return fun
 
 
-def default_model(use_cache: bool = True) -> SimulationModel:
-    """The general 2-DOF model of the paper (eq. 44 with quasi-static pads).
+def _own_linear_matrix(model: SimulationModel, params: Any, sm: Any) -> np.ndarray:
+    """State matrix of ``E xi' = A xi``, ``xi = (dQ, dQdot, dL_dyn)``: quasi-static pads eliminated with ``ldot = 0``."""
+    cm = model.compiled
+    p = list(map(float, params.vector()))
+    n, m = cm.n, cm.m
+    J = cm.zero_jacobian_matrix(p) if sm.trivial else cm.jacobian_matrix(sm.state(), p)
+    R, G = J[:n], J[n:]
+    Q, dQ, ddQ, L, dL = (slice(0, n), slice(n, 2 * n), slice(2 * n, 3 * n), slice(3 * n, 3 * n + m),
+                         slice(3 * n + m, 3 * n + 2 * m))  # fmt: skip
+    dyn = np.array([k == "dynamic" for k in model.pad_kinds], dtype=bool)
+    qs = ~dyn
+    M, D, K = R[:, ddQ].copy(), R[:, dQ].copy(), R[:, Q].copy()
+    R_L, R_dL = R[:, L], R[:, dL]
+    G_Q, G_dQ, G_ddQ, G_L, G_dL = G[:, Q], G[:, dQ], G[:, ddQ], G[:, L], G[:, dL]
+    if qs.any():
+        P = np.linalg.solve(G_L[np.ix_(qs, qs)].T, R_L[:, qs].T).T
+        M, D, K = M - P @ G_ddQ[qs], D - P @ G_dQ[qs], K - P @ G_Q[qs]
+        Pd = np.linalg.solve(G_L[np.ix_(qs, qs)].T, G_L[np.ix_(dyn, qs)].T).T
+        R_Ld = R_L[:, dyn] - P @ G_L[np.ix_(qs, dyn)]
+        G_Qd, G_dQd, G_ddQd = G_Q[dyn] - Pd @ G_Q[qs], G_dQ[dyn] - Pd @ G_dQ[qs], G_ddQ[dyn] - Pd @ G_ddQ[qs]
+        G_Ld = G_L[np.ix_(dyn, dyn)] - Pd @ G_L[np.ix_(qs, dyn)]
+    else:
+        R_Ld, G_Qd, G_dQd, G_ddQd, G_Ld = R_L, G_Q, G_dQ, G_ddQ, G_L
+    k = int(dyn.sum())
+    I, Z = np.eye(n), np.zeros((n, n))
+    Znk, Zkn = np.zeros((n, k)), np.zeros((k, n))
+    E = np.block([[I, Z, Znk], [Z, M, R_dL[:, dyn]], [Zkn, G_ddQd, G_dL[np.ix_(dyn, dyn)]]])
+    A = np.block([[Z, I, Znk], [-K, -D, -R_Ld], [-G_Qd, -G_dQd, -G_Ld]])
+    return np.linalg.solve(E, A)
+
+
+_MODELS: dict[tuple[str, bool], SimulationModel] = {}
+
+
+def simulation_model(model: Any = "paper", *, use_cache: bool = True) -> SimulationModel:
+    """The compiled simulation model of any model.
 
     Parameters
     ----------
+    model : ModelSpec or str, optional
+        The model, a built-in model's name or a model file (default the
+        paper's model).
     use_cache : bool, optional
         Keep the generated kernel source in the package cache (see
-        :mod:`brakesqueal.numeric.cache`), where numba also caches its machine
-        code (default ``True``).  ``False`` generates and compiles in memory
-        and writes no file.
+        :mod:`brakesqueal.numeric.cache`), where numba also caches its
+        machine code (default ``True``); ``False`` generates and compiles in
+        memory and writes no file.
 
     Returns
     -------
     SimulationModel
-        The model ``"general-2dof"`` with its numba-compiled kernels, ready
-        for :func:`simulate`.
+        Memoized per process by the model's equations.
     """
+    from ..codegen import compile_model
+    from ..codegen.compiled import model_key
+    from ..model.parameters import _model
     from ._kernels import load_kernels
 
-    return SimulationModel(name="general-2dof", kernels=load_kernels(use_cache), use_cache=use_cache)
+    spec = _model(model)
+    key = (model_key(spec), use_cache)
+    sim = _MODELS.get(key)
+    if sim is None:
+        sim = SimulationModel(spec=spec, kernels=load_kernels(spec, use_cache), compiled=compile_model(
+            spec, use_cache=use_cache), use_cache=use_cache)
+        _MODELS[key] = sim
+    elif sim.spec is not spec:
+        sim = SimulationModel(spec=spec, kernels=sim.kernels, compiled=compile_model(spec, use_cache=use_cache),
+                              use_cache=use_cache)
+    return sim
 
 
-def _check_tolerances(rtol: float, atol: Any, scale_rate: float) -> np.ndarray:
+def default_model(use_cache: bool = True) -> SimulationModel:
+    """The paper's general 2-DOF model (eq. 44 with quasi-static pads): ``simulation_model("paper")``.
+
+    Parameters
+    ----------
+    use_cache : bool, optional
+        See :func:`simulation_model`.
+
+    Returns
+    -------
+    SimulationModel
+    """
+    return simulation_model("paper", use_cache=use_cache)
+
+
+def _value(params: Any, v: Any) -> float:
+    return float(params[v]) if isinstance(v, str) else float(v)
+
+
+def _scales(model: SimulationModel, params: Any) -> np.ndarray:
+    """Scale of every coordinate and pad state ``(Q, L_dynamic)``: 1 rad for a tilt, the largest pad radius [m]
+    for a length."""
+    length = max(abs(_value(params, p.radius)) for p in model.spec.pads) or 1.0
+    q = [1.0 if c in ("q1", "q2") and model.tilting else length for c in model.coords]
+    return np.array(q + [length] * len(model.dynamic))
+
+
+def _default_atol(model: SimulationModel, params: Any, rtol: float, modes: LinearModes | None) -> np.ndarray:
+    """``1e-6 rtol`` times the scale of every component (:func:`_scales`), the rates' scale times
+    ``w = sqrt(k_t/Theta)`` (a non-tilting disk: the largest ``|lambda|``)."""
+    spec = model.spec
+    if model.tilting:
+        w = math.sqrt(max(_value(params, spec.disk.k_t), 1.0) / _value(params, spec.disk.Theta))
+    else:
+        w = float(np.abs(modes.eigenvalues).max()) if modes is not None else 1.0
+        w = w if math.isfinite(w) and w > 0 else 1.0
+    s = _scales(model, params)
+    n = model.n
+    return rtol * 1e-6 * np.concatenate([s[:n], s[:n] * w, s[n:]])
+
+
+def _check_tolerances(rtol: float, atol: Any, default: np.ndarray) -> np.ndarray:
     if not (isinstance(rtol, (int, float)) and math.isfinite(rtol) and 1e-13 <= rtol <= 1e-2):
         raise ParameterError(f"The option 'rtol' must be in [1e-13, 1e-2]; got {rtol!r}")
     if atol is None:
-        return rtol * 1e-6 * np.array([1.0, 1.0, scale_rate, scale_rate])
-    a = np.broadcast_to(np.asarray(atol, dtype=float), (4,)).copy()
+        return default
+    try:
+        a = np.broadcast_to(np.asarray(atol, dtype=float), default.shape).copy()
+    except (ValueError, TypeError):
+        raise ParameterError(f"The option 'atol' must be one value or {default.size}; got {atol!r}") from None
     if not np.all(np.isfinite(a)) or np.any(a <= 0) or np.any(a > 1.0):
-        raise ParameterError(f"The option 'atol' must be in (0, 1] (scalar or 4 values); got {atol!r}")
+        raise ParameterError(f"The option 'atol' must be in (0, 1] (one value or {default.size}); got {atol!r}")
     return a
 
 
-def _initial_state(
-    x0: Any, perturbation: Any, y_s: np.ndarray, modes: LinearModes | None
-) -> tuple[np.ndarray, str]:
+def _start_vector(model: SimulationModel, modes: LinearModes, scales: np.ndarray) -> np.ndarray:
+    """``Re(v_0)`` scaled so that its largest coordinate or pad state relative to its scale is ``START_AMPLITUDE``."""
+    v = np.real(modes.right[:, 0])
+    n = model.n
+    ref = np.concatenate([v[:n], v[2 * n:]]) / scales
+    s = float(np.abs(ref).max())
+    return START_AMPLITUDE * v / (s if s > 0 else 1.0)
+
+
+def _initial_state(model: SimulationModel, x0: Any, perturbation: Any, y_s: np.ndarray,
+                   modes: LinearModes | None, scales: np.ndarray) -> tuple[np.ndarray, str]:
     """Initial state and a description of it (``start`` of the trajectory)."""
+    n, N = model.n, y_s.size
+    names = model.state_names
     if x0 is not None and perturbation is not None:
         raise ParameterError("give either x0 (absolute initial state) or perturbation, not both")
     if x0 is not None:
         v = np.asarray(x0, dtype=float).ravel()
-        if v.size != 4:
-            raise ParameterError(f"The initial state x0 must have 4 values (q1, q2, dq1, dq2); got {v.size}")
-        y0, start = v, "x0 (absolute state)"
+        if v.size not in (2 * n, N):
+            sizes = f"{2 * n}" + (f" or {N}" if N > 2 * n else "")
+            raise ParameterError(f"The initial state x0 must have {sizes} values ({', '.join(names[:2 * n])}"
+                                 f"{', ' + ', '.join(names[2 * n:]) if N > 2 * n else ''}); got {v.size}")
+        y0, start = np.concatenate([v, y_s[v.size:]]), "x0 (absolute state)"
     elif perturbation is None and modes is not None:
-        y0 = y_s + modes.start_vector(START_AMPLITUDE)
-        start = f"leading mode, real part of its eigenvector, max tilt deviation {START_AMPLITUDE:g} rad"
+        y0 = y_s + _start_vector(model, modes, scales)
+        start = "leading mode, real part of its eigenvector, "
+        if model.tilting and model.n == 2 and not model.dynamic:
+            start += f"max tilt deviation {START_AMPLITUDE:g} rad"
+        else:
+            length = float(max(v for v, c in zip(scales, (*model.coords, *model.dynamic))
+                               if c not in ("q1", "q2") or not model.tilting))
+            start += (f"max deviation {START_AMPLITUDE:g} of a coordinate or pad state relative to its scale "
+                      f"(tilts 1 rad, lengths {length:g} m)")
     else:
-        d = np.asarray((START_AMPLITUDE, 0.0) if perturbation is None else perturbation, dtype=float).ravel()
-        if d.size not in (2, 4):
+        if perturbation is None:
+            d = np.zeros(n)
+            d[0] = START_AMPLITUDE * scales[0]
+        else:
+            d = np.asarray(perturbation, dtype=float).ravel()
+        if d.size not in (n, 2 * n, N):
             raise ParameterError(
-                f"The perturbation must have 2 (dq1, dq2) or 4 values (dq1, dq2, dq1dot, dq2dot); got {d.size}"
-            )
-        y0 = y_s + np.concatenate([d, np.zeros(4 - d.size)])
+                f"The perturbation must have {n} ({', '.join(names[:n])}) or {2 * n} values (with the rates "
+                f"{', '.join(names[n:2 * n])}){f' or {N} (with the pad states)' if N > 2 * n else ''}; got {d.size}")
+        y0 = y_s + np.concatenate([d, np.zeros(N - d.size)])
         start = "perturbation of the silent motion"
     if not np.all(np.isfinite(y0)):
         raise ParameterError(f"The initial state must be finite; got {y0.tolist()}")
-    if np.any(np.abs(y0[:2]) >= 0.5 * math.pi):
+    if model.tilting and np.any(np.abs(y0[:2]) >= 0.5 * math.pi):
         raise ParameterError(f"The initial tilt angles must be in (-pi/2, pi/2); got {y0[:2].tolist()}")
     return y0, start
 
@@ -158,15 +449,27 @@ def estimation_rate(modes: LinearModes | None, duration: float) -> float:
 
     The "frequency" of a mode is ``|lambda| / 2 pi`` (so that a real, fast
     eigenvalue is resolved too); at least 64 samples cover ``duration``.
-    Without a linear model the rate is 64 samples over the run.
+
+    Parameters
+    ----------
+    modes : LinearModes or None
+        Linear modes of the silent motion; without them the rate is 64
+        samples over the run.
+    duration : float
+        Duration of the run [s].
+
+    Returns
+    -------
+    float
+        The rate [Hz].
     """
     fmax = float(np.abs(modes.eigenvalues).max()) / (2 * math.pi) if modes is not None else 0.0
     return max(POINTS_PER_PERIOD * fmax, 64.0 / duration)
 
 
 def simulate(
-    model: SimulationModel | None,
-    params: Parameters,
+    model: SimulationModel | Any | None,
+    params: Any,
     t_span: float | Sequence[float] = 0.5,
     x0: Sequence[float] | np.ndarray | None = None,
     *,
@@ -181,33 +484,38 @@ def simulate(
     progress: Callable[[float], None] | None = None,
     estimate_samples: int = 65536,
 ) -> Trajectory:
-    r"""Integrate the nonlinear 2-DOF equations (44) of the wobbling disk.
+    r"""Integrate the nonlinear equations of any model (eq. 44 generalized) from a perturbed silent motion.
 
     Parameters
     ----------
-    model : SimulationModel or None
-        The model; ``None`` is :func:`default_model` (the paper's general model).
+    model : SimulationModel, ModelSpec, str or None
+        The model; ``None`` is the model of ``params`` (:func:`simulation_model`).
     params : Parameters
-        Model parameters.
+        Parameter values (of the model; the paper's 17-parameter sets are accepted for the paper's model).
     t_span : float or (float, float)
         End time ``t_end`` [s] (start 0) or ``(t0, t_end)``; ``t_end > t0``.
-    x0 : array_like, shape (4,), optional
-        Absolute initial state ``(q1, q2, dq1, dq2)`` [rad, rad/s].
-    perturbation : array_like, shape (2,) or (4,), optional
-        Initial deviation from the silent motion ``q_m0`` (rates zero if two
-        values).  Default when neither is given: along the leading mode of
-        the linearization, ``x(0) = a Re(v_0)`` with ``v_0`` its right
-        eigenvector scaled so that the largest tilt component is 1 and
-        ``a = START_AMPLITUDE = 1e-5`` rad (a single mode, no beating).
+    x0 : array_like, shape (2n,) or (2n + k,), optional
+        Absolute initial state ``(Q, Qdot[, L_dynamic])`` (the paper's model:
+        ``(q1, q2, dq1, dq2)`` [rad, rad/s]).
+    perturbation : array_like, shape (n,), (2n,) or (2n + k,), optional
+        Initial deviation from the silent motion (rates zero if ``n`` values).
+        Default when neither is given: along the leading mode of the
+        linearization, ``x(0) = Re(v_0)`` with ``v_0`` its right eigenvector
+        scaled so that its largest coordinate or pad state, in units of 1 rad
+        for a tilt and of the largest pad radius for a length, is
+        ``START_AMPLITUDE = 1e-5`` (the paper's model: the largest tilt
+        deviation is 1e-5 rad).
     method : str
         ``"DOP853-jit"`` (compiled Dormand–Prince 8(5,3), default) or one of
         SciPy's ``solve_ivp`` methods ``"DOP853", "RK45", "RK23", "Radau",
-        "BDF", "LSODA"`` (same RHS, called from Python; slower).
+        "BDF", "LSODA"`` (the same compiled right-hand side, called from Python; slower).
     rtol : float
         Relative tolerance, in ``[1e-13, 1e-2]``.
-    atol : float or array_like (4,), optional
-        Absolute tolerance(s) in ``(0, 1]``; default ``1e-6 rtol (1, 1, w, w)``
-        with ``w = sqrt(k_t/Theta)`` [rad, rad/s].
+    atol : float or array_like (2n + k,), optional
+        Absolute tolerance(s) in ``(0, 1]``; default ``1e-6 rtol`` times 1 for
+        tilts [rad], the largest pad radius for lengths [m], and those times
+        ``w = sqrt(k_t/Theta)`` for the rates (a non-tilting disk: the
+        largest ``|lambda|``).
     sample_rate : float
         Output samples per second [Hz] (uniform grid, dense output) of
         :attr:`Trajectory.t` / :attr:`Trajectory.y` (NetCDF, WAV, plot).  The
@@ -216,22 +524,22 @@ def simulate(
     events : {"stop", "continue", "off"}
         ``"stop"`` ends the run at the first contact loss (``F_n <= 0``) or
         sliding reversal (``v_r . v_r0 <= 0``, ``v_r0`` the silent-motion
-        sliding velocity of that pad); ``"continue"`` records the event times
-        and integrates on with the same equations (documented model: bilateral
-        contact, friction direction ``v_r/|v_r|``); ``"off"`` ignores them.
+        sliding velocity of that pad) of any pad; ``"continue"`` records the
+        event times (``contact-loss-pad-<name>``, ``sliding-reversal-pad-<name>``)
+        and integrates on with the same equations (bilateral contact, friction
+        direction ``v_r/|v_r|``); ``"off"`` ignores them.
     max_step : float
         Largest step [s].
     max_steps : int
-        Step budget (compiled method); exceeding it ends the run with status
-        ``"failed"``.
+        Step budget (compiled method); exceeding it ends the run with status ``"failed"``.
     progress : callable, optional
-        Called with the fraction done (0..1) while integrating.
+        Called with the fraction done (0..1) while integrating (about every 0.1 s of wall time).
     estimate_samples : int
         Length of the estimation record (default 65536): the integrator's
         dense output at ``POINTS_PER_PERIOD = 20`` samples per period of the
         fastest linear mode (:func:`estimation_rate`), of which the last
-        ``estimate_samples`` are kept (a ring buffer, so memory stays bounded
-        for long runs).  :attr:`Trajectory.summary` is computed from it.
+        ``estimate_samples`` are kept (a ring buffer).  :attr:`Trajectory.summary`
+        is computed from it.
 
     Returns
     -------
@@ -246,15 +554,17 @@ def simulate(
         out of range, a pad out of contact at the initial state).
     SilentMotionError
         If the silent motion does not exist (needed for the reference state).
+    KeyboardInterrupt
+        On Ctrl-C: the compiled integrator runs in calls of about 0.1 s, and
+        the interrupt takes effect between them (nothing is returned).
 
     Notes
     -----
-    The pads are massless and quasi-static: ``ldot := 0`` in the relative
-    velocities and normal-force rates, and ``l`` follows ``(q, qdot)`` through
-    ``g(q, qdot, l, ldot=0) = 0`` (Newton from the previous ``l``), exactly
-    as in the linearization.
+    Massless pads with coulomb friction are quasi-static (``ldot := 0``,
+    ``l`` from ``G(Q, Qdot, l, 0) = 0``); with rate-dependent friction their
+    deformation is a state and ``ldot`` solves ``G(Q, Qdot, l, ldot) = 0``
+    (``docs/simulation.md``).
     """
-    model = model or default_model()
     if method not in METHODS:
         raise ParameterError(f"The option 'method' must be one of {', '.join(METHODS)}; got {method!r}")
     if events not in ("stop", "continue", "off"):
@@ -274,61 +584,82 @@ def simulate(
         raise ParameterError(f"The option 'max_step' must be positive; got {max_step!r}")
     if not (isinstance(estimate_samples, (int, np.integer)) and 64 <= estimate_samples <= 50_000_000):
         raise ParameterError(f"The option 'estimate_samples' must be an integer in [64, 5e7]; got {estimate_samples!r}")
+    from ..analysis.equilibrium import as_parameters
+    from ._interrupt import interrupt_guard
+
+    with interrupt_guard():
+        return _simulate(model, as_parameters(params), t0, t1, x0, perturbation, method, rtol, atol, sample_rate,
+                         events, max_step, max_steps, progress, estimate_samples, n_out)
+
+
+def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sample_rate, events, max_step,
+              max_steps, progress, estimate_samples, n_out):  # type: ignore[no-untyped-def]
+    from ._interrupt import check_interrupt
+
+    if not isinstance(model, SimulationModel):
+        model = simulation_model(params.model if model is None else model)
+    check_interrupt()
+    params = model.parameters(params)
     p = model.parameter_vector(params)
     try:
-        y_s, l_s, vr0 = model.silent(params)
+        st = model.silent(params)
     except SilentMotionError as exc:
-        raise SilentMotionError(f"cannot simulate: {exc}") from None
-    try:
-        modes: LinearModes | None = model.linear_modes(params)
-    except (BrakesquealError, np.linalg.LinAlgError):
-        modes = None
-    y0, start = _initial_state(x0, perturbation, y_s, modes)
-    atol_v = _check_tolerances(rtol, atol, math.sqrt(max(params.k_t, 1.0) / params.Theta))
+        raise type(exc)(f"cannot simulate: {exc}") from None
+    modes = model.linear_modes(params)
+    check_interrupt()
+    y0, start = _initial_state(model, x0, perturbation, st.y, modes, _scales(model, params))
+    atol_v = _check_tolerances(rtol, atol, _default_atol(model, params, rtol, modes))
     k = model.kernels
-    l0 = l_s.copy()
-    f0 = np.empty(4)
-    k.rhs(y0, l0, p, f0)
-    ev0 = np.empty(4)
-    k.event_values(y0, l0, p, vr0, ev0)
+    npad = len(model.pads)
+    l0, dl0 = st.l.copy(), st.dl.copy()
+    f0 = np.empty(y0.size)
+    g, mw = np.empty(2 * l0.size + 1), np.empty(model.n * model.n + model.n)
+    k.rhs(y0, l0, dl0, p, st.ztol, g, mw, f0)
+    ev0 = np.empty(2 * npad)
+    k.event_values(y0, l0, dl0, p, st.vr0, np.empty(7 * npad), ev0)
     if not np.all(np.isfinite(f0)) or not np.all(np.isfinite(ev0)):
         raise ParameterError(f"the equations cannot be evaluated at the initial state {y0.tolist()}")
-    for i in range(2):
-        if ev0[i] <= 0:
-            raise ParameterError(
-                f"pad {i + 1} is out of contact at the initial state (F_n{i + 1} = {ev0[i]:.6g} N <= 0); "
-                "use a smaller initial perturbation"
-            )
-        if ev0[i + 2] <= 0 and events != "off":
-            raise ParameterError(f"pad {i + 1} does not slide forward at the initial state; use a smaller perturbation")
+    for j, pad in enumerate(model.pads):
+        if ev0[j] <= 0:
+            raise ParameterError(f"pad '{pad}' is out of contact at the initial state (F_n = {ev0[j]:.6g} N <= 0); "
+                                 "use a smaller initial perturbation")
+        if ev0[npad + j] <= 0 and events != "off":
+            raise ParameterError(f"pad '{pad}' does not slide forward at the initial state; use a smaller "
+                                 "perturbation")
     t_out = t0 + np.arange(n_out) / sample_rate
-    est = _EstimationGrid(t0, 1.0 / estimation_rate(modes, t1 - t0), int(estimate_samples))
+    est = _EstimationGrid(t0, 1.0 / estimation_rate(modes, t1 - t0), int(estimate_samples), y0.size)
+    run = _Run(model, p, st, y0, l0, dl0, f0, ev0, t0, t1, rtol, atol_v, max_step, t_out, est, events, progress)
     wall = time.perf_counter()
-    if method == "DOP853-jit":
-        res = _run_jit(k, y0, l0, f0, p, vr0, t0, t1, rtol, atol_v, max_step, t_out, est, events, max_steps,
-                       progress)  # fmt: skip
-    else:
-        res = _run_scipy(model, params, k, y0, l0, p, vr0, t0, t1, method, rtol, atol_v, max_step, t_out, est,
-                         events, progress)  # fmt: skip
+    res = run.jit(max_steps) if method == "DOP853-jit" else run.scipy(method)
     wall = time.perf_counter() - wall
+    check_interrupt()
     n = res["n"]
     Y = res["Y"][:n]
-    L, C, E = k.post_process(Y, l_s, p) if n else (np.empty((0, 2)), np.empty((0, 12)), np.empty((0, 3)))
+    m = st.l.size
+    L, dL = np.full((n, m), np.nan), np.full((n, m), np.nan)
+    C, E = np.full((n, 7 * npad), np.nan), np.full((n, 5), np.nan)
+    lw, dlw = st.l.copy(), st.dl.copy()  # warm starts carried from block to block
+    for a in range(0, n, _POST_BLOCK):  # blocks of bounded wall time: Ctrl-C acts between them
+        b = min(a + _POST_BLOCK, n)
+        k.post_process(Y[a:b], b - a, lw, dlw, p, st.ztol, L[a:b], dL[a:b], C[a:b], E[a:b])
+        check_interrupt()
     return Trajectory(
-        status=res["status"], message=res["message"], t=t_out[:n], y=Y, l=L, contact=C, kinetic=E,
-        params=params, q_m0=y_s[:2].copy(), method=method, rtol=rtol, atol=atol_v, t_span=(t0, t1),
-        t_event=res.get("t_event"), y_event=res.get("y_event"), event_times=res.get("event_times", {}),
-        stats={"nfev": res["nfev"], "wall_s": wall, **res.get("stats", {})}, model=model.name,
-        record=est.record(), modes=modes, sample_rate=float(sample_rate), y_start=y0.copy(), start=start,
+        status=res["status"], message=res["message"], t=t_out[:n], y=Y, l=L, contact=C.reshape(n, npad, 7),
+        energy_terms=E, params=params, q0=np.asarray(st.silent.q0, dtype=float).copy(), method=method, rtol=rtol,
+        atol=atol_v, t_span=(t0, t1), t_event=res.get("t_event"), y_event=res.get("y_event"),
+        event_times=res.get("event_times", {}), stats={"nfev": res["nfev"], "wall_s": wall, **res.get("stats", {})},
+        model=model.name, record=est.record(), modes=modes, sample_rate=float(sample_rate), y_start=y0.copy(),
+        start=start, coords=model.coords, pads=model.pads, pad_unknowns=model.pad_unknowns, dynamic=model.dynamic,
+        tilting=model.tilting, y_silent=st.y.copy(), l_rates=dL, event_pad=res.get("event_pad"),
     )  # fmt: skip
 
 
 class _EstimationGrid:
     """The estimation record being filled: times ``t0 + i dt`` in a ring buffer of ``size`` rows."""
 
-    def __init__(self, t0: float, dt: float, size: int) -> None:
+    def __init__(self, t0: float, dt: float, size: int, width: int) -> None:
         self.t0, self.dt = float(t0), float(dt)
-        self.buf = np.full((size, 4), np.nan)
+        self.buf = np.full((size, width), np.nan)
         self.count = 0  # samples written so far (index of the next one)
 
     def put(self, Y: np.ndarray) -> None:
@@ -368,136 +699,171 @@ def _dop853_tables() -> tuple[np.ndarray, ...]:
         np.ascontiguousarray(c.D, dtype=float)  # fmt: skip
 
 
-def _run_jit(k, y0, l0, f0, p, vr0, t0, t1, rtol, atol, max_step, t_out, est, events, max_steps, progress):  # type: ignore[no-untyped-def]
-    tables = _dop853_tables()
-    i_est = 0
-    Y = np.full((t_out.size, 4), np.nan)
-    mode = {"off": 0, "stop": 1, "continue": 2}[events]
-    ev_t = np.zeros(10000)
-    ev_k = np.zeros(10000, dtype=np.int64)
-    n_ev = 0
-    y, l, f = y0.copy(), l0.copy(), f0.copy()
-    h = min(1e-7, (t1 - t0) / 10)
-    i_out = 0
-    nfev = nstep = nrej = 0
-    chunks = 50 if progress is not None else 1
-    edges = np.linspace(t0, t1, chunks + 1)
-    status, t_event, y_event, k_event = 0, None, None, -1
-    t = t0
-    for c in range(chunks):
-        out = k.dop853(y, l, f, p, vr0, t, float(edges[c + 1]), h, rtol, atol, max_step, t_out, i_out, Y,
-                       est.t0, est.dt, i_est, est.buf, mode, ev_t, ev_k, n_ev, max_steps - nstep,
-                       *tables)  # fmt: skip
-        status, t, y, l, f, h, i_out, n_ev, fe, ns, nr, k_event, te, ye, i_est = out
-        est.count = int(i_est)
-        nfev, nstep, nrej = nfev + fe, nstep + ns, nrej + nr
+class _Run:
+    """One integration: the compiled DOP853 in calls of bounded wall time, or SciPy's ``solve_ivp``."""
+
+    def __init__(self, model, p, st, y0, l0, dl0, f0, ev0, t0, t1, rtol, atol, max_step, t_out, est, events,
+                 progress):  # type: ignore[no-untyped-def]
+        self.model, self.p, self.st = model, p, st
+        self.y0, self.l0, self.dl0, self.f0, self.ev0 = y0, l0, dl0, f0, ev0
+        self.t0, self.t1, self.rtol, self.atol, self.max_step = t0, t1, rtol, atol, max_step
+        self.t_out, self.est, self.events, self.progress = t_out, est, events, progress
+        self.npad = len(model.pads)
+
+    def _event_name(self, k: int) -> tuple[str, str]:
+        pad = self.model.pads[k % self.npad]
+        return ("contact-loss" if k < self.npad else "sliding-reversal"), pad
+
+    def _status(self, code: int, t: float, k_event: int, t_event: float | None) -> tuple[str, str]:
+        if code == 0:
+            return "finished", "reached the end time"
+        if code == 1:
+            kind, pad = self._event_name(k_event)
+            if kind == "contact-loss":
+                return kind, f"pad '{pad}' lost contact (F_n <= 0) at t = {t_event:.6g} s"
+            return kind, f"sliding at pad '{pad}' reversed (v_r . v_r0 <= 0) at t = {t_event:.6g} s"
+        reason = {
+            -1: "step size became too small",
+            -2: "the state became non-finite or the pad equations G = 0 could not be solved",
+            -3: "the step budget max_steps was exhausted",
+        }.get(code, f"integrator error {code}")
+        return "failed", f"integration failed at t = {t:.6g} s: {reason}"
+
+    def jit(self, max_steps: int) -> dict[str, Any]:
+        from ._interrupt import check_interrupt
+
+        k, est, st = self.model.kernels, self.est, self.st
+        tables = _dop853_tables()
+        N = self.y0.size
+        Y = np.full((self.t_out.size, N), np.nan)
+        mode = {"off": 0, "stop": 1, "continue": 2}[self.events]
+        ev_t = np.zeros(10000)
+        ev_k = np.zeros(10000, dtype=np.int64)
+        y, f, l, dl, ev_old = self.y0.copy(), self.f0.copy(), self.l0.copy(), self.dl0.copy(), self.ev0.copy()
+        ev_prev = np.full(ev_old.size, np.inf)
+        stats = np.zeros(3, dtype=np.int64)
+        y_event = np.full(N, np.nan)
+        h = min(1e-7, (self.t1 - self.t0) / 10)
+        t, i_out, i_est, n_ev = self.t0, 0, 0, 0
+        status, k_event, t_event = 0, -1, math.nan
+        budget = 256
+        while True:
+            chunk = min(budget, max_steps - int(stats[1]))
+            if chunk <= 0:
+                status = -3
+                break
+            w0 = time.perf_counter()
+            status, t, h, i_out, i_est, n_ev, k_event, t_event = k.dop853(
+                y, f, l, dl, ev_old, ev_prev, self.p, st.ztol, st.vr0, t, self.t1, h, self.rtol, self.atol, self.max_step,
+                self.t_out, i_out, Y, est.t0, est.dt, i_est, est.buf, mode, ev_t, ev_k, n_ev, chunk, stats,
+                y_event, *tables)  # fmt: skip
+            dt = time.perf_counter() - w0
+            check_interrupt()
+            est.count = int(i_est)
+            if self.progress is not None:
+                self.progress((t - self.t0) / (self.t1 - self.t0))
+            if status != 2:
+                break
+            budget = int(min(max(budget * CHUNK_SECONDS / max(dt, 1e-4), 16), 10_000_000))
+        recorded: dict[str, list[float]] = {}
+        for i in range(min(n_ev, ev_t.size)):
+            kind, pad = self._event_name(int(ev_k[i]))
+            recorded.setdefault(f"{kind}-pad-{pad}", []).append(float(ev_t[i]))
+        te = float(t_event) if status == 1 else None
+        st_, msg = self._status(status, t, k_event, te)
+        return {"status": st_, "message": msg, "Y": Y, "n": i_out, "nfev": int(stats[0]), "t_event": te,
+                "y_event": y_event.copy() if status == 1 else None, "event_times": recorded,
+                "event_pad": self._event_name(k_event)[1] if status == 1 else None,
+                "stats": {"steps": int(stats[1]), "rejected": int(stats[2])}}  # fmt: skip
+
+    def scipy(self, method: str) -> dict[str, Any]:
+        """``solve_ivp`` in chunks no longer than the estimation ring buffer (bounded memory)."""
+        from scipy.integrate import solve_ivp
+
+        from ._interrupt import check_interrupt
+
+        k, st, est, p = self.model.kernels, self.st, self.est, self.p
+        t0, t1, progress = self.t0, self.t1, self.progress
+        N, npad = self.y0.size, self.npad
+        lbuf, dlbuf = self.l0.copy(), self.dl0.copy()
+        g, mw = np.empty(2 * lbuf.size + 1), np.empty(self.model.n ** 2 + self.model.n)
+        calls = [0]
+
+        def fun(t: float, y: np.ndarray) -> np.ndarray:
+            out = np.empty(N)
+            k.rhs(np.ascontiguousarray(y, dtype=float), lbuf, dlbuf, p, st.ztol, g, mw, out)
+            check_interrupt()
+            calls[0] += 1
+            if progress is not None and calls[0] % 2000 == 0:
+                progress((t - t0) / (t1 - t0))
+            return out
+
+        evfuns = []
+        names = [self._event_name(i) for i in range(2 * npad)]
+        if self.events != "off":
+            lev, dlev = self.l0.copy(), self.dl0.copy()
+            vals, cb, gev = np.empty(2 * npad), np.empty(7 * npad), np.empty(2 * lbuf.size + 1)
+
+            def make(i: int) -> Callable[[float, np.ndarray], float]:
+                def ev(t: float, y: np.ndarray) -> float:
+                    yy = np.ascontiguousarray(y, dtype=float)
+                    k.solve_pads(yy, lev, dlev, p, st.ztol, gev)
+                    k.event_values(yy, lev, dlev, p, st.vr0, cb, vals)
+                    return float(vals[i])
+
+                ev.terminal = self.events == "stop"  # type: ignore[attr-defined]
+                ev.direction = -1  # type: ignore[attr-defined]
+                return ev
+
+            evfuns = [make(i) for i in range(2 * npad)]
+        t_out = self.t_out
+        Y = np.full((t_out.size, N), np.nan)
+        n = 0
+        nfev = 0
+        t_event, y_event, k_event = None, None, -1
+        recorded: dict[str, list[float]] = {}
+        chunk = est.buf.shape[0] * est.dt
+        a, y = t0, np.asarray(self.y0, dtype=float)
+        code, t_end, sol_msg = 0, t0, ""
+        first = True
+        while True:
+            b = min(a + chunk, t1)
+            if t1 - b < 1e-9 * chunk:
+                b = t1
+            lo = "left" if first else "right"
+            i0, i1 = np.searchsorted(t_out, a, side=lo), np.searchsorted(t_out, b, side="right")
+            _, te = est.times(a, b)
+            if not first:
+                te = te[te > a]
+            ts, inv = np.unique(np.concatenate([t_out[i0:i1], te, [b]]), return_inverse=True)
+            sol = solve_ivp(fun, (a, b), y, method=method, t_eval=ts, rtol=self.rtol, atol=self.atol,
+                            max_step=self.max_step, events=evfuns or None)  # fmt: skip
+            nfev += int(sol.nfev)
+            got = sol.t.size
+            Yc = np.ascontiguousarray(sol.y.T)
+            io, ie = inv[: i1 - i0], inv[i1 - i0 : i1 - i0 + te.size]
+            ok_o, ok_e = io < got, ie < got
+            Y[i0 : i0 + int(ok_o.sum())] = Yc[io[ok_o]]
+            n = i0 + int(ok_o.sum())
+            est.put(Yc[ie[ok_e]])
+            if evfuns:
+                for i, tev in enumerate(sol.t_events):
+                    if tev.size:
+                        kind, pad = names[i]
+                        recorded.setdefault(f"{kind}-pad-{pad}", []).extend(float(v) for v in tev)
+                        if sol.status == 1 and (t_event is None or tev[0] < t_event):
+                            t_event, y_event, k_event = float(tev[0]), np.asarray(sol.y_events[i][0]), i
+            code = {0: 0, 1: 1, -1: -2}[sol.status]
+            t_end = float(sol.t[-1]) if got else a
+            sol_msg = sol.message
+            if code != 0 or b >= t1:
+                break
+            a, y, first = b, Yc[inv[-1]].copy(), False  # ts ends at b: the state to continue from
         if progress is not None:
-            progress((t - t0) / (t1 - t0))
-        if status != 0:
-            if status == 1:
-                t_event, y_event = float(te), np.asarray(ye).copy()
-            break
-    recorded: dict[str, list[float]] = {}
-    for i in range(min(n_ev, ev_t.size)):
-        recorded.setdefault(_EVENT_NAMES[int(ev_k[i])], []).append(float(ev_t[i]))
-    st, msg = _status(status, t, k_event, t_event)
-    return {"status": st, "message": msg, "Y": Y, "n": i_out, "nfev": int(nfev), "t_event": t_event,
-            "y_event": y_event, "event_times": recorded, "stats": {"steps": int(nstep), "rejected": int(nrej)}}  # fmt: skip
-
-
-def _status(code: int, t: float, k_event: int, t_event: float | None) -> tuple[str, str]:
-    if code == 0:
-        return "finished", "reached the end time"
-    if code == 1:
-        pad = k_event % 2 + 1
-        if k_event < 2:
-            return "contact-loss", f"pad {pad} lost contact (F_n{pad} <= 0) at t = {t_event:.6g} s"
-        return "sliding-reversal", f"sliding at pad {pad} reversed (v_r{pad} . v_r0 <= 0) at t = {t_event:.6g} s"
-    reason = {
-        -1: "step size became too small",
-        -2: "the state became non-finite or the pad equations g = 0 could not be solved",
-        -3: "the step budget max_steps was exhausted",
-    }.get(code, f"integrator error {code}")
-    return "failed", f"integration failed at t = {t:.6g} s: {reason}"
-
-
-def _run_scipy(model, params, k, y0, l0, p, vr0, t0, t1, method, rtol, atol, max_step, t_out, est, events, progress):  # type: ignore[no-untyped-def]
-    """``solve_ivp`` in chunks no longer than the estimation ring buffer (bounded memory)."""
-    from scipy.integrate import solve_ivp
-
-    lbuf = l0.copy()
-    calls = [0]
-
-    def fun(t: float, y: np.ndarray) -> np.ndarray:
-        out = np.empty(4)
-        k.rhs(np.ascontiguousarray(y, dtype=float), lbuf, p, out)
-        calls[0] += 1
-        if progress is not None and calls[0] % 2000 == 0:
-            progress((t - t0) / (t1 - t0))
-        return out
-
-    evfuns = []
-    if events != "off":
-        lev = l0.copy()
-        vals = np.empty(4)
-
-        def make(i: int) -> Callable[[float, np.ndarray], float]:
-            def ev(t: float, y: np.ndarray) -> float:
-                yy = np.ascontiguousarray(y, dtype=float)
-                k.solve_l(yy, lev, p)
-                k.event_values(yy, lev, p, vr0, vals)
-                return float(vals[i])
-
-            ev.terminal = events == "stop"  # type: ignore[attr-defined]
-            ev.direction = -1  # type: ignore[attr-defined]
-            return ev
-
-        evfuns = [make(i) for i in range(4)]
-    Y = np.full((t_out.size, 4), np.nan)
-    n = 0
-    nfev = 0
-    t_event, y_event, k_event = None, None, -1
-    recorded: dict[str, list[float]] = {}
-    chunk = est.buf.shape[0] * est.dt
-    a, y = t0, np.asarray(y0, dtype=float)
-    code, t_end, sol_msg = 0, t0, ""
-    first = True
-    while True:
-        b = min(a + chunk, t1)
-        if t1 - b < 1e-9 * chunk:
-            b = t1
-        lo = "left" if first else "right"
-        i0, i1 = np.searchsorted(t_out, a, side=lo), np.searchsorted(t_out, b, side="right")
-        _, te = est.times(a, b)
-        if not first:
-            te = te[te > a]
-        ts, inv = np.unique(np.concatenate([t_out[i0:i1], te, [b]]), return_inverse=True)
-        sol = solve_ivp(fun, (a, b), y, method=method, t_eval=ts, rtol=rtol, atol=atol, max_step=max_step,
-                        events=evfuns or None)  # fmt: skip
-        nfev += int(sol.nfev)
-        got = sol.t.size
-        Yc = np.ascontiguousarray(sol.y.T)
-        io, ie = inv[: i1 - i0], inv[i1 - i0 : i1 - i0 + te.size]
-        ok_o, ok_e = io < got, ie < got
-        Y[i0 : i0 + int(ok_o.sum())] = Yc[io[ok_o]]
-        n = i0 + int(ok_o.sum())
-        est.put(Yc[ie[ok_e]])
-        if evfuns:
-            for i, tev in enumerate(sol.t_events):
-                if tev.size:
-                    recorded.setdefault(_EVENT_NAMES[i], []).extend(float(v) for v in tev)
-                    if sol.status == 1 and (t_event is None or tev[0] < t_event):
-                        t_event, y_event, k_event = float(tev[0]), np.asarray(sol.y_events[i][0]), i
-        code = {0: 0, 1: 1, -1: -2}[sol.status]
-        t_end = float(sol.t[-1]) if got else a
-        sol_msg = sol.message
-        if code != 0 or b >= t1:
-            break
-        a, y, first = b, Yc[inv[-1]].copy(), False  # ts ends at b: the state to continue from
-    if progress is not None:
-        progress(1.0)
-    st, msg = _status(code, t_end, k_event, t_event)
-    if code == -2:
-        msg = f"solve_ivp ({method}) failed: {sol_msg}"
-    return {"status": st, "message": msg, "Y": Y, "n": n, "nfev": nfev, "t_event": t_event,
-            "y_event": y_event, "event_times": recorded if events == "continue" else {}}  # fmt: skip
+            progress(1.0)
+        st_, msg = self._status(code, t_end, k_event, t_event)
+        if code == -2:
+            msg = f"solve_ivp ({method}) failed: {sol_msg}"
+        return {"status": st_, "message": msg, "Y": Y, "n": n, "nfev": nfev, "t_event": t_event,
+                "y_event": y_event, "event_times": recorded if self.events == "continue" else {},
+                "event_pad": names[k_event][1] if code == 1 else None}  # fmt: skip

@@ -1,167 +1,347 @@
-r"""Compiled right-hand side and integrator kernels of the 2-DOF model.
+r"""Compiled simulation kernels of any model: generated numba functions plus a static DOP853 template.
 
-The symbolic model (:func:`~brakesqueal.symbolic.model.derive_equations`) is
-turned once into Python source with common subexpressions eliminated
-(symengine ``cse``):
+The equations of a model (:func:`~brakesqueal.symbolic.assemble.build_equations`,
+``R(Q, Qdot, Qddot, L, Ldot) = 0`` and ``G(Q, Qdot, L, Ldot) = 0``) are turned
+once into numba source by the package's one printer
+(:func:`brakesqueal.codegen.printer.generate_module`, common subexpressions
+eliminated):
 
-* ``pad_residuals(y, l, p)`` — ``g1, g2`` (eqs. 33-34) and ``dg_i/dl_i``,
-* ``mass_force(y, l, p)``    — ``M_m`` (eq. 45, row-major) and ``psi`` at
-  ``q_mddot = 0`` (eq. 44), so that ``q_mddot = -M_m^{-1} psi(q_mddot = 0)``,
-* ``contact(y, l, p)``       — ``F_n, v_r (3), h, hdot`` of both pads,
-* ``kinetic(y, p)``          — ``T2, T1, T0``: the disk's kinetic energy with
-  the spin constraint substituted, split by degree in ``q_mdot``,
+* ``pad_balance(y, l, dl, p, out)`` — per pad unknown ``j``: ``G_j`` and its
+  derivative with respect to the pad's unknown (``l_j`` of a quasi-static pad,
+  ``ldot_j`` of a pad with rate-dependent friction);
+* ``mass_force(y, l, dl, p, out)`` — the mass matrix ``M(Q) = dR/dQddot``
+  (``n x n``, row-major) and the forcing ``f = R(Qddot = 0)``, so that
+  ``M Qddot + f = 0`` (``R`` is linear in ``Qddot``: checked when generating);
+* ``contact(y, l, dl, p, out)`` — per pad the
+  :data:`~brakesqueal.codegen.compiled.CONTACT_FIELDS` ``F_n, v_r (3), h, hdot, l``;
+* ``pad_scale(y, l, dl, p, out)`` — per pad unknown the size of the terms of
+  ``G_j`` (its rounding level divided by ``eps``: the Newton tolerance);
+* ``energy(y, l, dl, p, out)`` — ``T2, T1, T0`` (kinetic energy by degree in the
+  tilt rates, the spin constraint substituted) and the potentials
+  ``V_support`` (disk and caliper springs) and ``V_pads`` (pad springs and preloads);
 
-all with ``y = (q1, q2, dq1, dq2)``, ``l = (l1, l2)`` and ``p`` in the order of
-:data:`~brakesqueal.symbolic.model.PARAMETER_SYMBOLS`; every pad rate
-``ldot`` is set to zero (quasi-static pads, as in the linearization).  A
-static template (:data:`_TEMPLATE`) adds the Newton solve for ``l``, the RHS,
-the event functions and a Dormand–Prince 8(5,3) integrator (the DOP853
-coefficients, step-size control and 7th-order dense output of SciPy's
-``solve_ivp``, ported to numba).  The whole file is written to the package
-cache and imported from there, so numba's own on-disk cache
-(``cache=True``) makes a warm start compile-free.
+with ``y = (Q, Qdot)`` (the first ``2n`` entries of the integrator state), ``l``
+and ``dl`` the pad deformations ``L`` and their rates, ``p``
+(:meth:`Parameters.vector <brakesqueal.model.parameters.Parameters.vector>`).
+
+**Pad treatment** (decided per pad from the model, :func:`pad_treatment`): a
+massless pad with a finite tangential stiffness and rate-independent
+(``coulomb``) friction is *quasi-static*: ``ldot := 0`` is substituted in all
+its expressions and ``l`` solves ``G(Q, Qdot, l, 0) = 0``.  With rate-dependent
+friction (``linear``, ``stribeck``) it is *dynamic*: ``l`` is a state and
+``ldot`` solves ``G(Q, Qdot, l, ldot) = 0``.  Each pad's ``G_j`` depends on its
+own unknown only (checked), so both are scalar Newton iterations per pad,
+warm-started from the previous value.
+
+A static template (:data:`_TEMPLATE`) adds the pad solve, the right-hand side
+(Gaussian elimination with partial pivoting for ``M Qddot = -f``), the event
+functions (contact loss ``F_n <= 0`` and sliding reversal ``v_r . v_r0 <= 0`` for
+every pad), post-processing and a Dormand–Prince 8(5,3) integrator (SciPy's
+DOP853 coefficients, error norm, step-size control and 7th-order dense output,
+ported to numba) that runs for a bounded number of steps per call and keeps its
+whole state in arrays, so a run split into calls is bitwise the same as one call.
+No compiled function returns an array: boxing an array calls back into the
+interpreter (numba's ``_numba_unpickle``), where a pending ``KeyboardInterrupt``
+would surface inside compiled code (issue 11).
+
+The module is cached per model (:func:`brakesqueal.numeric.cache.load_module`,
+entry ``model-<hash>/simulate.py``) and numba caches its machine code beside it.
 """
 
 from __future__ import annotations
 
-import hashlib
+import math
 import types
-from functools import lru_cache
-from typing import Any, Sequence
+from typing import Any
 
 from ..numeric import cache
-from ..symbolic.model import PARAMETER_SYMBOLS
 
-__all__ = ["KERNEL_KEY", "kernel_source", "load_kernels"]
+__all__ = ["KERNEL_NAME", "PAD_KINDS", "pad_treatment", "kernel_source", "load_kernels"]
 
-KERNEL_KEY = "simulate-rhs"
-
-_STATE = ("q1", "q2", "dq1", "dq2")
-
-
-def _py(expr: Any) -> str:
-    text = str(expr)
-    if "zoo" in text or "nan" in text or " I " in f" {text} ":
-        raise ValueError(f"cannot generate numeric code for {text!r}")
-    return text
+#: File name of the kernel module in the model's cache entry.
+KERNEL_NAME = "simulate.py"
+#: Treatments of a massless pad's tangential deformation (see the module docstring).
+PAD_KINDS = ("quasi-static", "dynamic")
 
 
-def _function(name: str, args: Sequence[tuple[str, Sequence[str]]], outputs: Sequence[Any], doc: str) -> str:
+def pad_treatment(spec: Any) -> tuple[str, ...]:
+    """Treatment of every pad deformation ``L`` of a model (``"quasi-static"`` or ``"dynamic"``).
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+
+    Returns
+    -------
+    tuple of str
+        One entry per massless pad with a finite tangential stiffness (the
+        order of ``Equations.algebraic``): ``"quasi-static"`` for
+        rate-independent (``coulomb``) friction, ``"dynamic"`` for
+        rate-dependent friction (``linear``, ``stribeck``).  Decided from the
+        friction law, never from parameter values.
+    """
+    out = []
+    for pad in spec.pads:
+        rigid = not isinstance(pad.k_ip, str) and math.isinf(pad.k_ip)
+        if "tangential" in pad.dofs or rigid:
+            continue
+        out.append("quasi-static" if pad.friction.law == "coulomb" else "dynamic")
+    return tuple(out)
+
+
+def _value(se: Any, eq: Any, v: Any) -> Any:
+    """Symbolic value of a component field (parameter name, number; stiffnesses through their compliance)."""
+    if v is None:
+        return se.Integer(0)
+    if isinstance(v, str):
+        names = list(eq.spec.parameters)
+        sym = eq.params[names.index(v)]
+        return 1 / sym if v in eq.spec.stiffness_names() else sym
+    return se.Integer(int(v)) if float(v).is_integer() else se.sympify(float(v))
+
+
+def _state_name(prefix: str, component: str) -> str:
+    return f"{prefix}{component}" if component.isdigit() else f"{prefix}_{component}"
+
+
+def _check_free(what: str, expr: Any, forbidden: set[Any]) -> None:
+    bad = set(expr.free_symbols) & forbidden
+    if bad:
+        raise ValueError(f"cannot generate simulation kernels: {what} depends on {sorted(map(str, bad))}")
+
+
+def _expressions(spec: Any) -> dict[str, Any]:
+    """Symbolic outputs of the generated functions and the metadata of the module."""
     import symengine as se
 
-    lines = ["@njit(cache=True)", f"def {name}({', '.join(a for a, _ in args)}):", f'    """{doc}"""']
-    for arg, names in args:
-        lines.extend(f"    {n} = {arg}[{i}]" for i, n in enumerate(names))
-    reps, reduced = se.cse([se.sympify(e) for e in outputs])
-    lines.extend(f"    {s} = {_py(v)}" for s, v in reps)
-    lines.append(f"    return ({', '.join(_py(e) for e in reduced)},)")
-    return "\n".join(lines) + "\n"
+    from ..symbolic.assemble import build_equations
 
+    eq = build_equations(spec)
+    n, m = eq.n, eq.m
+    kinds = pad_treatment(spec)
+    if len(kinds) != m:
+        raise AssertionError("pad treatment does not match the pad deformations of the equations")
+    quasi = {eq.dL[j]: 0 for j in range(m) if kinds[j] == "quasi-static"}
 
-def _expressions() -> dict[str, list[Any]]:
-    """The symbolic outputs of the generated functions (symengine)."""
-    import symengine as se
+    def qs(e: Any) -> Any:
+        return se.sympify(e).subs(quasi) if quasi else se.sympify(e)
 
-    from ..symbolic.constraint import spin_constraint
-    from ..symbolic.model import derive_equations
-
-    eq = derive_equations("symengine")
-    st, pr = eq.state, eq.params
-    quasi = {st["dl1"]: 0, st["dl2"]: 0}
-    g = [eq.g[i].subs(quasi) for i in range(2)]
-    gl = [g[0].diff(st["l1"]), g[1].diff(st["l2"])]
-    psi0 = [eq.psi[i].subs({**quasi, st["ddq1"]: 0, st["ddq2"]: 0}) for i in range(2)]
-    M = eq.reduced.M_m
-    mass = [M[0, 0], M[0, 1], M[1, 0], M[1, 1]] + psi0
+    ddQ = set(eq.ddQ)
+    # mass matrix and forcing: R = M(Q) Qddot + f(Q, Qdot, L, Ldot), R linear in Qddot
+    R = [qs(eq.R[i]) for i in range(n)]
+    Mx, f = [], []
+    zero_dd = {s: 0 for s in eq.ddQ}
+    for i in range(n):
+        for j in range(n):
+            e = R[i].diff(eq.ddQ[j])
+            _check_free(f"dR/dQddot[{i}, {j}]", e, ddQ)  # R is linear in Qddot
+            Mx.append(e)
+        f.append(R[i].subs(zero_dd))
+    # pad balances: each G_j depends on its own unknown only
+    bal, dbal = [], []
+    for j in range(m):
+        g = qs(eq.G[j])
+        others = {eq.L[k] for k in range(m) if k != j} | {eq.dL[k] for k in range(m) if k != j}
+        _check_free(f"G[{j}]", g, others | ddQ)
+        bal.append(g)
+        dbal.append(g.diff(eq.L[j] if kinds[j] == "quasi-static" else eq.dL[j]))
+    scale = [qs(e) for e in _pad_scales(se, eq)]
     contact: list[Any] = []
-    for c in eq.pads:
-        contact.extend([c.F_n.subs(quasi), *(c.v_r[i].subs(quasi) for i in range(3)), c.h, c.hdot.subs(quasi)])
-    # kinetic energy with the constraint substituted, T = T2 + T1 + T0 in dq_m
-    kin = eq.kinematics
-    con = spin_constraint(se, (st["q1"], st["q2"]), pr["Omega"])
-    dqm = se.Matrix([st["dq1"], st["dq2"]])
-    I3 = se.diag(pr["Theta"], pr["Theta"], pr["Phi"])
-    w3 = kin.A.T * (kin.J_R0 * (con.s + con.S * dqm))
-    T = (w3.T * I3 * w3)[0, 0] / 2
-    neg = {st["dq1"]: -st["dq1"], st["dq2"]: -st["dq2"]}
-    zero = {st["dq1"]: 0, st["dq2"]: 0}
-    Tm, T0 = T.subs(neg), T.subs(zero)
-    kinetic = [se.expand((T + Tm) / 2 - T0), se.expand((T - Tm) / 2), T0]
-    return {"mass": mass, "g": g + gl, "contact": contact, "kinetic": kinetic}
+    for c, l in zip(eq.pads, eq.tangential):
+        contact += [qs(c.F_n), qs(c.v_r[0]), qs(c.v_r[1]), qs(c.v_r[2]), qs(c.h), qs(c.hdot), qs(l)]
+    energy = _energy(se, eq)
+    return {"eq": eq, "kinds": kinds, "mass_force": Mx + f, "pad_balance": bal + dbal, "contact": contact,
+            "energy": [qs(e) for e in energy], "pad_scale": scale}
 
 
-def generated_source() -> str:
-    """Source of the generated functions (without the static template)."""
-    ex = _expressions()
-    y = ("y", _STATE)
-    ll = ("l", ("l1", "l2"))
-    pp = ("p", PARAMETER_SYMBOLS)
-    parts = [
-        _function("pad_residuals", (y, ll, pp), ex["g"], "(g1, g2, dg1/dl1, dg2/dl2) with ldot = 0, eqs. (33)-(34)."),
-        _function("mass_force", (y, ll, pp), ex["mass"], "(M11, M12, M21, M22, psi1, psi2) at q_mddot = ldot = 0."),
-        _function(
-            "contact", (y, ll, pp), ex["contact"],
-            "(F_n, v_rx, v_ry, v_rz, h, hdot) of pad 1 then pad 2, ldot = 0, eqs. (16)-(30).",
-        ),  # fmt: skip
-        _function("kinetic", (y, pp), ex["kinetic"], "(T2, T1, T0): kinetic energy by degree in q_mdot [J]."),
-    ]
-    return "\n\n".join(parts)
+def _pad_scales(se: Any, eq: Any) -> list[Any]:
+    """Per pad unknown, the size of the terms of ``G_j = (l - u_m) + c (f_t + mu* N0)`` (its rounding level / eps)."""
+    from ..symbolic.contact import angle_cos_sin
+
+    spec = eq.spec
+    Q = dict(zip(eq.coords, eq.Q))
+    cal = {c.name: c for c in spec.calipers}
+    out = []
+    for pad, c, l in zip(spec.pads, eq.pads, eq.tangential):
+        rigid = not isinstance(pad.k_ip, str) and math.isinf(pad.k_ip)
+        if "tangential" in pad.dofs or rigid:
+            continue
+        comp = 1 / _value(se, eq, pad.k_ip)  # the compliance (symbol, or 1/number)
+        mount = cal.get(pad.mount) if pad.mount else None
+        ca = angle_cos_sin(se, pad.angle_deg)[0]
+        u_m = Q[_state_name("uc", mount.name)] * ca if mount and "tangential" in mount.dofs else se.Integer(0)
+        out.append(abs(l) + abs(u_m) + abs(comp * c.f_t) + abs(comp * c.mu_star * _value(se, eq, pad.preload)))
+    return out
 
 
-_HEADER = '''"""Generated by brakesqueal.simulation from the symbolic model. Do not edit.
+def _energy(se: Any, eq: Any) -> list[Any]:
+    """``T2, T1, T0, V_support, V_pads`` (see ``docs/simulation.md``, energy)."""
+    from ..symbolic.contact import angle_cos_sin
 
-y = (q1, q2, dq1, dq2) [rad, rad/s]; l = (l1, l2) [m];
-p = ({params}) [SI; c_ip = 1/k_ip].
-"""
-import math
-from math import sin, cos, tan, sqrt, pi
+    spec = eq.spec
+    Q = dict(zip(eq.coords, eq.Q))
+    dQ = dict(zip(eq.coords, eq.dQ))
+    val = lambda v: _value(se, eq, v)  # noqa: E731
+    half = se.Rational(1, 2)
+    T2 = T1 = T0 = se.Integer(0)
+    V_support = V_pads = se.Integer(0)
+    disk = spec.disk
+    if disk.tilting:
+        kin = eq.kinematics
+        w3 = kin.A.T * (kin.J_R0 * eq.constraint_qdot)  # body-frame angular velocity with the constraint (eq. 41)
+        I3 = se.diag(val(disk.Theta), val(disk.Theta), val(disk.Phi))
+        T = (w3.T * I3 * w3)[0, 0] / 2
+        dqm = (dQ["q1"], dQ["q2"])
+        Tm = T.subs({dqm[0]: -dqm[0], dqm[1]: -dqm[1]})
+        T0 = T.subs({dqm[0]: 0, dqm[1]: 0})
+        T2 = se.expand((T + Tm) / 2 - T0)
+        T1 = se.expand((T - Tm) / 2)
+        V_support = half * val(disk.k_t) * (Q["q1"] ** 2 + Q["q2"] ** 2)
+    cal = {c.name: c for c in spec.calipers}
+    for cp in spec.calipers:
+        for d, pre, k in (("normal", "wc", cp.k_n), ("tangential", "uc", cp.k_t)):
+            if d in cp.dofs:
+                name = _state_name(pre, cp.name)
+                T2 += half * val(cp.mass) * dQ[name] ** 2
+                V_support += half * val(k) * Q[name] ** 2
+    for pad, c, l in zip(spec.pads, eq.pads, eq.tangential):
+        s = 1 if pad.face == "upper" else -1
+        N0, k = val(pad.preload), val(pad.k)
+        mount = cal.get(pad.mount) if pad.mount else None
+        ca = angle_cos_sin(se, pad.angle_deg)[0]
+        w_m = Q[_state_name("wc", mount.name)] if mount and "normal" in mount.dofs else se.Integer(0)
+        u_m = Q[_state_name("uc", mount.name)] * ca if mount and "tangential" in mount.dofs else se.Integer(0)
+        if "normal" in pad.dofs:
+            w = Q[_state_name("w", pad.name)]
+            T2 += half * val(pad.mass) * dQ[_state_name("w", pad.name)] ** 2
+            delta = s * (w - c.h)
+            V_pads += half * k * (w - w_m) ** 2 - s * N0 * w + N0 * delta + half * val(pad.k_c) * delta**2
+        else:
+            V_pads += half * k * (c.h - w_m) ** 2 - s * N0 * c.h
+        if "tangential" in pad.dofs:
+            u = Q[_state_name("u", pad.name)]
+            T2 += half * val(pad.mass) * dQ[_state_name("u", pad.name)] ** 2
+            V_pads += half * val(pad.k_ip) * (u - u_m) ** 2 + c.mu_star * N0 * u
+        elif not (not isinstance(pad.k_ip, str) and math.isinf(pad.k_ip)):
+            # massless pad on its balance g = 0 (eqs. 33-34): k_ip (l - u_m)^2 / 2 = -(l - u_m)(f_t + mu* N0) / 2,
+            # finite also for a rigid support given as k_ip = inf (compliance 0)
+            V_pads += -half * (l - u_m) * (c.f_t + c.mu_star * N0) + c.mu_star * N0 * l
+    return [T2, T1, T0, V_support, V_pads]
+
+
+_PREAMBLE = '''import math
+from math import sin, cos, tan, sqrt, exp, log, pi
 
 import numpy as np
 from numba import njit
 
+_N = {n}  # coordinates Q
+_M = {m}  # pad deformations L
+_NPAD = {npad}  # pads
+_NDYN = {ndyn}  # pad deformations that are states (rate-dependent friction)
+_NY = {ny}  # integrator state (Q, Qdot, L_dynamic)
+_NEV = {nev}  # event functions: contact loss and sliding reversal of every pad
+_KIND = np.array({kind}, dtype=np.int64)  # per L: 0 quasi-static (unknown l, ldot = 0), 1 dynamic (unknown ldot)
+_DYN = np.array({dyn}, dtype=np.int64)  # index into L of the i-th state y[2 N + i]
 '''
 
-# The static part of the kernel module: l solve, RHS, events, DOP853 with dense output.
+_DECORATOR = '@njit(cache=True, error_model="numpy")'
+
+# The static part of the kernel module: pad solve, RHS, events, post-processing, DOP853 with dense output.
 _TEMPLATE = r'''
 
 @njit(cache=True)
-def solve_l(y, l, p):
-    """Newton iterations for g(q, dq, l, ldot=0) = 0, in place from the current l (warm start)."""
-    for _ in range(30):
-        g1, g2, g1l, g2l = pad_residuals(y, l, p)
-        d1 = g1 / g1l
-        d2 = g2 / g2l
-        l[0] -= d1
-        l[1] -= d2
-        if abs(d1) <= 1e-13 * abs(l[0]) + 1e-300 and abs(d2) <= 1e-13 * abs(l[1]) + 1e-300:
+def solve_pads(y, l, dl, p, ztol, g):
+    """Newton iterations for G = 0 per pad, in place from the current l, dl (warm start).
+
+    Quasi-static pads: unknown l_j (ldot_j = 0); dynamic pads: l_j = y[2N + i] and unknown ldot_j.
+    Converged when every step is below 1e-13 |z_j| + ztol_j (ztol: the rounding level of G_j / dG_j).
+    """
+    for i in range(_NDYN):
+        l[_DYN[i]] = y[2 * _N + i]
+    if _M == 0:
+        return True
+    for _ in range(40):
+        pad_balance(y, l, dl, p, g)
+        done = True
+        for j in range(_M):
+            d = g[j] / g[_M + j]
+            if not abs(d) < 1e300:
+                return False
+            if _KIND[j] == 0:
+                l[j] -= d
+                z = l[j]
+            else:
+                dl[j] -= d
+                z = dl[j]
+            if abs(d) > 1e-13 * abs(z) + ztol[j]:
+                done = False
+        if done:
             return True
-        if not (abs(d1) < 1e300 and abs(d2) < 1e300):
-            return False
-    return abs(d1) <= 1e-10 * abs(l[0]) + 1e-20 and abs(d2) <= 1e-10 * abs(l[1]) + 1e-20
+    return False
 
 
 @njit(cache=True)
-def rhs(y, l, p, out):
-    """out = dy/dt for y = (q1, q2, dq1, dq2); l is solved (and updated) on the way."""
-    ok = solve_l(y, l, p)
-    m11, m12, m21, m22, f1, f2 = mass_force(y, l, p)
-    det = m11 * m22 - m12 * m21
-    out[0] = y[2]
-    out[1] = y[3]
-    out[2] = -(m22 * f1 - m12 * f2) / det
-    out[3] = -(m11 * f2 - m21 * f1) / det
+def rhs(y, l, dl, p, ztol, g, mw, out):
+    """out = dy/dt for y = (Q, Qdot, L_dyn); the pad unknowns l, dl are solved (and updated) on the way.
+
+    Qddot solves M(Q) Qddot = -f (Gaussian elimination with partial pivoting); a failed pad solve or a
+    singular mass matrix gives NaN (the step is rejected).
+    """
+    ok = solve_pads(y, l, dl, p, ztol, g)
+    mass_force(y, l, dl, p, mw)
+    n = _N
+    f0 = n * n
+    for i in range(n):
+        out[i] = y[n + i]
+        mw[f0 + i] = -mw[f0 + i]
+    for k in range(n):
+        piv = k
+        big = abs(mw[k * n + k])
+        for i in range(k + 1, n):
+            v = abs(mw[i * n + k])
+            if v > big:
+                big = v
+                piv = i
+        if not big > 0.0:
+            ok = False
+            break
+        if piv != k:
+            for j in range(k, n):
+                tmp = mw[k * n + j]
+                mw[k * n + j] = mw[piv * n + j]
+                mw[piv * n + j] = tmp
+            tmp = mw[f0 + k]
+            mw[f0 + k] = mw[f0 + piv]
+            mw[f0 + piv] = tmp
+        inv = 1.0 / mw[k * n + k]
+        for i in range(k + 1, n):
+            fac = mw[i * n + k] * inv
+            if fac != 0.0:
+                for j in range(k + 1, n):
+                    mw[i * n + j] -= fac * mw[k * n + j]
+                mw[f0 + i] -= fac * mw[f0 + k]
+    if ok:
+        for i in range(n - 1, -1, -1):
+            acc = mw[f0 + i]
+            for j in range(i + 1, n):
+                acc -= mw[i * n + j] * out[n + j]
+            out[n + i] = acc / mw[i * n + i]
+    for i in range(_NDYN):
+        out[2 * n + i] = dl[_DYN[i]]
     if not ok:
-        out[2] = math.nan
+        out[n] = math.nan
 
 
 @njit(cache=True)
-def event_values(y, l, p, vr0, out):
-    """(F_n1, F_n2, v_r1 . v_r1_silent, v_r2 . v_r2_silent); contact is lost / sliding reverses at <= 0."""
-    c = contact(y, l, p)
-    out[0] = c[0]
-    out[1] = c[6]
-    out[2] = c[1] * vr0[0] + c[2] * vr0[1] + c[3] * vr0[2]
-    out[3] = c[7] * vr0[3] + c[8] * vr0[4] + c[9] * vr0[5]
+def event_values(y, l, dl, p, vr0, cb, out):
+    """Per pad F_n (contact loss at <= 0), then per pad v_r . v_r0 (sliding reversal at <= 0); l, dl solved."""
+    contact(y, l, dl, p, cb)
+    for j in range(_NPAD):
+        b = 7 * j
+        out[j] = cb[b]
+        out[_NPAD + j] = cb[b + 1] * vr0[3 * j] + cb[b + 2] * vr0[3 * j + 1] + cb[b + 3] * vr0[3 * j + 2]
 
 
 @njit(cache=True)
@@ -181,30 +361,37 @@ def dense_eval(F, y_old, x, out):
 
 
 @njit(cache=True)
-def post_process(Y, l0, p):
-    """Pad deformations, contact quantities and energy pieces at every output sample."""
-    n = Y.shape[0]
-    L = np.empty((n, 2))
-    C = np.empty((n, 12))
-    E = np.empty((n, 3))
-    l = l0.copy()
-    for i in range(n):
+def post_process(Y, count, l, dl, p, ztol, L_out, dL_out, C_out, E_out):
+    """Pad unknowns, contact quantities and energy terms at the first ``count`` rows of Y (in place).
+
+    l, dl: start values (the silent motion's), updated as warm starts from sample to sample.
+    """
+    g = np.empty(2 * _M + 1)
+    cb = np.empty(7 * _NPAD)
+    eb = np.empty(5)
+    for i in range(count):
         y = Y[i]
-        if not np.all(np.isfinite(y)):
-            L[i, :] = math.nan
-            C[i, :] = math.nan
-            E[i, :] = math.nan
+        finite = True
+        for j in range(_NY):
+            if not abs(y[j]) < 1e300:
+                finite = False
+        if finite:
+            finite = solve_pads(y, l, dl, p, ztol, g)
+        if not finite:
+            L_out[i, :] = math.nan
+            dL_out[i, :] = math.nan
+            C_out[i, :] = math.nan
+            E_out[i, :] = math.nan
             continue
-        solve_l(y, l, p)
-        L[i, 0] = l[0]
-        L[i, 1] = l[1]
-        c = contact(y, l, p)
-        for k in range(12):
-            C[i, k] = c[k]
-        e = kinetic(y, p)
-        for k in range(3):
-            E[i, k] = e[k]
-    return L, C, E
+        for j in range(_M):
+            L_out[i, j] = l[j]
+            dL_out[i, j] = dl[j]
+        contact(y, l, dl, p, cb)
+        for k in range(7 * _NPAD):
+            C_out[i, k] = cb[k]
+        energy(y, l, dl, p, eb)
+        for k in range(5):
+            E_out[i, k] = eb[k]
 
 
 @njit(cache=True)
@@ -226,52 +413,111 @@ def _error_norm(K, E5, E3, h, scale):
 
 
 @njit(cache=True)
-def dop853(y0, l0, f0, p, vr0, t0, t1, h0, rtol, atol, max_step, t_out, i_out, Y, te0, dte, i_est, Yest,
-           event_mode, ev_t, ev_k, n_ev, max_steps, A, B, C, E3, E5, D):
-    """Adaptive DOP853 from t0 to t1 (SciPy's algorithm), writing dense output at t_out[i_out:] into Y.
+def _event_at(k, x, F, y, l, dl, p, ztol, vr0, g, cb, ev, yint):
+    """Event function k at normalized time x of the step (pad unknowns solved from l, dl, updated)."""
+    dense_eval(F, y, x, yint)
+    solve_pads(yint, l, dl, p, ztol, g)
+    event_values(yint, l, dl, p, vr0, cb, ev)
+    return ev[k]
 
-    The estimation record: dense output at te0 + i dte (i = i_est, i_est + 1, ...) is written into the
-    ring buffer Yest (row i % Yest.shape[0]), so that it holds the last Yest.shape[0] samples.
-    event_mode: 0 = no events, 1 = stop at the first event, 2 = record events and continue.
-    Returns (status, t, y, l, f, h, i_out, n_ev, nfev, nstep, nreject, k_event, t_event, y_event, i_est);
-    status 0 = reached t1, 1 = stopped at an event, -1 = step size too small,
-    -2 = non-finite state or pad equations unsolvable, -3 = max_steps reached.
+
+@njit(cache=True)
+def _bisect(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb):
+    """First x in [a, b] with event k <= 0, given event k > 0 at a and <= 0 at b (60 halvings; returns the <= 0 end)."""
+    lb[:] = l0
+    dlb[:] = dl0
+    for _ in range(60):
+        c = 0.5 * (a + b)
+        if _event_at(k, c, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint) > 0.0:
+            a = c
+        else:
+            b = c
+    return b
+
+
+@njit(cache=True)
+def _golden(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb):
+    """Minimum of event k on [a, b] (golden-section search, 48 steps): returns (x, value); stops early at a value <= 0."""
+    lb[:] = l0
+    dlb[:] = dl0
+    r = 0.6180339887498949
+    c = b - r * (b - a)
+    d = a + r * (b - a)
+    fc = _event_at(k, c, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint)
+    fd = _event_at(k, d, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint)
+    for _ in range(48):
+        if fc <= 0.0:
+            return c, fc
+        if fd <= 0.0:
+            return d, fd
+        if fc < fd:
+            b = d
+            d = c
+            fd = fc
+            c = b - r * (b - a)
+            fc = _event_at(k, c, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint)
+        else:
+            a = c
+            c = d
+            fc = fd
+            d = a + r * (b - a)
+            fd = _event_at(k, d, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint)
+    if fc < fd:
+        return c, fc
+    return d, fd
+
+
+@njit(cache=True)
+def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol, max_step, t_out, i_out, Y, te0, dte,
+           i_est, Yest, event_mode, ev_t, ev_k, n_ev, budget, stats, y_event, A, B, C, E3, E5, D):
+    """Adaptive DOP853 from t towards t1 (SciPy's algorithm), at most ``budget`` accepted steps per call.
+
+    Integrator state, updated in place: y (state), f (its derivative), l, dl (pad unknowns, solved at y),
+    ev_old (event values at y), ev_prev (at the previous step's last inner point; inf at the start); stats
+    (int64) accumulates nfev, accepted steps, rejected steps.  Events: sign changes between NSUB + 1 points
+    per step are bisected; a sampled minimum within twice the second difference of zero (a grazing dip) is
+    located by golden-section search and, if it is <= 0, the crossing before it is bisected.
+    Dense output at t_out[i_out:] goes into Y; at te0 + i dte (i = i_est, ...) into the ring buffer Yest
+    (row i % Yest.shape[0]).  event_mode: 0 = none, 1 = stop at the first event, 2 = record and continue.
+    Returns (status, t, h_abs, i_out, i_est, n_ev, k_event, t_event): status 0 = reached t1,
+    1 = stopped at an event (state in y_event), 2 = budget used (call again to continue),
+    -1 = step size too small, -2 = non-finite state or pad equations unsolvable.
     """
-    n = y0.shape[0]
+    n = y.shape[0]
     SAFETY = 0.9
     MIN_FACTOR = 0.2
     MAX_FACTOR = 10.0
     expo = -1.0 / 8.0
+    NSUB = 4
     K = np.zeros((16, n))
     F = np.zeros((7, n))
-    y = y0.copy()
-    l = l0.copy()
-    f = f0.copy()
     ynew = np.empty(n)
     fnew = np.empty(n)
     ystage = np.empty(n)
     scale = np.empty(n)
-    ev_old = np.empty(4)
-    ev_new = np.empty(4)
-    ev_mid = np.empty(4)
-    ev_a = np.empty(4)
-    NSUB = 4
     yint = np.empty(n)
-    lint = l.copy()
+    g = np.empty(2 * _M + 1)
+    mw = np.empty(_N * _N + _N)
+    cb = np.empty(7 * _NPAD)
+    ev_new = np.empty(_NEV)
+    ev_mid = np.empty(_NEV)
+    evs = np.empty((NSUB + 1, _NEV))
+    Ls = np.empty((NSUB + 1, _M))
+    dLs = np.empty((NSUB + 1, _M))
     lnew = l.copy()
-    t = t0
-    h_abs = h0
-    nfev = 0
-    nstep = 0
-    nrej = 0
+    dlnew = dl.copy()
+    lsave = l.copy()
+    dlsave = dl.copy()
+    lint = l.copy()
+    dlint = dl.copy()
+    lb = l.copy()
+    dlb = dl.copy()
     k_event = -1
     t_event = math.nan
-    y_event = np.full(n, math.nan)
-    if event_mode > 0:
-        event_values(y, l, p, vr0, ev_old)
+    steps = 0
     while t < t1:
-        if nstep >= max_steps:
-            return (-3, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event, i_est)
+        if steps >= budget:
+            return (2, t, h_abs, i_out, i_est, n_ev, k_event, t_event)
         min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
         if h_abs > max_step:
             h_abs = max_step
@@ -280,29 +526,30 @@ def dop853(y0, l0, f0, p, vr0, t0, t1, h0, rtol, atol, max_step, t_out, i_out, Y
         rejected = False
         while True:
             if h_abs < min_step:
-                return (-1, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event, i_est)
+                return (-1, t, h_abs, i_out, i_est, n_ev, k_event, t_event)
             t_new = t + h_abs
             if t_new > t1:
                 t_new = t1
             h = t_new - t
             h_abs = abs(h)
             lnew[:] = l
+            dlnew[:] = dl
             for j in range(n):
                 K[0, j] = f[j]
             for s in range(1, 12):
                 for j in range(n):
                     acc = 0.0
-                    for m in range(s):
-                        acc += K[m, j] * A[s, m]
+                    for q in range(s):
+                        acc += K[q, j] * A[s, q]
                     ystage[j] = y[j] + h * acc
-                rhs(ystage, lnew, p, K[s])
+                rhs(ystage, lnew, dlnew, p, ztol, g, mw, K[s])
             for j in range(n):
                 acc = 0.0
-                for m in range(12):
-                    acc += K[m, j] * B[m]
+                for q in range(12):
+                    acc += K[q, j] * B[q]
                 ynew[j] = y[j] + h * acc
-            rhs(ynew, lnew, p, fnew)
-            nfev += 12
+            rhs(ynew, lnew, dlnew, p, ztol, g, mw, fnew)
+            stats[0] += 12
             for j in range(n):
                 K[12, j] = fnew[j]
             finite = True
@@ -325,11 +572,14 @@ def dop853(y0, l0, f0, p, vr0, t0, t1, h0, rtol, atol, max_step, t_out, i_out, Y
                 h_abs *= factor
                 break
             if not finite and h_abs <= 1e3 * min_step:
-                return (-2, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event, i_est)
+                return (-2, t, h_abs, i_out, i_est, n_ev, k_event, t_event)
             h_abs *= max(MIN_FACTOR, SAFETY * err ** expo)
             rejected = True
-            nrej += 1
-        nstep += 1
+            stats[2] += 1
+        steps += 1
+        stats[1] += 1
+        lsave[:] = lnew  # pad unknowns solved at ynew
+        dlsave[:] = dlnew
         # dense output of this step (3 extra stages)
         need_dense = (i_out < t_out.shape[0] and t_out[i_out] <= t_new) or event_mode > 0 \
             or te0 + i_est * dte <= t_new
@@ -337,11 +587,11 @@ def dop853(y0, l0, f0, p, vr0, t0, t1, h0, rtol, atol, max_step, t_out, i_out, Y
             for s in range(13, 16):
                 for j in range(n):
                     acc = 0.0
-                    for m in range(s):
-                        acc += K[m, j] * A[s, m]
+                    for q in range(s):
+                        acc += K[q, j] * A[s, q]
                     ystage[j] = y[j] + h * acc
-                rhs(ystage, lnew, p, K[s])
-            nfev += 3
+                rhs(ystage, lnew, dlnew, p, ztol, g, mw, K[s])
+            stats[0] += 3
             for j in range(n):
                 dy = ynew[j] - y[j]
                 F[0, j] = dy
@@ -349,66 +599,81 @@ def dop853(y0, l0, f0, p, vr0, t0, t1, h0, rtol, atol, max_step, t_out, i_out, Y
                 F[2, j] = 2.0 * dy - h * (fnew[j] + f[j])
                 for r in range(4):
                     acc = 0.0
-                    for m in range(16):
-                        acc += D[r, m] * K[m, j]
+                    for q in range(16):
+                        acc += D[r, q] * K[q, j]
                     F[3 + r, j] = h * acc
         t_stop = t_new
         stop = False
         if event_mode > 0:
-            # sign changes are looked for at NSUB points per step (dense output), then bisected
+            # event values at NSUB + 1 points of the step (dense output; the end with the saved pad unknowns)
+            for k in range(_NEV):
+                evs[0, k] = ev_old[k]
+            Ls[0, :] = l
+            dLs[0, :] = dl
+            lint[:] = l
+            dlint[:] = dl
+            for sub in range(1, NSUB + 1):
+                if sub == NSUB:
+                    event_values(ynew, lsave, dlsave, p, vr0, cb, ev_new)
+                    Ls[sub, :] = lsave
+                    dLs[sub, :] = dlsave
+                else:
+                    dense_eval(F, y, sub / NSUB, yint)
+                    solve_pads(yint, lint, dlint, p, ztol, g)
+                    event_values(yint, lint, dlint, p, vr0, cb, ev_new)
+                    Ls[sub, :] = lint
+                    dLs[sub, :] = dlint
+                for k in range(_NEV):
+                    evs[sub, k] = ev_new[k]
             first = -1
             tf = t_new
-            yf = ynew.copy()
-            xa = 0.0
-            for k in range(4):
-                ev_a[k] = ev_old[k]
-            lint[:] = l
-            for sub in range(1, NSUB + 1):
-                xb = sub / NSUB
-                if sub == NSUB:
-                    rhs(ynew, lnew, p, fnew)  # refresh l at ynew (cheap warm start)
-                    event_values(ynew, lnew, p, vr0, ev_new)
-                else:
-                    dense_eval(F, y, xb, yint)
-                    solve_l(yint, lint, p)
-                    event_values(yint, lint, p, vr0, ev_new)
-                for k in range(4):
-                    if ev_a[k] > 0.0 and ev_new[k] <= 0.0:
-                        a = xa
-                        b = xb
-                        lb = lint.copy()
-                        for _ in range(60):
-                            c = 0.5 * (a + b)
-                            dense_eval(F, y, c, yint)
-                            solve_l(yint, lb, p)
-                            event_values(yint, lb, p, vr0, ev_mid)
-                            if ev_mid[k] > 0.0:
-                                a = c
-                            else:
-                                b = c
-                        tk = t + b * h
+            for k in range(_NEV):
+                # in time order: a sign change between two points (bisected), or a sampled minimum close to zero
+                # (a grazing dip: the minimum is located by golden-section search, and a crossing before it bisected)
+                i = 0
+                while i <= NSUB:
+                    xc = -1.0
+                    nxt = i + 1
+                    if i >= 1 and evs[i - 1, k] > 0.0 and evs[i, k] <= 0.0:
+                        xc = _bisect(k, (i - 1) / NSUB, i / NSUB, F, y, Ls[i - 1], dLs[i - 1], p, ztol, vr0, g, cb,
+                                     ev_mid, yint, lb, dlb)
+                    elif evs[i, k] > 0.0:
+                        left = evs[i - 1, k] if i >= 1 else ev_prev[k]
+                        right = evs[i + 1, k] if i < NSUB else math.inf
+                        if left > evs[i, k] and right >= evs[i, k]:
+                            c = min(max(i, 1), NSUB - 1)
+                            trig = 2.0 * abs(evs[c - 1, k] - 2.0 * evs[c, k] + evs[c + 1, k])
+                            if evs[i, k] <= trig:
+                                lo = max(i - 1, 0)
+                                hi = min(i + 1, NSUB)
+                                xm, vm = _golden(k, lo / NSUB, hi / NSUB, F, y, Ls[i], dLs[i], p, ztol, vr0, g, cb,
+                                                 ev_mid, yint, lb, dlb)
+                                if vm <= 0.0:
+                                    xc = _bisect(k, lo / NSUB, xm, F, y, Ls[lo], dLs[lo], p, ztol, vr0, g, cb,
+                                                 ev_mid, yint, lb, dlb)
+                                    nxt = hi + 1
+                    if xc >= 0.0:
+                        tk = t + xc * h
                         if event_mode == 2:
                             if n_ev < ev_t.shape[0]:
                                 ev_t[n_ev] = tk
                                 ev_k[n_ev] = k
                             n_ev += 1
-                        elif tk < tf or first < 0:
-                            first = k
-                            tf = tk
-                            dense_eval(F, y, b, yf)
-                if event_mode == 1 and first >= 0:
-                    break
-                for k in range(4):
-                    ev_a[k] = ev_new[k]
-                xa = xb
+                        else:
+                            if first < 0 or tk < tf:
+                                first = k
+                                tf = tk
+                                dense_eval(F, y, xc, y_event)
+                            break
+                    i = nxt
             if event_mode == 1 and first >= 0:
                 stop = True
                 t_stop = tf
                 k_event = first
                 t_event = tf
-                y_event = yf
-            for k in range(4):
-                ev_old[k] = ev_new[k]
+            for k in range(_NEV):
+                ev_prev[k] = evs[NSUB - 1, k]
+                ev_old[k] = evs[NSUB, k]
         while i_out < t_out.shape[0] and t_out[i_out] <= t_stop:
             x = (t_out[i_out] - t) / h
             dense_eval(F, y, x, yint)
@@ -427,28 +692,86 @@ def dop853(y0, l0, f0, p, vr0, t0, t1, h0, rtol, atol, max_step, t_out, i_out, Y
         for j in range(n):
             y[j] = ynew[j]
             f[j] = fnew[j]
-        l[:] = lnew
+        l[:] = lsave
+        dl[:] = dlsave
         if stop:
-            return (1, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event, i_est)
-    return (0, t, y, l, f, h_abs, i_out, n_ev, nfev, nstep, nrej, k_event, t_event, y_event, i_est)
+            return (1, t, h_abs, i_out, i_est, n_ev, k_event, t_event)
+    return (0, t, h_abs, i_out, i_est, n_ev, k_event, t_event)
 '''
 
 
-def _template_hash() -> str:
-    return hashlib.sha256(_TEMPLATE.encode()).hexdigest()[:10]
+def kernel_source(spec: Any) -> str:
+    """Complete source of a model's kernel module (generated functions + template).
 
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
 
-def kernel_source() -> str:
-    """Complete source of the kernel module (generated functions + template)."""
-    return _HEADER.format(params=", ".join(PARAMETER_SYMBOLS)) + generated_source() + _TEMPLATE
+    Returns
+    -------
+    str
+        Python source (numba).
 
-
-@lru_cache(maxsize=2)
-def load_kernels(use_cache: bool = True) -> types.ModuleType:
-    """Import the kernel module, generating and caching it on first use.
-
-    With ``use_cache`` the source lives in the package cache (see
-    :mod:`brakesqueal.numeric.cache`) and numba caches its machine code next
-    to it; otherwise it is generated and compiled in memory (no files).
+    Raises
+    ------
+    ValueError
+        If the equations do not have the structure the integrator relies on
+        (``R`` linear in ``Qddot``, each pad balance depending on its own
+        unknown only).
     """
-    return cache.load_module(KERNEL_KEY, f"kernels_{_template_hash()}.py", kernel_source, use_cache=use_cache)
+    from ..codegen.printer import FunctionSpec, generate_module
+
+    ex = _expressions(spec)
+    eq = ex["eq"]
+    n, m, npad = eq.n, eq.m, len(spec.pads)
+    kinds = ex["kinds"]
+    dyn = [j for j in range(m) if kinds[j] == "dynamic"]
+    meta = {"model": spec.name, "coords": list(eq.coords), "algebraic": list(eq.algebraic), "kinds": list(kinds),
+            "pads": [p.name for p in spec.pads], "params": list(eq.param_names), "tilting": bool(spec.disk.tilting)}
+    preamble = _PREAMBLE.format(n=n, m=m, npad=npad, ndyn=len(dyn), ny=2 * n + len(dyn), nev=2 * npad,
+                                kind=[0 if k == "quasi-static" else 1 for k in kinds], dyn=dyn)
+    y = ("y_", [*eq.Q, *eq.dQ])
+    ll, dl, pp = ("l_", eq.L), ("dl_", eq.dL), ("p_", eq.params)
+    args = (y, ll, dl, pp)
+    specs = [
+        FunctionSpec("pad_balance", args, ex["pad_balance"],
+                     "G_j, then dG_j/dz_j (z_j = l_j quasi-static, ldot_j dynamic), eqs. (33)-(34) generalized."),
+        FunctionSpec("mass_force", args, ex["mass_force"],
+                     "M = dR/dQddot (n x n, row-major), then f = R(Qddot = 0): M Qddot + f = 0 (eq. 44 generalized)."),
+        FunctionSpec("contact", args, ex["contact"],
+                     "Per pad: F_n [N], v_r (3) [m/s], h [m], hdot [m/s], l [m] (eqs. 12-34)."),
+        FunctionSpec("energy", args, ex["energy"], "T2, T1, T0, V_support, V_pads [J]."),
+        FunctionSpec("pad_scale", args, ex["pad_scale"],
+                     "Per pad unknown: |l| + |u_m| + |c f_t| + |c mu* N0|, the size of the terms of G_j [m]."),
+    ]
+    header = (f"Generated by brakesqueal.simulation for the equations of model {spec.name!r}. Do not edit.\n\n"
+              f"y = ({', '.join(str(s) for s in y[1])}, <dynamic pad deformations>)\n"
+              f"l = ({', '.join(map(str, eq.L))}); dl = their rates; pad treatment {list(kinds)}\n"
+              f"p = ({', '.join(eq.param_names)})")
+    src = generate_module(specs, header, decorator=_DECORATOR, unpack="index", out="out_", preamble=preamble)
+    return src + _TEMPLATE + f"\nMETA = {meta!r}\n"
+
+
+def load_kernels(spec: Any, use_cache: bool = True) -> types.ModuleType:
+    """Import a model's kernel module, generating and caching it on first use.
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+    use_cache : bool, optional
+        Keep the source in the package cache (entry ``model-<hash>``, file
+        :data:`KERNEL_NAME`), where numba also caches its machine code
+        (default ``True``); ``False`` generates and compiles in memory and
+        writes no file.
+
+    Returns
+    -------
+    module
+        The numba functions ``rhs``, ``solve_pads``, ``event_values``,
+        ``contact``, ``energy``, ``post_process``, ``dop853`` and ``META``.
+    """
+    from ..codegen.compiled import model_key
+
+    return cache.load_module(model_key(spec), KERNEL_NAME, lambda: kernel_source(spec), use_cache=use_cache)

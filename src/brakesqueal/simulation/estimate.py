@@ -401,15 +401,22 @@ def modal_coordinate(x: np.ndarray, modes: LinearModes, index: int = 0) -> np.nd
     return x @ np.conj(modes.left[:, index])
 
 
-def _share(x: np.ndarray, part: np.ndarray) -> float:
-    """RMS of ``part`` over RMS of ``x`` (coordinates only, last tenth of the samples)."""
-    n = max(x.shape[1] // 2, 1)
+def _share(x: np.ndarray, part: np.ndarray, coordinates: int | None = None) -> float:
+    """RMS of ``part`` over RMS of ``x`` (last tenth of the samples) over the displacement-like components.
+
+    Those are the first ``n`` columns (coordinates; default ``n`` = half of
+    them) and, when ``coordinates`` is given, the columns after ``2n`` (first-order
+    pad states), not the rates.
+    """
+    n = coordinates if coordinates else max(x.shape[1] // 2, 1)
+    cols = np.r_[0:n, 2 * n:x.shape[1]] if coordinates else np.arange(n)
     k = max(x.shape[0] // 10, 1)
-    den = float(np.sqrt((x[-k:, :n] ** 2).sum()))
-    return float(np.sqrt((part[-k:, :n] ** 2).sum())) / den if den > 0 else math.nan
+    den = float(np.sqrt((x[-k:][:, cols] ** 2).sum()))
+    return float(np.sqrt((part[-k:][:, cols] ** 2).sum())) / den if den > 0 else math.nan
 
 
-def modal_projection(t: np.ndarray, x: np.ndarray, modes: LinearModes, index: int = 0) -> ModeEstimate:
+def modal_projection(t: np.ndarray, x: np.ndarray, modes: LinearModes, index: int = 0, *,
+                     coordinates: int | None = None) -> ModeEstimate:
     """Growth rate and frequency of mode ``index`` by projection onto its left eigenvector.
 
     Parameters
@@ -422,6 +429,10 @@ def modal_projection(t: np.ndarray, x: np.ndarray, modes: LinearModes, index: in
         Eigen-decomposition of the linear model's state matrix.
     index : int, optional
         Mode (default 0, the leading mode).
+    coordinates : int, optional
+        Number of coordinates ``n`` among the components of ``x`` (default
+        half of them), for the mode's share of the motion; components after
+        the ``2n`` coordinates and rates (first-order pad states) count too.
 
     Returns
     -------
@@ -454,7 +465,7 @@ def modal_projection(t: np.ndarray, x: np.ndarray, modes: LinearModes, index: in
         warns.append(f"only {ppp:.3g} samples per period of the mode: its frequency may be aliased")
     part = 2 * np.real(np.outer(z, modes.right[:, index])) if lam.imag != 0 else np.real(
         np.outer(z, modes.right[:, index]))  # fmt: skip
-    share = _share(x, part)
+    share = _share(x, part, coordinates)
     if math.isfinite(share) and share < 0.5:
         warns.append(f"the mode carries only {100 * share:.3g} % of the motion at the end of the window")
     if math.isfinite(res) and res > 0.1:
@@ -630,7 +641,8 @@ def _pick(t: np.ndarray, x: np.ndarray, reference: complex | None) -> tuple[Penc
 
 
 def dominant_mode(
-    t: np.ndarray, x: np.ndarray, *, max_samples: int = 1024, reference: complex | None = None
+    t: np.ndarray, x: np.ndarray, *, max_samples: int = 1024, reference: complex | None = None,
+    coordinates: int | None = None,
 ) -> ModeEstimate:
     """Growth rate and frequency of the mode with the largest amplitude at the end of the window (matrix pencil).
 
@@ -653,6 +665,9 @@ def dominant_mode(
     reference : complex, optional
         Report the pole nearest this eigenvalue [1/s] instead of the dominant
         one (e.g. to cross-check a modal projection).
+    coordinates : int, optional
+        Number of coordinates ``n`` among the columns of ``x`` (default half
+        of them), for the mode's share (as in :func:`modal_projection`).
 
     Returns
     -------
@@ -692,7 +707,7 @@ def dominant_mode(
     sel = np.abs(pm.eigenvalues - lam) < 1e-9 * abs(lam) + 1e-12
     sel |= np.abs(pm.eigenvalues - lam.conjugate()) < 1e-9 * abs(lam) + 1e-12
     part = np.real(Z[:, sel] @ pm.amplitudes[sel])
-    share = _share(np.real(xx), part)
+    share = _share(np.real(xx), part, coordinates)
     fit = np.real(Z @ pm.amplitudes)
     res = float(np.linalg.norm(fit - np.real(xx)) / max(np.linalg.norm(np.real(xx)), 1e-300))
     rate = 1.0 / pm.dt

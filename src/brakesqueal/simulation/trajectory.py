@@ -10,7 +10,6 @@ from typing import Any
 
 import numpy as np
 
-from ..parameters import Parameters
 from .estimate import LinearModes, ModeEstimate, dominant_mode, modal_projection
 
 __all__ = ["EstimationRecord", "Trajectory", "Summary", "envelope", "fit_growth_frequency", "integration_error_bound",
@@ -158,8 +157,9 @@ class Summary:
         uncertainty (:class:`~brakesqueal.simulation.estimate.ModeEstimate`);
         ``integration`` [1/s]: a bound on the integrator's error of growth
         rate and angular frequency (per-step relative tolerance of the
-        deviation times accepted steps per second; divided by 2 pi for the
-        frequency).
+        leading modal coordinate, or of the deviation without a linear model,
+        times accepted steps per second; divided by 2 pi for the frequency;
+        :func:`integration_error_bound`).
     regime : str
         ``"linear"`` when growth rate and frequency agree with the linear
         eigenvalue within 3 uncertainties, ``"nonlinear"`` when not (an
@@ -227,18 +227,24 @@ _STAGES = {"DOP853": 12, "RK45": 6, "RK23": 3}
 
 
 def integration_error_bound(
-    x: np.ndarray, y: np.ndarray, rtol: float, atol: np.ndarray | float, steps: float, duration: float
+    x: np.ndarray, y: np.ndarray, rtol: float, atol: np.ndarray | float, steps: float, duration: float,
+    mode: np.ndarray | None = None,
 ) -> float:
     """Bound on an adaptive integrator's error of a growth rate and an angular frequency [1/s].
 
     Every accepted step keeps its local error estimate below
-    ``rtol |y| + atol``.  Relative to the deviation ``x`` that is
-    ``tau = max_j (rtol max|y_j| + atol_j) / RMS(x_j)``.  Errors in amplitude
-    and phase of a (nearly) neutral oscillation add up from step to step, so
-    growth rate and angular frequency can be off by at most about ``tau``
-    times the accepted steps per second.  DOP853's error estimate is that of
-    a lower-order combination, so the true error is usually much smaller
-    (measured at paper-fig2, ``rtol = 1e-9``: under 1 % of this bound).
+    ``s_j = rtol |y_j| + atol_j`` per component.  Relative to the deviation
+    ``x`` that is ``tau = max_j s_j / RMS(x_j)`` (with ``max |y_j|``); with
+    the left eigenvector ``w`` of the estimated mode (``mode``), the relative
+    error of its modal coordinate ``z = w^H x`` instead,
+    ``tau = sum_j |w_j| s_j / RMS(|z|)`` (components that hardly move, such as
+    a caliper's tangential coordinate in a mode of the disk, then do not
+    dominate).  Errors in amplitude and phase of a (nearly) neutral
+    oscillation add up from step to step, so growth rate and angular
+    frequency can be off by at most about ``tau`` times the accepted steps
+    per second.  DOP853's error estimate is that of a lower-order
+    combination, so the true error is usually much smaller (measured at
+    paper-fig2, ``rtol = 1e-9``: under 1 % of this bound).
 
     Parameters
     ----------
@@ -254,6 +260,8 @@ def integration_error_bound(
         Accepted steps over the run.
     duration : float
         Duration of the run [s].
+    mode : ndarray, shape (m,), optional
+        Left eigenvector of the estimated mode (modal projection).
 
     Returns
     -------
@@ -267,6 +275,12 @@ def integration_error_bound(
     ymax = np.nanmax(np.abs(np.asarray(y, dtype=float)), axis=0)
     rms = np.sqrt(np.nanmean(x**2, axis=0))
     at = np.broadcast_to(np.asarray(atol, dtype=float), rms.shape)
+    if mode is not None:
+        w = np.asarray(mode, dtype=complex)
+        z = np.abs(np.where(np.isfinite(x), x, 0.0) @ np.conj(w))
+        zr = math.sqrt(float(np.mean(z**2)))
+        if zr > 0:
+            return float(np.sum(np.abs(w) * (rtol * ymax + at))) / zr * steps / duration
     ok = rms > 0
     if not ok.any():
         return 0.0
@@ -292,6 +306,7 @@ def summarize(
     x_start: np.ndarray | None = None,
     integration_error: float = 0.0,
     cross_check: bool = True,
+    coordinates: int | None = None,
 ) -> Summary:
     """Summary numbers from uniformly sampled state deviations (any number of coordinates).
 
@@ -318,6 +333,10 @@ def summarize(
         [1/s] (default 0), added to the uncertainties.
     cross_check : bool, optional
         Also run the matrix pencil on the same samples (default ``True``).
+    coordinates : int, optional
+        Number of coordinates ``n`` among the state components (default half
+        of them); a state ``(dq, dqdot, extra)`` with ``k`` more first-order
+        components (pads kept as states) has ``2n + k`` columns.
 
     Returns
     -------
@@ -325,7 +344,7 @@ def summarize(
     """
     t = np.asarray(t, dtype=float)
     x = np.asarray(x, dtype=float)
-    n = max(x.shape[1] // 2, 1) if x.ndim == 2 else 1
+    n = coordinates if coordinates else (max(x.shape[1] // 2, 1) if x.ndim == 2 else 1)
     nan = math.nan
     warns: list[str] = []
     lin_g = lin_f = None
@@ -335,7 +354,8 @@ def summarize(
         amp = nan if t.size == 0 else float(np.sqrt((x[:, :n] ** 2).sum(axis=1)).max())
         return Summary(status, nan, nan, amp, None, linear_growth_rate=lin_g, linear_frequency_hz=lin_f,
                        warnings=(f"only {t.size} samples: no growth rate or frequency",))  # fmt: skip
-    est: ModeEstimate = modal_projection(t, x, modes) if modes is not None else dominant_mode(t, x)
+    est: ModeEstimate = (modal_projection(t, x, modes, coordinates=n) if modes is not None
+                         else dominant_mode(t, x, coordinates=n))
     warns.extend(est.warnings)
     ie = float(integration_error)
     terms = {"fit_growth": est.growth_rate_stderr, "fit_frequency": est.frequency_stderr, "integration": ie}
@@ -349,7 +369,7 @@ def summarize(
     cc = None
     if cross_check and modes is not None and math.isfinite(est.growth_rate):
         try:
-            pen = dominant_mode(t, x, reference=est.eigenvalue, max_samples=512)
+            pen = dominant_mode(t, x, reference=est.eigenvalue, max_samples=512, coordinates=n)
         except Exception as exc:  # noqa: BLE001 - a failed cross-check is reported, never fatal
             warns.append(f"matrix-pencil cross-check failed: {exc}")
         else:
@@ -358,7 +378,7 @@ def summarize(
             # compare with the projection over the pencil's (shorter) window: the same samples, so only the
             # fits' own uncertainties count (the growth rate of a nonlinear motion varies between windows)
             inside = (t >= pen.window[0]) & (t <= pen.window[1])
-            ref = modal_projection(t[inside], x[inside], modes) if inside.sum() >= 16 else est
+            ref = modal_projection(t[inside], x[inside], modes, coordinates=n) if inside.sum() >= 16 else est
             scale = 1e-9 * abs(est.eigenvalue)
             if not (_agree(ref.growth_rate, ref.growth_rate_stderr, pen.growth_rate, pen.growth_rate_stderr, scale)
                     and _agree(ref.frequency_hz, ref.frequency_stderr, pen.frequency_hz, pen.frequency_stderr,
@@ -390,7 +410,7 @@ def summarize(
         local = float(np.polyfit(seg_t, np.log(seg), 1)[0])
         if x_start is not None and f_lead > 0:
             xs = np.asarray(x_start, dtype=float)
-            a0 = math.sqrt(float((xs[:n] ** 2).sum()) + float((xs[n:] ** 2).sum()) / (2 * math.pi * f_lead) ** 2)
+            a0 = math.sqrt(float((xs[:n] ** 2).sum()) + float((xs[n:2 * n] ** 2).sum()) / (2 * math.pi * f_lead) ** 2)
         else:
             a0 = float(env[N // 10])
         if abs(local) * (seg_t[-1] - seg_t[0]) < 0.02 and seg.mean() > 1.5 * a0:
@@ -401,25 +421,30 @@ def summarize(
 
 @dataclass(frozen=True, eq=False)
 class Trajectory:
-    """A simulated motion of the wobbling disk.
+    """A simulated motion of any model.
 
     Attributes
     ----------
     status, message : str
         How the run ended (see :class:`Summary`) and a one-line explanation.
-    t : ndarray, shape (n,)
+    t : ndarray, shape (N,)
         Uniform output times [s].
-    y : ndarray, shape (n, 4)
-        ``(q1, q2, dq1, dq2)`` [rad, rad/s].
-    l : ndarray, shape (n, 2)
-        Tangential pad deformations ``l1, l2`` [m] (quasi-static).
-    contact : ndarray, shape (n, 12)
-        Per pad ``F_n`` [N], ``v_r`` (3) [m/s], ``h`` [m], ``hdot`` [m/s].
-    kinetic : ndarray, shape (n, 3)
-        ``T2, T1, T0`` [J]: kinetic energy split by degree in ``q_mdot``.
+    y : ndarray, shape (N, 2n + k)
+        Integrator state ``(Q, Qdot, L_dynamic)``: coordinates (tilts [rad],
+        displacements [m]), their rates, and the deformations of the pads with
+        rate-dependent friction (``k`` of them; none for the paper's model,
+        whose ``y`` is ``(q1, q2, dq1, dq2)``).
+    l : ndarray, shape (N, m)
+        Tangential deformations ``L`` of the massless pads [m] (quasi-static
+        ones solved, dynamic ones from ``y``).
+    contact : ndarray, shape (N, n_pads, 7)
+        Per pad :data:`~brakesqueal.codegen.compiled.CONTACT_FIELDS`:
+        ``F_n`` [N], ``v_r`` (3) [m/s], ``h`` [m], ``hdot`` [m/s], ``l`` [m].
+    energy_terms : ndarray, shape (N, 5)
+        ``T2, T1, T0, V_support, V_pads`` [J] (see :meth:`energy`).
     params : Parameters
-    q_m0 : ndarray, shape (2,)
-        Silent-motion tilt [rad].
+    q0 : ndarray, shape (n,)
+        Coordinates at the silent motion.
     method : str
     rtol : float
     atol : ndarray
@@ -427,21 +452,39 @@ class Trajectory:
     t_event, y_event : float or None, ndarray or None
         Time and state of the terminal event, if the run stopped at one.
     event_times : dict
-        Recorded event times by name (``events="continue"``).
+        Recorded event times by name (``events="continue"``):
+        ``contact-loss-pad-<name>``, ``sliding-reversal-pad-<name>``.
     stats : dict
         ``nfev``, ``wall_s`` and (compiled method) ``steps``, ``rejected``.
     model : str
+        The model's name.
     record : EstimationRecord or None
         Dense output at a rate set by the linear frequencies (the last part
         of a long run), from which :attr:`summary` is computed.
     modes : LinearModes or None
-        Linear modes of the silent motion (state ``(q - q_m0, dq)``).
+        Linear modes of the silent motion for the state ``y - y_silent``.
     sample_rate : float
         Rate of the output grid ``t`` [Hz].
     y_start : ndarray or None
         Initial state.
     start : str
         How the initial state was chosen.
+    coords : tuple of str
+        Names of the coordinates ``Q`` (``q1, q2, w1, u1, wc_caliper, ...``).
+    pads : tuple of str
+        Pad names (the ``pad`` dimension of the arrays).
+    pad_unknowns : tuple of str
+        Names of the columns of ``l`` (``l_<pad>``).
+    dynamic : tuple of str
+        Pad deformations that are states (the last ``k`` columns of ``y``).
+    tilting : bool
+        Whether the disk tilts (``q1, q2`` are the first two coordinates).
+    y_silent : ndarray or None
+        The silent motion as an integrator state ``(Q0, 0, L0_dynamic)``.
+    l_rates : ndarray or None, shape (N, m)
+        ``Ldot`` (zero for quasi-static pads).
+    event_pad : str or None
+        The pad of the terminal event.
     """
 
     status: str
@@ -450,9 +493,9 @@ class Trajectory:
     y: np.ndarray
     l: np.ndarray
     contact: np.ndarray
-    kinetic: np.ndarray
-    params: Parameters
-    q_m0: np.ndarray
+    energy_terms: np.ndarray
+    params: Any
+    q0: np.ndarray
     method: str
     rtol: float
     atol: np.ndarray
@@ -461,72 +504,143 @@ class Trajectory:
     y_event: np.ndarray | None = None
     event_times: dict[str, list[float]] = field(default_factory=dict)
     stats: dict[str, Any] = field(default_factory=dict)
-    model: str = "general-2dof"
+    model: str = "paper"
     record: EstimationRecord | None = None
     modes: LinearModes | None = None
     sample_rate: float = math.nan
     y_start: np.ndarray | None = None
     start: str = ""
+    coords: tuple[str, ...] = ("q1", "q2")
+    pads: tuple[str, ...] = ("1", "2")
+    pad_unknowns: tuple[str, ...] = ()
+    dynamic: tuple[str, ...] = ()
+    tilting: bool = True
+    y_silent: np.ndarray | None = None
+    l_rates: np.ndarray | None = None
+    event_pad: str | None = None
 
+    # ---------------------------------------------------------------- structure
     @property
     def success(self) -> bool:
         """True when the end time was reached."""
         return self.status == "finished"
 
     @property
+    def n(self) -> int:
+        """Number of coordinates."""
+        return len(self.coords)
+
+    @property
+    def silent_state(self) -> np.ndarray:
+        """The silent motion as an integrator state ``(Q0, 0, L0_dynamic)``."""
+        if self.y_silent is not None:
+            return self.y_silent
+        return np.concatenate([self.q0, np.zeros(self.y.shape[1] - self.q0.size)])
+
+    @property
+    def q_m0(self) -> np.ndarray:
+        """Alias of :attr:`q0` (the silent-motion tilt of the paper's model), kept for earlier code."""
+        return self.q0
+
+    @property
+    def Q(self) -> np.ndarray:
+        """Coordinates, shape (N, n)."""
+        return self.y[:, : self.n]
+
+    @property
+    def Qdot(self) -> np.ndarray:
+        """Coordinate rates, shape (N, n)."""
+        return self.y[:, self.n : 2 * self.n]
+
+    @property
     def dq(self) -> np.ndarray:
-        """Tilt deviation from the silent motion ``q_m - q_m0`` [rad], shape (n, 2)."""
-        return self.y[:, :2] - self.q_m0
+        """Deviation of the coordinates from the silent motion ``Q - Q0``, shape (N, n)."""
+        return self.Q - self.q0
 
     @property
     def normal_forces(self) -> np.ndarray:
-        """``F_n1, F_n2`` [N], shape (n, 2)."""
-        return self.contact[:, [0, 6]]
+        """``F_n`` of every pad [N], shape (N, n_pads)."""
+        return self.contact[:, :, 0]
 
     @property
     def sliding_velocities(self) -> np.ndarray:
-        """``v_r`` of both pads [m/s], shape (n, 2, 3)."""
-        return np.stack([self.contact[:, 1:4], self.contact[:, 7:10]], axis=1)
+        """``v_r`` of every pad [m/s], shape (N, n_pads, 3)."""
+        return self.contact[:, :, 1:4]
+
+    @property
+    def kinetic(self) -> np.ndarray:
+        """``T2, T1, T0`` [J], shape (N, 3): kinetic energy by degree in the tilt rates (earlier layout)."""
+        return self.energy_terms[:, :3]
 
     def energy(self) -> dict[str, np.ndarray]:
         """Energy terms [J] at every sample.
 
-        ``T2, T1, T0`` (kinetic energy with the spin constraint, by degree in
-        ``q_mdot``), ``V_support = k_t (q1^2 + q2^2)/2``, ``V_pads = sum_i
-        k_i h_i^2/2 - s_i N0 h_i + l_i^2/(2 c_ip_i)`` (``s = +1, -1``) and the
-        tilt energy ``E = T2 + V_support + V_pads``.  Without friction and
-        damping ``E`` is conserved to leading (quadratic) order in the tilt;
-        the exact energy balance and why no exact integral exists for the
-        modelled supports are derived in ``docs/simulation.md``.
+        ``T2, T1, T0`` (kinetic energy with the spin constraint by degree in
+        the tilt rates; pads and calipers with mass add to ``T2``),
+        ``V_support`` (``k_t (q1^2 + q2^2)/2`` and the calipers' springs),
+        ``V_pads`` (per pad ``k (h - w_m)^2/2 - s N0 h``, or with a normal DOF
+        ``k (w - w_m)^2/2 - s N0 w + N0 delta + k_c delta^2/2``; tangential
+        ``k_ip (l - u_m)^2/2 + mu* N0 l``) and ``E = T2 + V_support + V_pads``.
+        Without friction and damping ``E`` is conserved to leading (quadratic)
+        order in the tilt, exactly for a non-tilting disk; see
+        ``docs/simulation.md``.
         """
-        p = self.params
-        q = self.y[:, :2]
-        h1, h2 = self.contact[:, 4], self.contact[:, 10]
-        c1, c2 = p.compliances()
-        vs = 0.5 * p.k_t * (q[:, 0] ** 2 + q[:, 1] ** 2)
-        vp = 0.5 * p.k1 * h1**2 - p.N0 * h1 + 0.5 * p.k2 * h2**2 + p.N0 * h2
-        if c1 > 0:
-            vp = vp + 0.5 * self.l[:, 0] ** 2 / c1
-        if c2 > 0:
-            vp = vp + 0.5 * self.l[:, 1] ** 2 / c2
-        T2, T1, T0 = self.kinetic.T
+        T2, T1, T0, vs, vp = self.energy_terms.T
         return {"T2": T2, "T1": T1, "T0": T0, "V_support": vs, "V_pads": vp, "E": T2 + vs + vp}
+
+    def _radius(self, radius: float | None) -> float:
+        if radius is not None:
+            return float(radius)
+        if "r" in self.params:
+            return float(self.params["r"])
+        pad = self.params.model.pads[0]
+        return float(self.params[pad.radius]) if isinstance(pad.radius, str) else float(pad.radius)
 
     def rim_velocity(self, radius: float | None = None, azimuth_deg: float = -45.0) -> np.ndarray:
         """Normal (``z0``) velocity [m/s] of the disk's mid-plane under a fixed point of the rim.
 
         The point is at ``(R cos a, R sin a)`` in the fixed frame (``R`` =
-        ``radius``, default the braking radius ``r``; the pads are at
-        ``a = -90 deg``).  The mid-plane height there is
-        ``z = y tan q1 - x tan q2 / cos q1``.
+        ``radius``, default the braking radius ``r``, else the first pad's
+        radius; the paper's pads are at ``a = -90 deg``).  The mid-plane
+        height there is ``z = y tan q1 - x tan q2 / cos q1``.
+
+        Raises
+        ------
+        ParameterError
+            For a model whose disk does not tilt (see :meth:`audio_velocity`).
         """
-        R = self.params.r if radius is None else float(radius)
+        from ..errors import ParameterError
+
+        if not self.tilting:
+            raise ParameterError(f"model '{self.model}' has a non-tilting disk: no rim velocity (see audio_velocity)")
+        R = self._radius(radius)
         a = math.radians(azimuth_deg)
         x, yy = R * math.cos(a), R * math.sin(a)
-        q1, q2, d1, d2 = self.y.T
+        n = self.n
+        q1, q2, d1, d2 = self.y[:, 0], self.y[:, 1], self.y[:, n], self.y[:, n + 1]
         c1 = np.cos(q1)
         return yy * d1 / c1**2 - x * (d2 / (np.cos(q2) ** 2 * c1) + np.tan(q2) * np.sin(q1) * d1 / c1**2)
 
+    def audio_velocity(self, radius: float | None = None) -> tuple[np.ndarray, str]:
+        """The velocity written to audio and what it is.
+
+        A tilting disk: :meth:`rim_velocity` (a microphone or vibrometer at
+        the rim).  A non-tilting disk (a belt): the velocity of the first
+        pad's tangential coordinate ``u_<pad>`` if there is one, else of the
+        first coordinate (a vibrometer on the pad).
+
+        Returns
+        -------
+        velocity : ndarray, shape (N,)
+            [m/s]
+        description : str
+        """
+        if self.tilting:
+            return self.rim_velocity(radius), "normal velocity of the disk's mid-plane under the rim at -45 deg"
+        j = next((i for i, c in enumerate(self.coords) if c.startswith("u")), 0)
+        return self.Qdot[:, j], f"velocity of the coordinate {self.coords[j]} (the disk does not tilt)"
+
+    # ---------------------------------------------------------------- summary
     @cached_property
     def summary(self) -> Summary:
         """Growth rate and frequency of the leading mode with uncertainties, final and limit-cycle amplitude.
@@ -535,7 +649,7 @@ class Trajectory:
         dense output, independent of ``sample_rate``); without a record,
         from the output grid (with a warning).
         """
-        y_s = np.concatenate([self.q_m0, np.zeros(self.q_m0.size)])
+        y_s = self.silent_state
         x_start = None if self.y_start is None else self.y_start - y_s
         if self.record is not None:
             t, y = self.record.t, self.record.y
@@ -545,7 +659,7 @@ class Trajectory:
             extra = ("no estimation record: the summary uses the output samples",)
         fs = self.sample_rate if math.isfinite(self.sample_rate) else None
         s = summarize(self.status, t, y - y_s, self.modes, output_rate=fs, x_start=x_start,
-                      integration_error=self.integration_error_bound(t, y - y_s))  # fmt: skip
+                      integration_error=self.integration_error_bound(t, y - y_s), coordinates=self.n)  # fmt: skip
         if extra:
             s = replace(s, warnings=s.warnings + extra)
         return s
@@ -557,7 +671,7 @@ class Trajectory:
         ----------
         t : ndarray, shape (N,)
             Sample times [s].
-        x : ndarray, shape (N, 4)
+        x : ndarray, shape (N, 2n + k)
             State deviations from the silent motion.
 
         Returns
@@ -569,11 +683,11 @@ class Trajectory:
         if steps is None:  # solve_ivp: estimate the steps from the RHS evaluations
             steps = self.stats.get("nfev", 0) / _STAGES.get(self.method, 1)
         dur = (float(self.t[-1]) if self.t.size else self.t_span[1]) - self.t_span[0]
-        y_s = np.concatenate([self.q_m0, np.zeros(self.q_m0.size)])
-        return integration_error_bound(x, x + y_s, self.rtol, self.atol, float(steps), dur)
+        mode = self.modes.left[:, 0] if self.modes is not None else None
+        return integration_error_bound(x, x + self.silent_state, self.rtol, self.atol, float(steps), dur, mode)
 
     def spectrum(self) -> tuple[np.ndarray, np.ndarray]:
-        """Hann-windowed amplitude spectrum of ``q1 - q10``: ``(frequency [Hz], |X|)``."""
+        """Hann-windowed amplitude spectrum of the first coordinate's deviation: ``(frequency [Hz], |X|)``."""
         x = self.dq[:, 0] - self.dq[:, 0].mean()
         w = np.hanning(x.size)
         X = np.abs(np.fft.rfft(x * w)) * 2 / w.sum()
@@ -583,7 +697,8 @@ class Trajectory:
     def plot(self, fig: Any = None) -> Any:
         """Time history with envelope, phase portrait and spectrum (squeal frequency marked).
 
-        Returns the matplotlib ``Figure`` (never calls ``show``).
+        The time history shows the tilt deviations (a non-tilting disk: every
+        coordinate's).  Returns the matplotlib ``Figure`` (never calls ``show``).
         """
         import matplotlib.pyplot as plt
 
@@ -594,51 +709,66 @@ class Trajectory:
         ax_p = fig.add_subplot(gs[1, 0])
         ax_s = fig.add_subplot(gs[1, 1])
         s = self.summary
-        dq = self.dq
-        ax_t.plot(self.t, dq[:, 0], lw=0.5, label=r"$q_1 - q_{10}$")
-        ax_t.plot(self.t, dq[:, 1], lw=0.5, alpha=0.7, label=r"$q_2 - q_{20}$")
+        cols = [0, 1] if self.tilting else list(range(self.n))
+        dq = self.dq[:, cols]
+        unit = "rad" if self.tilting else "m"
+        for i, j in enumerate(cols):
+            c = self.coords[j]
+            ax_t.plot(self.t, dq[:, i], lw=0.5, alpha=1.0 if i == 0 else 0.7, label=f"{c} - {c}0")
         if self.t.size >= 16:
             env, _ = envelope(dq)
             ax_t.plot(self.t, env, "k", lw=1, label="envelope")
             ax_t.plot(self.t, -env, "k", lw=1)
         ax_t.set_xlabel("t [s]")
-        ax_t.set_ylabel("tilt deviation [rad]")
+        ax_t.set_ylabel(f"{'tilt' if self.tilting else 'coordinate'} deviation [{unit}]")
         ax_t.set_title(
-            f"{self.status}: f = {s.frequency_hz:.2f} Hz, growth = {s.growth_rate:.4g} 1/s, "
-            f"final amplitude = {s.amplitude_final:.3g} rad"
+            f"{self.model}, {self.status}: f = {s.frequency_hz:.2f} Hz, growth = {s.growth_rate:.4g} 1/s, "
+            f"final amplitude = {s.amplitude_final:.3g}"
         )
         if self.t_event is not None:
             ax_t.axvline(self.t_event, color="r", ls="--", lw=1, label=self.status)
         ax_t.legend(loc="upper left", fontsize=8)
-        ax_p.plot(dq[:, 0], self.y[:, 2], lw=0.3)
-        ax_p.set_xlabel(r"$q_1 - q_{10}$ [rad]")
-        ax_p.set_ylabel(r"$\dot q_1$ [rad/s]")
+        c0 = self.coords[0]
+        ax_p.plot(self.dq[:, 0], self.Qdot[:, 0], lw=0.3)
+        ax_p.set_xlabel(f"{c0} - {c0}0")
+        ax_p.set_ylabel(f"d{c0}/dt")
         ax_p.set_title("phase portrait")
         if self.t.size >= 16:
             f, X = self.spectrum()
             ax_s.semilogy(f, X + 1e-300, lw=0.7)
-            if math.isfinite(s.frequency_hz):
+            if math.isfinite(s.frequency_hz) and s.frequency_hz > 0:
                 ax_s.axvline(s.frequency_hz, color="r", ls="--", lw=1, label=f"squeal {s.frequency_hz:.1f} Hz")
                 ax_s.set_xlim(0, min(f[-1], 4 * s.frequency_hz))
                 ax_s.legend(fontsize=8)
         ax_s.set_xlabel("frequency [Hz]")
-        ax_s.set_ylabel(r"$|Q_1|$ [rad]")
+        ax_s.set_ylabel(f"|{c0}|")
         ax_s.set_title("spectrum")
         return fig
 
+    # ---------------------------------------------------------------- export
     def to_xarray(self) -> Any:
-        """``xarray.Dataset`` with dims ``time``, ``dof``, ``pad``, ``component``; summary in ``attrs``."""
+        """``xarray.Dataset`` with dims ``time``, ``coord``, ``pad``, ``component``; summary in ``attrs``.
+
+        Variables: ``Q``, ``Qdot`` (``time``, ``coord``), ``Q0`` (``coord``),
+        per pad ``F_n``, ``v_r``, ``h``, ``hdot``, ``l`` (tangential position),
+        ``energy`` and its terms, ``audio_velocity``; for a tilting disk also
+        the earlier keys ``q``, ``dq`` (``time``, ``dof`` = ``q1, q2``),
+        ``q_m0`` and ``rim_velocity``; the dynamic pads' states ``L_state``.
+        """
         import xarray as xr
 
-        vr = self.sliding_velocities
         e = self.energy()
+        audio, what = self.audio_velocity()
         attrs: dict[str, Any] = {
             "status": self.status, "message": self.message, "model": self.model, "method": self.method,
             "rtol": self.rtol, "atol": self.atol.tolist(), "t_start": self.t_span[0], "t_end": self.t_span[1],
             "parameters": json.dumps(self.params.to_json_dict()),
             "t_event": math.nan if self.t_event is None else self.t_event,
+            "event_pad": "" if self.event_pad is None else self.event_pad,
             "event_times": json.dumps(self.event_times),
-            "pad_treatment": "quasi-static massless pads: ldot = 0, g(q, qdot, l, 0) = 0",
+            "pad_treatment": json.dumps({name: ("dynamic" if name in self.dynamic else "quasi-static")
+                                         for name in self.pad_unknowns}),
+            "audio_velocity": what,
         }  # fmt: skip
         for k, v in self.summary.to_dict().items():
             if k == "status":
@@ -648,25 +778,50 @@ class Trajectory:
             else:
                 attrs[k] = math.nan if v is None else (np.asarray(v, dtype=float) if isinstance(v, list) else v)
         attrs["start"] = self.start
-        ds = xr.Dataset(
-            {
-                "q": (("time", "dof"), self.y[:, :2], {"units": "rad", "long_name": "tilt angles"}),
-                "dq": (("time", "dof"), self.y[:, 2:], {"units": "rad/s", "long_name": "tilt rates"}),
-                "l": (("time", "pad"), self.l, {"units": "m", "long_name": "tangential pad deformation"}),
-                "F_n": (("time", "pad"), self.normal_forces, {"units": "N", "long_name": "normal contact force"}),
-                "v_r": (("time", "pad", "component"), vr, {"units": "m/s", "long_name": "relative sliding velocity"}),
-                "h": (("time", "pad"), self.contact[:, [4, 10]], {"units": "m", "long_name": "pad normal displacement"}),
-                "rim_velocity": (("time",), self.rim_velocity(), {"units": "m/s", "long_name": "rim normal velocity"}),
-                "energy": (("time",), e["E"], {"units": "J", "long_name": "tilt energy T2 + V"}),
-            },
-            coords={"time": ("time", self.t, {"units": "s"}), "dof": ["q1", "q2"], "pad": [1, 2],
-                    "component": ["x0", "y0", "z0"], "q_m0": ("dof", self.q_m0, {"units": "rad"})},  # fmt: skip
-            attrs=attrs,
-        )
-        return ds
+        n = self.n
+        c = self.contact
+        data: dict[str, Any] = {
+            "Q": (("time", "coord"), self.Q, {"long_name": "coordinates (tilts [rad], displacements [m])"}),
+            "Qdot": (("time", "coord"), self.Qdot, {"long_name": "coordinate rates"}),
+            "F_n": (("time", "pad"), c[:, :, 0], {"units": "N", "long_name": "normal contact force"}),
+            "v_r": (("time", "pad", "component"), c[:, :, 1:4],
+                    {"units": "m/s", "long_name": "relative sliding velocity"}),
+            "h": (("time", "pad"), c[:, :, 4], {"units": "m", "long_name": "height of the contact point"}),
+            "hdot": (("time", "pad"), c[:, :, 5], {"units": "m/s", "long_name": "rate of h"}),
+            "l": (("time", "pad"), c[:, :, 6], {"units": "m", "long_name": "tangential position of the pad"}),
+            "energy": (("time",), e["E"], {"units": "J", "long_name": "E = T2 + V_support + V_pads"}),
+            "audio_velocity": (("time",), audio, {"units": "m/s", "long_name": what}),
+        }  # fmt: skip
+        for k in ("T2", "T1", "T0", "V_support", "V_pads"):
+            data[f"energy_{k}"] = (("time",), e[k], {"units": "J"})
+        coords: dict[str, Any] = {"time": ("time", self.t, {"units": "s"}), "coord": list(self.coords),
+                                  "pad": list(self.pads), "component": ["x0", "y0", "z0"],
+                                  "Q0": ("coord", self.q0)}  # fmt: skip
+        if self.dynamic:
+            data["L_state"] = (("time", "pad_state"), self.y[:, 2 * n:], {"units": "m"})
+            coords["pad_state"] = list(self.dynamic)
+        if self.tilting:
+            data["q"] = (("time", "dof"), self.y[:, :2], {"units": "rad", "long_name": "tilt angles"})
+            data["dq"] = (("time", "dof"), self.y[:, n:n + 2], {"units": "rad/s", "long_name": "tilt rates"})
+            data["rim_velocity"] = (("time",), audio, {"units": "m/s", "long_name": "rim normal velocity"})
+            coords["dof"] = ["q1", "q2"]
+            coords["q_m0"] = ("dof", self.q0[:2], {"units": "rad"})
+        return xr.Dataset(data, coords=coords, attrs=attrs)
 
-    def to_netcdf(self, path: str) -> None:
-        """Write :meth:`to_xarray` to a NetCDF file (netCDF4 engine if installed, else SciPy's NetCDF3)."""
+    def to_netcdf(self, path: str, *, what: str = "NetCDF output") -> None:
+        """Write :meth:`to_xarray` to a NetCDF file (netCDF4 engine if installed, else SciPy's NetCDF3).
+
+        The file is written atomically (:func:`brakesqueal.outputs.atomic_write`):
+        an interrupted or failed write leaves no partial file and keeps an
+        existing file of that name.
+
+        Raises
+        ------
+        OutputError
+            One line when the file cannot be written (``what`` names it).
+        """
+        from ..outputs import atomic_write
+
         ds = self.to_xarray()
         ds.attrs["atol"] = json.dumps(ds.attrs["atol"])
         try:
@@ -675,20 +830,24 @@ class Trajectory:
             engine = "netcdf4"
         except ImportError:
             engine = "scipy"
-        ds.to_netcdf(path, engine=engine)
+        with atomic_write(path, what=what) as tmp:
+            ds.to_netcdf(tmp, engine=engine)
 
-    def to_wav(self, path: str, *, rate: int = 44100, radius: float | None = None) -> int:
-        """Write the rim's normal velocity as 16-bit mono PCM audio, normalized to 90 % full scale.
+    def to_wav(self, path: str, *, rate: int = 44100, radius: float | None = None, what: str = "WAV output") -> int:
+        """Write :meth:`audio_velocity` as 16-bit mono PCM audio, normalized to 90 % full scale.
 
-        The signal (:meth:`rim_velocity`, mean removed) is resampled from the
-        output rate to ``rate`` (polyphase filter).  Returns the number of frames.
+        The signal (mean removed) is resampled from the output rate to
+        ``rate`` (polyphase filter) and written atomically (see
+        :meth:`to_netcdf`).  Returns the number of frames.
         """
         import wave
         from fractions import Fraction
 
         from scipy.signal import resample_poly
 
-        v = self.rim_velocity(radius)
+        from ..outputs import atomic_write
+
+        v = self.audio_velocity(radius)[0]
         v = v[np.isfinite(v)]
         v = v - v.mean() if v.size else v
         fs = 1.0 / (self.t[1] - self.t[0]) if self.t.size > 1 else float(rate)
@@ -697,9 +856,10 @@ class Trajectory:
             v = resample_poly(v, fr.numerator, fr.denominator)
         peak = float(np.abs(v).max()) if v.size else 0.0
         pcm = np.zeros(v.size, dtype="<i2") if peak == 0 else np.round(v / peak * 0.9 * 32767).astype("<i2")
-        with wave.open(str(path), "wb") as w:
-            w.setnchannels(1)
-            w.setsampwidth(2)
-            w.setframerate(int(rate))
-            w.writeframes(pcm.tobytes())
+        with atomic_write(path, what=what) as tmp:
+            with wave.open(str(tmp), "wb") as w:
+                w.setnchannels(1)
+                w.setsampwidth(2)
+                w.setframerate(int(rate))
+                w.writeframes(pcm.tobytes())
         return int(pcm.size)

@@ -244,9 +244,14 @@ def build_equations(spec: Any, backend: Backend = "symengine", *, kronecker: boo
             l = L[_name("l", pad.name)]
         normal = "normal" in pad.dofs
         quasi = "tangential" not in pad.dofs and not _rigid(pad)
+        law = pad.friction
+
+        def mu_of(v: Any, law: Any = law) -> Any:
+            return friction_coefficient(sm, law, v, val)
+
         c = pad_contact(
             sm, side=s, h0=val(disk.h_upper if s == 1 else disk.h_lower), base=base, e_t=e_t, l=l, z3=z3,
-            omega0=omega0, rate=rate, friction=lambda v, law=pad.friction: friction_coefficient(sm, law, v, val),
+            omega0=omega0, rate=rate, friction=mu_of,
             N0=N0, nominal_speed=Omega * r, k=val(pad.k), d=val(pad.d), w_m=w_m,
             normal_dof=Q[_name("w", pad.name)] if normal else None, k_c=val(pad.k_c) if normal else None,
             d_c=val(pad.d_c) if normal else None, u_m=u_m, compliance=val.compliance(pad.k_ip) if quasi else None,
@@ -279,6 +284,7 @@ def build_equations(spec: Any, backend: Backend = "symengine", *, kronecker: boo
     if disk.tilting:
         I3 = sm.diag(val(disk.Theta), val(disk.Theta), val(disk.Phi))
         q_m, dq_m, ddq_m = (Q["q1"], Q["q2"]), (dQ["q1"], dQ["q2"]), (ddQ["q1"], ddQ["q2"])
+        assert kin is not None and con is not None
         if kronecker:
             M0, Cstar0 = euler_matrices(sm, kin, I3)
             red = reduce_equations(sm, M0, Cstar0, con, q_m, dq_m, ddq_m, val(disk.k_t), val(disk.d_t), moment)

@@ -70,7 +70,7 @@ class SymbolicEquations:
     state: dict[str, Any]
     params: dict[str, Any]
     backend: str
-    kinematics: CardanKinematics = field(repr=False)
+    kinematics: CardanKinematics | None = field(repr=False)
     equations: Equations = field(repr=False)
 
     @property
