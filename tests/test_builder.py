@@ -1,4 +1,7 @@
-"""The model builder: equivalence with the engine, limits, symmetry, classic criteria, bad input."""
+"""Built-in and custom models through the one engine: limits, symmetry, classic criteria, bad input.
+
+(The former builder-versus-engine comparisons are gone: there is one engine.)
+"""
 
 from __future__ import annotations
 
@@ -7,45 +10,15 @@ import tomllib
 
 import numpy as np
 import pytest
-import symengine as se
 
 from brakesqueal.analysis.linear import linearize
-from brakesqueal.builder import (
-    MODELS, Caliper, Disk, FrictionLaw, ModelSpec, Pad, build_equations, get_model, linearize_model,
-    model_to_toml, spec_from_dict,
-)  # fmt: skip
 from brakesqueal.errors import ParameterError
-from brakesqueal.parameters import Parameters
-from brakesqueal.symbolic.model import derive_equations
+from brakesqueal.model import MODELS, Caliper, Disk, FrictionLaw, ModelSpec, Pad, get_model, model_to_toml, spec_from_dict
 
 
-def test_two_pad_coulomb_model_reproduces_the_engine_symbolically():
-    built = build_equations(get_model("paper-2dof"))
-    eng = derive_equations("symengine")
-    ren = {se.Symbol("l1"): se.Symbol("l_1"), se.Symbol("l2"): se.Symbol("l_2"),
-           se.Symbol("c_ip1"): se.Symbol("c__k_ip1"), se.Symbol("c_ip2"): se.Symbol("c__k_ip2"),
-           se.Symbol("dl1"): 0, se.Symbol("dl2"): 0}  # fmt: skip
-    for i in range(2):
-        assert se.expand(built.R[i] - eng.psi[i].xreplace(ren)) == 0
-        assert se.expand(built.G[i] - eng.g[i].xreplace(ren)) == 0
-    assert built.coords == ("q1", "q2") and built.algebraic == ("l_1", "l_2")
-
-
-@pytest.mark.parametrize("asym", [False, True])
-def test_builder_linearization_equals_engine_numerically(asym):
-    over = {"mu1": 0.6, "mu2": 0.35, "k_ip1": 3e8, "k_ip2": 7e7, "k2": 4e6, "d2": 8.0}
-    if asym:
-        over["h10"] = 0.013  # non-trivial silent motion
-    lm_b = linearize_model(get_model("paper-2dof"), over)
-    base = {**get_model("paper-2dof").parameters, **over}
-    p = Parameters(**{k: base[k] for k in ("Theta", "Phi", "k_t", "d_t", "k1", "k2", "d1", "d2", "k_ip1", "k_ip2",
-                                          "mu1", "mu2", "h10", "h20", "r", "N0", "Omega")})  # fmt: skip
-    lm_e = linearize(p, pad_rates="quasi-static")  # the builder keeps the quasi-static pads
-    # vector norm: q1 is ~1e-13 rad here, at rounding level next to q2 ~ 1e-7 rad
-    assert np.linalg.norm(lm_b.Q0 - lm_e.q_m0) <= 1e-9 * max(np.linalg.norm(lm_e.q_m0), 1e-300)
-    for name in "MDK":
-        a, b = getattr(lm_b, name), getattr(lm_e, name)
-        assert np.allclose(a, b, rtol=1e-10, atol=1e-12 * np.abs(b).max()), name
+def linearize_model(spec, overrides=None):
+    """The linear model of ``spec`` at its default values with ``overrides`` (the unified engine)."""
+    return linearize(spec.get_preset().resolve(dict(overrides or {})))
 
 
 def _slow_eigs(lm, k=4):
@@ -147,13 +120,14 @@ def test_bad_parameter_values_are_named():
         linearize_model(get_model("six-dof"), {"m_p": 0.0})
     with pytest.raises(ParameterError, match="'mu1'.*\\[0, inf\\)"):
         linearize_model(get_model("paper-2dof"), {"mu1": -0.1})
-    with pytest.raises(ParameterError, match="not a parameter of model"):
+    with pytest.raises(ParameterError, match="'zzz'"):
         linearize_model(get_model("paper-2dof"), {"zzz": 1.0})
 
 
 def test_silent_motion_converges_when_residual_reaches_rounding_level():
     """Regression: a three-pad Stribeck model whose Newton step stalled just above an absolute tolerance."""
-    from brakesqueal.builder.library import paper_parameters
+    from brakesqueal.codegen import compile_model
+    from brakesqueal.model.library import paper_parameters
 
     pads = (
         Pad("1", "upper", k="k1", d="d1", preload="N0", k_ip="k_ip1",
@@ -165,10 +139,9 @@ def test_silent_motion_converges_when_residual_reaches_rounding_level():
     par = {**paper_parameters(), "r": 0.13, "k1": 6e6, "k2": 6e6, "d1": 5.0, "d2": 5.0, "N0": 3600.0, "mu1": 0.5,
            "mu2": 0.5, "k_ip1": 1e8, "k_ip2": 1e8, "mu_s": 0.6, "v_s": 1.0, "k3": 3e6, "N3": 1000.0, "mu3": 0.4}
     spec = ModelSpec("three-pad-stribeck", Disk(), pads, parameters=par)
-    lm = linearize_model(spec, {"Omega": 1.19377, "mu_s": 0.55833})
-    from brakesqueal.builder.numeric import _pvec, compile_model
-
+    params = spec.get_preset().resolve({"Omega": 1.19377, "mu_s": 0.55833})
+    lm = linearize(params)
     cm = compile_model(spec)
-    x = list(lm.Q0) + [0.0] * (2 * cm.n) + list(lm.L0)
-    res = np.array(cm.residuals(x, _pvec(cm, lm.values)))
-    assert np.abs(lm.Q0).max() > 1e-7 and np.abs(res[:2]).max() < 1e-9 * par["k_t"] * np.abs(lm.Q0).max()
+    res = np.array(cm.residuals(lm.silent.state(), list(params.vector())))
+    Q0 = lm.silent.q0
+    assert np.abs(Q0).max() > 1e-7 and np.abs(res[:2]).max() < 1e-9 * par["k_t"] * np.abs(Q0).max()

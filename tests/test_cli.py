@@ -14,7 +14,7 @@ import pytest
 import sympy as sp
 
 from brakesqueal.analysis.linear import linearize
-from brakesqueal.parameters import get_preset
+from brakesqueal.model import get_preset
 
 
 def run(*args: str, cache: Path, extra_env: dict | None = None) -> subprocess.CompletedProcess:
@@ -126,7 +126,7 @@ def test_invalid_toml_names_file_and_position(tmp_path, cache):
 
 
 def test_negative_thickness_sum_is_rejected(tmp_path, cache):
-    from brakesqueal.parameters import parameters_to_toml
+    from brakesqueal.model.io import parameters_to_toml
 
     text = parameters_to_toml(get_preset("paper-fig2").resolve())
     assert "h10 = 0.01" in text

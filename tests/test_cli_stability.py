@@ -9,7 +9,7 @@ import pytest
 
 from brakesqueal.cli import main
 from brakesqueal.analysis.linear import linearize
-from brakesqueal.parameters import get_preset
+from brakesqueal.model import get_preset
 from brakesqueal.results import open_map
 
 

@@ -17,7 +17,7 @@ import pytest
 from brakesqueal.analysis.equilibrium import parameter_vector, silent_motion
 from brakesqueal.analysis.linear import linearize
 from brakesqueal.numeric.compiled import compiled_model
-from brakesqueal.parameters import Parameters
+from brakesqueal.model import Parameters, get_model
 from brakesqueal.symbolic.model import PARAMETER_SYMBOLS, STATE_SYMBOLS
 
 ref = pytest.importorskip("tests.reference.newton_euler")
@@ -28,12 +28,12 @@ def _random_params(rng: np.random.Generator, *, trivial: bool, finite_kip: bool 
     h20 = rng.uniform(0.005, 0.015)
     h10 = mu2 * h20 / mu1 if trivial else rng.uniform(0.005, 0.015)
     kip = rng.uniform(2e7, 5e8, 2) if finite_kip else (math.inf, math.inf)
-    return Parameters(
+    return Parameters(get_model("paper"), dict(
         Theta=rng.uniform(0.1, 0.3), Phi=rng.uniform(0.2, 0.5), k_t=rng.uniform(5e6, 3e7), d_t=rng.uniform(0, 1),
         k1=rng.uniform(2e6, 9e6), k2=rng.uniform(2e6, 9e6), d1=rng.uniform(1, 10), d2=rng.uniform(1, 10),
         k_ip1=kip[0], k_ip2=kip[1], mu1=mu1, mu2=mu2, h10=h10, h20=h20, r=rng.uniform(0.08, 0.16),
         N0=rng.uniform(1000, 5000), Omega=rng.uniform(5, 300),
-    )  # fmt: skip
+    ))  # fmt: skip
 
 
 def _ref_params(p: Parameters) -> dict[str, float]:

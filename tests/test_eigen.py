@@ -7,7 +7,7 @@ import pytest
 
 from brakesqueal.analysis.eigen import eigen_analysis
 from brakesqueal.analysis.linear import LinearModel, linearize, state_matrix
-from brakesqueal.parameters import get_preset
+from brakesqueal.model import get_preset
 
 
 @pytest.fixture(scope="module")

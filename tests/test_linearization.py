@@ -13,7 +13,7 @@ from brakesqueal.errors import ContactLossError, NoSilentMotionError
 from brakesqueal.analysis.linear import linearize, pad_rate_eigenvalues, state_matrix
 from brakesqueal.errors import SilentMotionError
 from brakesqueal.numeric.compiled import compiled_model
-from brakesqueal.parameters import get_preset
+from brakesqueal.model import get_preset
 
 
 def _reduced_psi(model, p, q, dq, ddq, l_guess):

@@ -43,7 +43,7 @@ def test_tracks_are_continuous_through_a_crossing_of_frequencies():
 def test_paper_crossings_agree_with_the_exact_route():
     from brakesqueal.analysis.crossings import crossings
     from brakesqueal.analysis.maps import Axis
-    from brakesqueal.analysis.space import ParameterSpace
+    from brakesqueal.model import ParameterSpace
 
     tr = modes_along(resolve_space(preset="paper-fig2", sets=["mu=0.5"]), "k_ip", 1e5, 1e10, num=120, log=True)
     exact = crossings(ParameterSpace.from_preset("paper-fig2", {"mu": 0.5}), Axis("k_ip", 1e5, 1e10, 2, True))

@@ -11,7 +11,7 @@ import pytest
 
 from brakesqueal.analysis.linear import linearize
 from brakesqueal.errors import ParameterError
-from brakesqueal.parameters import get_preset
+from brakesqueal.model import get_preset
 from brakesqueal.simulation import simulate
 
 # least-stable mode: Re(lambda) = +3.37 1/s (unstable) and -1.01 1/s (stable), both at ~1739 Hz

@@ -272,7 +272,7 @@ def test_first_contact_loss_is_not_missed(seed):
     Reference: an event-free run of the same equations sampled at 2 MHz: no pad's F_n is <= 0 before the event
     (to the grid's resolution), the event pad's F_n is 0 at the located state and goes below zero right after.
     """
-    from brakesqueal.parameters import get_preset
+    from brakesqueal.model import get_preset
 
     rng = np.random.default_rng(1000 + seed)
     params = get_preset("paper-fig2").resolve({"mu": 1.0, "h": 0.05})

@@ -20,7 +20,7 @@ import scipy.linalg as sla
 from brakesqueal import linearize
 from brakesqueal.cli import main
 from brakesqueal.errors import ParameterError
-from brakesqueal.parameters import get_preset
+from brakesqueal.model import get_preset
 from brakesqueal.simulation import (
     dominant_mode,
     fit_growth_frequency,

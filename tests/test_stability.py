@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from brakesqueal.analysis.crossings import critical_speeds, crossings
-from brakesqueal.analysis.kernels import critical_speeds_batch, map_kernel, real_roots
+from brakesqueal.analysis.crossings import critical_speeds, critical_speeds_batch, crossings
+from brakesqueal.analysis.kernels import map_kernel, real_roots
 from brakesqueal.analysis.linear import linearize
 from brakesqueal.analysis.maps import Axis, stability_map
 from brakesqueal.analysis.equilibrium import parameter_vector

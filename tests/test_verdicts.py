@@ -26,9 +26,9 @@ import mpmath
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.crossings import critical_speeds, crossings, exact_omega_crossings
+from brakesqueal.analysis.crossings import critical_speeds, critical_speeds_batch, crossings, exact_omega_crossings
 from brakesqueal.analysis.equilibrium import parameter_vector
-from brakesqueal.analysis.kernels import critical_speeds_batch, map_kernel
+from brakesqueal.analysis.kernels import map_kernel
 from brakesqueal.analysis.maps import STATUS, Axis, stability_map
 from brakesqueal.analysis.robust import (
     STABLE, UNDECIDED, UNSTABLE, eigen_verdicts, isolate_real_roots, isolate_real_roots_float, routh_exact,

@@ -38,12 +38,12 @@ import numpy as np
 from ..errors import ParameterError
 from ..model.expressions import names_in
 from ..status import PointStatus
-from .kernels import QuarticNumerators, critical_speeds_batch, omega_kernel_available, quartic_numerators
+from .kernels import QuarticNumerators, omega_entries, omega_kernel_available, omega_subranges, quartic_numerators
 from .maps import Axis
 from .robust import isolate_real_roots
 
-__all__ = ["crossings", "critical_speeds", "critical_speeds_many", "exact_crossings", "exact_omega_crossings",
-           "omega_name", "PROFILE_POINTS", "NUMERIC_GRID"]
+__all__ = ["crossings", "critical_speeds", "critical_speeds_many", "critical_speeds_batch", "exact_crossings",
+           "exact_omega_crossings", "omega_name", "PROFILE_POINTS", "NUMERIC_GRID"]
 
 #: Points of the stored ``max_real`` profile of a path (for plots).
 PROFILE_POINTS = 200
@@ -584,6 +584,74 @@ def critical_speeds_many(space: Any, changes: dict[str, np.ndarray], lo: float =
         counts[i] = len(found)
         start[i] = bool(res.stable_at_start)  # type: ignore[attr-defined]
         status[i] = int(PointStatus.OK) if res.complete else int(PointStatus.UNDECIDED)  # type: ignore[attr-defined]
+    if return_status:
+        return roots, dirs, counts, start, status
+    return roots, dirs, counts, start
+
+
+def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossings: int = 8, *,
+                          return_status: bool = False, spec: Any = None) -> tuple[np.ndarray, ...]:
+    """All stability changes along Ω in ``(lo, hi)`` for many parameter vectors (trivial silent motion).
+
+    Each set is first handled by the certified compiled kernel
+    (:func:`~._compiled.critical_batch`); sets it cannot certify (roots
+    closer than 2^-40 relative, a root at ``lo``/``hi``, overflow) are
+    recomputed by exact rational root isolation
+    (:func:`exact_omega_crossings`).  The result is complete: every
+    stability change in ``(lo, hi)`` is reported (up to ``max_crossings``
+    columns; ``counts`` holds the true number).
+
+    Parameters
+    ----------
+    params : ndarray, shape (n, n_parameters)
+        Parameter vectors in the model's packing order (Ω ignored); the
+        silent motion of every row must be trivial (for the paper's model
+        ``mu1 h10 = mu2 h20``, eq. 49).
+    lo, hi : float
+        The Ω range [rad/s], ``0 < lo < hi``; any width (split internally).
+    max_crossings : int
+        Columns of the outputs.
+    return_status : bool
+        Also return the per-set status (0 complete, 5 undecided somewhere in the range).
+    spec : ModelSpec, optional
+        The model (default: the paper's); it needs :func:`~.kernels.omega_kernel_available`.
+
+    Returns
+    -------
+    crossings : ndarray (n, max_crossings)
+        Ω values [rad/s] where stability changes, ascending, NaN-padded.
+    directions : ndarray (n, max_crossings) int8
+        ``-1`` destabilizing (stable below, unstable above), ``+1`` stabilizing.
+    counts : ndarray (n,)
+        Number of crossings found (may exceed ``max_crossings``).
+    stable_at_start : ndarray (n,) bool
+        Verdict just above ``lo``.
+    status : ndarray (n,) int8, only with ``return_status``
+        0 if the result is complete, 5 if a part of the range stayed undecided.
+    """
+    from ._compiled import critical_batch
+
+    P = np.ascontiguousarray(np.atleast_2d(params), dtype=float)
+    n = P.shape[0]
+    bounds = omega_subranges(float(lo), float(hi))
+    roots = np.full((n, max_crossings), np.nan)
+    dirs = np.zeros((n, max_crossings), dtype=np.int8)
+    counts = np.zeros(n, dtype=np.int64)
+    start = np.zeros(n, dtype=np.bool_)
+    flags = np.zeros(n, dtype=np.uint8)
+    status = np.zeros(n, dtype=np.int8)
+    E, R = omega_entries(P, spec)
+    critical_batch(E, R, bounds, roots, dirs, counts, start, flags)
+    for i in np.flatnonzero(flags):
+        st, found, undecided = exact_omega_crossings(P[i], float(lo), float(hi), spec)
+        roots[i] = np.nan
+        dirs[i] = 0
+        for k, (v, d) in enumerate(found[:max_crossings]):
+            roots[i, k] = v
+            dirs[i, k] = 1 if d == "stabilizing" else -1
+        counts[i] = len(found)
+        start[i] = bool(st)
+        status[i] = 5 if undecided else 0
     if return_status:
         return roots, dirs, counts, start, status
     return roots, dirs, counts, start

@@ -42,11 +42,11 @@ Generated / compiled pieces:
   1 (stable) or 2 (uncertain).
 * :func:`trivial_entries` — ``Mbar, Dbar, Kbar`` from a parameter vector with
   a rigorous rounding bound per entry (generated, compiled).
-* :func:`omega_entries` / :func:`critical_speeds_batch` — ``Mbar, Dbar, Kbar``
-  are Laurent polynomials in Ω, so ``Ω^6 H3`` is a polynomial in Ω; its real
-  roots are isolated with certified Descartes bisection in compiled code
-  (:func:`~._compiled.critical_batch`), sets that cannot be certified are
-  recomputed exactly (:mod:`.crossings`).
+* :func:`omega_entries` — ``Mbar, Dbar, Kbar`` are Laurent polynomials in Ω,
+  so ``Ω^6 H3`` is a polynomial in Ω; :func:`~.crossings.critical_speeds_batch`
+  isolates its real roots with certified Descartes bisection in compiled code
+  (:func:`~._compiled.critical_batch`) and recomputes exactly the sets that
+  cannot be certified.
 """
 
 from __future__ import annotations
@@ -64,8 +64,7 @@ if TYPE_CHECKING:
 __all__ = [
     "quartic_coefficients", "hurwitz_h3", "hurwitz_stable", "ModelForm", "model_form", "QuarticNumerators",
     "quartic_numerators", "GridKernel", "grid_kernel", "MapKernel", "map_kernel", "classify_numpy", "real_roots",
-    "trivial_entries", "omega_entries", "omega_coefficients", "omega_kernel_available", "critical_speeds_batch",
-    "omega_subranges", "inner_exponent", "kernel_segments", "run_classify", "kernel_scaling",
+    "trivial_entries", "RateBlocks", "zero_rate_blocks", "omega_entries", "omega_coefficients", "omega_kernel_available", "omega_subranges", "inner_exponent", "kernel_segments", "run_classify", "kernel_scaling",
 ]
 
 _U = 2.0 ** -53
@@ -255,6 +254,89 @@ def _build_form(spec: Any) -> ModelForm | None:
     omega_free = omega is None or all(S[omega] not in r.free_symbols for r in residuals)
     return ModelForm(key=_key(spec), names=names, symbols=syms, compliance=comp, M=M, D=D,
                      K=K, model_symbols=dict(S), residuals=residuals, omega=omega, omega_free=omega_free)
+
+
+@dataclass(frozen=True, eq=False)
+class RateBlocks:
+    """The pads' rate blocks of a model at the zero state, simplified symbolically (no cancellation noise).
+
+    At the zero state a massless pad's rate terms are differences of terms
+    that cancel exactly for a constant friction coefficient (the derivative of
+    the sliding direction along the sliding velocity vanishes); generated
+    code evaluates such differences to rounding noise, which would give a
+    spurious pad mode ``-G_L / G_dL`` of any sign.  Here they are simplified
+    with the parameters' signs from their roles (``sqrt(Omega^2 r^2) = Omega
+    r``), so only the genuine part remains (e.g. ``c_ip N0 mu'(v*)`` of a
+    falling friction law) and an exact zero stays zero.
+
+    Attributes
+    ----------
+    evaluate : callable
+        ``evaluate(cols) -> (R_dL, G_dL, G_ddQ)`` for packing-order parameter
+        arrays of length ``N``: arrays of shapes ``(N, n, m)``, ``(N, m, m)``,
+        ``(N, m, n)``.
+    """
+
+    n: int
+    m: int
+    evaluate: Callable[[list[np.ndarray]], tuple[np.ndarray, np.ndarray, np.ndarray]]
+
+
+def zero_rate_blocks(spec: Any) -> RateBlocks:
+    """The zero-state rate blocks ``R_dL``, ``G_dL``, ``G_ddQ`` of a model, simplified (see :class:`RateBlocks`).
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+
+    Returns
+    -------
+    RateBlocks
+        Memoized by :func:`~brakesqueal.codegen.model_key`.
+    """
+    return _memo(("rates", _key(spec)), lambda: _build_rates(spec))
+
+
+def _build_rates(spec: Any) -> RateBlocks:
+    import sympy as sp
+    import symengine as se
+
+    from ..symbolic.assemble import build_equations
+    from ..symbolic.linearize import model_closed_form
+
+    eq = build_equations(spec, "symengine")
+    n, m = len(eq.coords), len(eq.algebraic)
+    S = model_closed_form(spec).symbols
+    names = tuple(spec.parameters)
+    kip = set(spec.stiffness_names())
+    csyms = {pn: sp.Symbol(pn, nonnegative=True) for n_, pn in zip(names, eq.param_names) if n_ in kip}
+    back = {sp.Symbol(pn): (1 / S[n_] if n_ in kip else S[n_]) for n_, pn in zip(names, eq.param_names)}
+    fwd = {S[n_]: 1 / csyms[pn] for n_, pn in zip(names, eq.param_names) if n_ in kip}
+    zero = {s: 0 for s in eq.x}
+    G = eq.G if eq.G is not None else se.zeros(0, 1)
+
+    def clean(e: Any) -> Any:
+        v = sp.factor_terms(sp.cancel(sp.sympify(e.subs(zero)).xreplace(back)))
+        return sp.cancel(v.xreplace(fwd)) if fwd else v
+
+    exprs = []
+    for res, var, rows, cols in ((eq.R, eq.dL, n, m), (G, eq.dL, m, m), (G, eq.ddQ, m, n)):
+        for i in range(rows):
+            for j in range(cols):
+                exprs.append(clean(se.diff(res[i], var[j])) if m else sp.Integer(0))
+    args = [csyms[pn] if pn in csyms else S[n_] for n_, pn in zip(names, eq.param_names)]
+    fn = sp.lambdify(args, exprs, modules="numpy")
+
+    def evaluate(cols: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        N = int(np.size(cols[0])) if cols else 1
+        with np.errstate(all="ignore"):
+            vals = [np.broadcast_to(np.asarray(v, dtype=float), (N,)) for v in fn(*cols)] if exprs else []
+        a = np.stack(vals, axis=-1) if vals else np.zeros((N, 0))
+        k1, k2 = n * m, n * m + m * m
+        return a[:, :k1].reshape(N, n, m), a[:, k1:k2].reshape(N, m, m), a[:, k2:].reshape(N, m, n)
+
+    return RateBlocks(n=n, m=m, evaluate=evaluate)
 
 
 def _specialise(space: ParameterSpace, axes: dict[str, Any]) -> tuple[Any, Any, Any, list[Any]] | None:
@@ -1189,73 +1271,3 @@ def omega_subranges(lo: float, hi: float, decades: float = 6.0) -> np.ndarray:
     inner = [2.0 ** e for e in range(e0 + step // 2, e1, step)] if e1 - e0 > step else []
     pts = [lo] + [b for b in inner if lo < b < hi] + [hi]
     return np.array(pts, dtype=float)
-
-
-def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossings: int = 8, *,
-                          return_status: bool = False, spec: Any = None) -> tuple[np.ndarray, ...]:
-    """All stability changes along Ω in ``(lo, hi)`` for many parameter vectors (trivial silent motion).
-
-    Each set is first handled by the certified compiled kernel
-    (:func:`~._compiled.critical_batch`); sets it cannot certify (roots
-    closer than 2^-40 relative, a root at ``lo``/``hi``, overflow) are
-    recomputed by exact rational root isolation
-    (:func:`~.crossings.exact_omega_crossings`).  The result is complete: every
-    stability change in ``(lo, hi)`` is reported (up to ``max_crossings``
-    columns; ``counts`` holds the true number).
-
-    Parameters
-    ----------
-    params : ndarray, shape (n, n_parameters)
-        Parameter vectors in the model's packing order (Ω ignored); the
-        silent motion of every row must be trivial (for the paper's model
-        ``mu1 h10 = mu2 h20``, eq. 49).
-    lo, hi : float
-        The Ω range [rad/s], ``0 < lo < hi``; any width (split internally).
-    max_crossings : int
-        Columns of the outputs.
-    return_status : bool
-        Also return the per-set status (0 complete, 5 undecided somewhere in the range).
-    spec : ModelSpec, optional
-        The model (default: the paper's); it needs :func:`omega_kernel_available`.
-
-    Returns
-    -------
-    crossings : ndarray (n, max_crossings)
-        Ω values [rad/s] where stability changes, ascending, NaN-padded.
-    directions : ndarray (n, max_crossings) int8
-        ``-1`` destabilizing (stable below, unstable above), ``+1`` stabilizing.
-    counts : ndarray (n,)
-        Number of crossings found (may exceed ``max_crossings``).
-    stable_at_start : ndarray (n,) bool
-        Verdict just above ``lo``.
-    status : ndarray (n,) int8, only with ``return_status``
-        0 if the result is complete, 5 if a part of the range stayed undecided.
-    """
-    from ._compiled import critical_batch
-
-    P = np.ascontiguousarray(np.atleast_2d(params), dtype=float)
-    n = P.shape[0]
-    bounds = omega_subranges(float(lo), float(hi))
-    roots = np.full((n, max_crossings), np.nan)
-    dirs = np.zeros((n, max_crossings), dtype=np.int8)
-    counts = np.zeros(n, dtype=np.int64)
-    start = np.zeros(n, dtype=np.bool_)
-    flags = np.zeros(n, dtype=np.uint8)
-    status = np.zeros(n, dtype=np.int8)
-    E, R = omega_entries(P, spec)
-    critical_batch(E, R, bounds, roots, dirs, counts, start, flags)
-    for i in np.flatnonzero(flags):
-        from .crossings import exact_omega_crossings
-
-        st, found, undecided = exact_omega_crossings(P[i], float(lo), float(hi), spec)
-        roots[i] = np.nan
-        dirs[i] = 0
-        for k, (v, d) in enumerate(found[:max_crossings]):
-            roots[i, k] = v
-            dirs[i, k] = 1 if d == "stabilizing" else -1
-        counts[i] = len(found)
-        start[i] = bool(st)
-        status[i] = 5 if undecided else 0
-    if return_status:
-        return roots, dirs, counts, start, status
-    return roots, dirs, counts, start

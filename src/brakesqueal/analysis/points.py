@@ -308,15 +308,24 @@ def _zero_descriptor(cm: Any, cols: list[np.ndarray]) -> tuple[np.ndarray, np.nd
     """Batched descriptor ``(E, A)`` at the zero state with the rate-free pads eliminated.
 
     Mirrors :func:`~.linear.linearize` (quasi-static pads: ``L`` eliminated
-    through ``G = 0``; the others kept as states).  Returns ``(E, A, usable)``
-    where ``usable`` is false for points at which a kept pad's rate blocks
-    vanish (:func:`~.linear.linearize` would eliminate it there; such points
-    go through the per-point route).
+    through ``G = 0``; the others kept as states), with the rate blocks from
+    their simplified symbolic form (:func:`~.kernels.zero_rate_blocks`).
+    Returns ``(E, A, kind)``: ``kind`` 0 where every kept pad has rate terms
+    (the descriptor applies), 1 where all of them vanish (every pad is
+    quasi-static: the second-order ``M, D, K`` of the zero state are exact),
+    2 where only some vanish (the per-point route decides).
     """
+    from .kernels import zero_rate_blocks
+
     n, m, nx = cm.n, cm.m, cm.nx
     vals = cm.zero_jacobians(cols)
     N = cols[0].shape[0] if cols else 1
     J = np.stack([np.broadcast_to(np.asarray(v, dtype=float), (N,)) for v in vals], axis=-1).reshape(N, n + m, nx)
+    # the rate blocks from their simplified symbolic form: exact zeros instead of cancellation noise
+    RdL_c, GdL_c, GddQ_c = zero_rate_blocks(cm.spec).evaluate(cols)
+    J[:, :n, 3 * n + m:] = RdL_c
+    J[:, n:, 3 * n + m:] = GdL_c
+    J[:, n:, 2 * n:3 * n] = GddQ_c
     dyn = ~np.array(cm.rate_free_at_zero, dtype=bool)
     qs = ~dyn
     M, D, K = J[:, :n, 2 * n:3 * n], J[:, :n, n:2 * n], J[:, :n, :n]
@@ -325,7 +334,8 @@ def _zero_descriptor(cm: Any, cols: list[np.ndarray]) -> tuple[np.ndarray, np.nd
     R_L, R_dL = J[:, :n, 3 * n:3 * n + m], J[:, :n, 3 * n + m:]
     with np.errstate(all="ignore"):
         rates = np.concatenate([R_dL[:, :, dyn], np.swapaxes(G_dL[:, :, dyn], 1, 2), G_dL[:, dyn, :]], axis=2)
-        usable = np.all(np.any(rates != 0.0, axis=2), axis=1)
+        per_pad = np.any(rates != 0.0, axis=2)
+        usable = np.where(np.all(per_pad, axis=1), 0, np.where(np.any(per_pad, axis=1), 2, 1))
         if qs.any():
             Gss = G_L[:, qs][:, :, qs]
             P = np.swapaxes(np.linalg.solve(np.swapaxes(Gss, 1, 2), np.swapaxes(R_L[:, :, qs], 1, 2)), 1, 2)
@@ -398,9 +408,13 @@ def _trivial_batch(model: _Model, P: np.ndarray, eigen: bool, codes: np.ndarray 
                 M, D, K = cm.zero_linear(cols)
                 c, m, f = (matrix_verdicts(M, D, K) if cm.n == 2 else eigen_verdicts(M, D, K))
             else:
-                E, A, usable = _zero_descriptor(cm, cols)
+                E, A, kind = _zero_descriptor(cm, cols)
                 c, m, f = descriptor_verdicts(E, A)
-                st = np.where(usable | (st != int(PointStatus.OK)), st, -1).astype(np.int8)  # -1: per point
+                qs = np.flatnonzero(kind == 1)
+                if qs.size:  # every kept pad's rate terms vanish here (a falling law at zero slope): quasi-static
+                    M, D, K = cm.zero_linear([col[qs] for col in cols])
+                    c[qs], m[qs], f[qs] = matrix_verdicts(M, D, K) if cm.n == 2 else eigen_verdicts(M, D, K)
+                st = np.where((kind == 2) & (st == int(PointStatus.OK)), -1, st).astype(np.int8)  # -1: per point
             ok = st == int(PointStatus.OK)
             out[sl] = np.where(ok, c, UNDECIDED)
             mr[sl] = np.where(ok, m, np.nan)
@@ -485,8 +499,7 @@ def evaluate_arrays(space: Any, arr: Mapping[str, Any], *, eigen: bool = True, c
         status[tix] = st
         stable[tix] = (c == STABLE) & (st == int(PointStatus.OK))
         mr[tix], fr[tix] = m, f
-        back = np.flatnonzero(st == -1)
-        triv[t[back]] = False  # kept pads without rate blocks here: per-point route
+        triv[t[st == -1]] = False  # some kept pads without rate terms here: the per-point route decides
     names = list(space.model.parameters)
     for j in np.flatnonzero(~triv):
         i = flat[j]

@@ -67,12 +67,10 @@ GENERATOR_MODULES: tuple[str, ...] = (
     "model/components.py",  # components: their equations and parameter order
     "model/friction.py",  # friction laws: their formulas enter the equations
     "numeric/*.py",  # code generation (CSE), this cache, the compiled 2-DOF model
-    "builder/assemble.py",  # built-model equations
     "builder/components.py",  # built-model components (their equations and parameter order)
-    "builder/numeric.py",  # built-model code generation
     "analysis/kernels.py",  # stability kernel generators
     "analysis/_compiled.py",  # numba root isolation linked with the stability kernels
-    "analysis/space.py",  # parameter spaces specialised into the stability kernels
+    "analysis/_rows.py",  # numba row evaluation of the stability kernels' coefficient tables
     "simulation/_kernels.py",  # simulation kernels and their static template
     "export/*.py",  # exported code and LaTeX
     "render.py",  # the rendered closed forms cached by ``derive``
