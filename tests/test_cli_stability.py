@@ -67,11 +67,71 @@ def test_map_writes_netcdf_and_plot(tmp_path, capsys):
     (["map", "--x", "N0=1:2:3", "--y", "mu=0.1:1:10"], "tied"),
     (["crossings", "--along", "k_ip=5:1"], "reversed"),
     (["critical-speed", "--range", "0:10"], "positive"),
+    (["map", "--x", "k_ip=1e5:1e10:100000:log", "--y", "mu=0.1:1:100000", "--force"], "GiB of memory"),
+    (["map", "--x", "k_ip=1e5:1e10:10:log", "--y", "mu=0.1:1:10", "--plot", "m.xyz"], "--plot"),
+    (["crossings", "--along", "k_ip=1e5:1e10:log", "--plot", "no/such/dir/c.png"], "does not exist"),
+    (["map", "--model", "belt", "--preset", "paper-fig2", "--x", "slope=0:1:3", "--y", "m=1:2:3"], "paper-fig2"),
 ])
-def test_bad_input_one_line_exit_2(tmp_path, capsys, args, fragment):
+def test_bad_input_one_line_exit_2(tmp_path, capsys, monkeypatch, args, fragment):
+    monkeypatch.chdir(tmp_path)
     rc, _, err = run(capsys, *args, *(["--out", str(tmp_path / "x.nc")] if args[0] == "map" else []))
     assert rc == 2
     assert err.count("\n") == 1 and fragment in err
+    assert not (tmp_path / "x.nc").exists()
+
+
+def test_output_paths_are_checked_before_computing(tmp_path, capsys, monkeypatch):
+    """A bad --out fails at once, before the (here deliberately slow) map is computed; an old file survives errors."""
+    import brakesqueal.analysis.maps as maps
+
+    called = []
+    monkeypatch.setattr(maps, "evaluate_arrays", lambda *a, **k: called.append(1))
+    rc, _, err = run(capsys, "map", "--x", "k_ip=1e5:1e10:5:log", "--y", "mu=0.1:1:5", "--out", str(tmp_path / "m.txt"))
+    assert rc == 2 and ".nc" in err and not called
+    old = tmp_path / "old.nc"
+    old.write_bytes(b"previous results")
+    rc, _, err = run(capsys, "map", "--x", "N0=1:2:3", "--y", "mu=0.1:1:3", "--out", str(old))
+    assert rc == 2 and old.read_bytes() == b"previous results"
+    assert [p.name for p in tmp_path.iterdir()] == ["old.nc"]  # no temporary file left behind
+
+
+def test_map_no_eigen_leaves_the_eigenvalue_variables_out(tmp_path, capsys):
+    nc = tmp_path / "v.nc"
+    rc, out, err = run(capsys, "map", "--x", "k_ip=1e5:1e10:12:log", "--y", "mu=0.1:1:9", "--out", str(nc), "--no-eigen")
+    assert rc == 0, err
+    m = open_map(str(nc))
+    assert set(m.data.data_vars) == {"stable", "status"}
+    full = run(capsys, "map", "--x", "k_ip=1e5:1e10:12:log", "--y", "mu=0.1:1:9", "--out", str(tmp_path / "f.nc"))
+    assert full[0] == 0
+    f = open_map(str(tmp_path / "f.nc"))
+    np.testing.assert_array_equal(f.data["stable"].values, m.data["stable"].values)
+    assert np.array_equal(f.data["stable"].values, f.data["max_real"].values < 0)
+
+
+@pytest.mark.parametrize("model,args", [
+    ("six-dof", ["--x", "k_c=1e8:1e10:6:log", "--y", "mu1=0.45:0.55:3"]),
+    ("belt", ["--x", "slope=0:0.02:5", "--y", "d_ip=0.1:1:3"]),
+])
+def test_map_of_any_model_uses_the_shared_options(tmp_path, capsys, model, args):
+    """--model/--set are resolved like everywhere else: the map equals stability_map on resolve_space."""
+    from brakesqueal.analysis.maps import parse_axis, stability_map
+    from brakesqueal.model import resolve_space
+
+    nc = tmp_path / "m.nc"
+    rc, out, err = run(capsys, "map", "--model", model, "--set", "N0=3000", *args, "--out", str(nc))
+    assert rc == 0, err
+    got = open_map(str(nc)).data
+    ref = stability_map(resolve_space(model, sets=["N0=3000"]), parse_axis(args[1]), parse_axis(args[3])).data
+    assert got.attrs["model"] == model and got.attrs["method"] == ref.attrs["method"]
+    np.testing.assert_array_equal(got["stable"].values, ref["stable"].values)
+    np.testing.assert_array_equal(got["status"].values, ref["status"].values)
+
+
+def test_crossings_plot_draws_the_stored_profile(tmp_path, capsys):
+    png = tmp_path / "c.png"
+    rc, out, err = run(capsys, "crossings", "--along", "k_ip=1e5:1e10:log", "--set", "mu=0.7", "--plot", str(png))
+    assert rc == 0, err
+    assert png.stat().st_size > 1000 and "k_ip =" in out
 
 
 def test_reproduce_fig3_small(tmp_path, monkeypatch):
