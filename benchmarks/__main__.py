@@ -1,8 +1,8 @@
-"""``make bench``: run every ``brakesqueal bench`` target and the scripts in ``benchmarks/``.
+"""``make bench``: run every script ``benchmarks/bench_*.py``, each in its own process.
 
-Each target runs in its own process (so one target's imports and compiled
-code do not warm another's) and prints its table; all results are written to
-``benchmarks/results.json``.
+Each script prints its table; scripts that end with one JSON line (the
+:mod:`common` convention, or ``--format json`` where a script supports it)
+have their results collected into ``benchmarks/results.json``.
 """
 
 from __future__ import annotations
@@ -13,34 +13,21 @@ import sys
 from pathlib import Path
 
 
-def _targets() -> list[str]:
-    from brakesqueal.cli import bench_app
-
-    return [c.name or c.callback.__name__.removeprefix("bench_").replace("_", "-") for c in bench_app.registered_commands]
-
-
 def main() -> int:
     here = Path(__file__).resolve().parent
     results: dict[str, object] = {}
-    for target in _targets():
-        print(f"== brakesqueal bench {target}", flush=True)
-        proc = subprocess.run(
-            [sys.executable, "-m", "brakesqueal", "bench", target, "--format", "json"], capture_output=True, text=True
-        )
+    for script in sorted(here.glob("bench_*.py")):
+        print(f"== {script.name}", flush=True)
+        proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True)
+        sys.stdout.write(proc.stdout)
         if proc.returncode != 0:
             print(proc.stderr, file=sys.stderr)
             return proc.returncode
-        data = json.loads(proc.stdout)
-        results[target] = data
-        for rec in [data, *data.get("more", [])]:
-            base = "none" if rec["baseline"] is None else f"{rec['baseline']:.4g}"
-            ratio = "" if rec["ratio"] is None else f" ratio {rec['ratio']:.1f}x"
-            print(f"  {rec['metric']}: {rec['value']:.4g} {rec['unit']} (baseline {base}){ratio}")
-    for script in sorted(here.glob("bench_*.py")):
-        print(f"== {script.name}", flush=True)
-        proc = subprocess.run([sys.executable, str(script)], text=True)
-        if proc.returncode != 0:
-            return proc.returncode
+        lines = proc.stdout.strip().splitlines()
+        try:
+            results[script.stem] = json.loads(lines[-1]) if lines else None
+        except json.JSONDecodeError:
+            results[script.stem] = None
     (here / "results.json").write_text(json.dumps(results, indent=2) + "\n")
     print(f"results written to {here / 'results.json'}")
     return 0

@@ -16,7 +16,7 @@ from .model.options import resolve_parameters
 from .model.parameters import ParameterSpace, Parameters, Preset, Value, parse_sets
 
 __all__ = ["Parameters", "Preset", "ParameterSpace", "Value", "get_preset", "parse_sets", "parameters_to_toml",
-           "load_parameter_file", "resolve_parameters", "PRESETS"]
+           "load_parameter_file", "resolve_parameters"]
 
 
 def __getattr__(name: str) -> Any:

@@ -174,7 +174,8 @@ def exact_crossings(qn: QuarticNumerators, lo: float, hi: float, log: bool = Tru
     # merge isolating intervals closer than 1e-30 relative (a multiple root split by rounded constants)
     merged: list[list[Fraction]] = []
     for a, b in iv:
-        if merged and a - merged[-1][1] <= Fraction(1, 10 ** 30) * max(abs(a), abs(merged[-1][1]), Fraction(1, 10 ** 300)):
+        tiny = Fraction(1, 10 ** 30) * max(abs(a), abs(merged[-1][1]), Fraction(1, 10 ** 300)) if merged else 0
+        if merged and a - merged[-1][1] <= tiny:
             merged[-1][1] = max(merged[-1][1], b)
         else:
             merged.append([a, b])

@@ -30,7 +30,8 @@ Generated / compiled pieces:
 * :func:`quartic_numerators` — the closed form (trivial silent motion)
   specialised to a parameter space with some axes symbolic, after checking
   that every zero-state residual of the model vanishes identically under the
-  space's ties (the silent motion is trivial on the whole grid); entries are converted to elements of a rational function field
+  space's ties (the silent motion is trivial on the whole grid); entries are converted to elements of a
+  rational function field
   (``sympy.polys.fields``, exact rational arithmetic with cancellation), so
   ``a_i = N_i / Den`` with small, exact numerator polynomials.  Constants such
   as π are extra generators.
@@ -64,7 +65,8 @@ if TYPE_CHECKING:
 __all__ = [
     "quartic_coefficients", "hurwitz_h3", "hurwitz_stable", "ModelForm", "model_form", "QuarticNumerators",
     "quartic_numerators", "GridKernel", "grid_kernel", "MapKernel", "map_kernel", "classify_numpy", "real_roots",
-    "trivial_entries", "RateBlocks", "zero_rate_blocks", "omega_entries", "omega_coefficients", "omega_kernel_available", "omega_subranges", "inner_exponent", "kernel_segments", "run_classify", "kernel_scaling",
+    "trivial_entries", "RateBlocks", "zero_rate_blocks", "omega_entries", "omega_coefficients",
+    "omega_kernel_available", "omega_subranges", "inner_exponent", "kernel_segments", "run_classify", "kernel_scaling",
 ]
 
 _U = 2.0 ** -53

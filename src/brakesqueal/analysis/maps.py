@@ -168,9 +168,10 @@ def _check_axes(space: object, axes: list[Axis], force: bool, eigen: bool) -> No
         raise ParameterError(f"the map has {n:.3g} points (> {MAX_POINTS:.0e}); pass --force to compute it anyway")
     need = map_bytes(n, eigen)
     if need > MAX_MAP_BYTES:
+        hint = "; --no-eigen stores 2 bytes per point" if eigen else ""
         raise ParameterError(f"the map has {n:.3g} points: its results would take {need / 2**30:.3g} GiB of memory "
-                             f"(limit {MAX_MAP_BYTES / 2**30:g} GiB{'; --no-eigen stores 2 bytes per point' if eigen else ''}"
-                             "); use fewer points or a sweep (brakesqueal sweep), which writes chunks to a store")
+                             f"(limit {MAX_MAP_BYTES / 2**30:g} GiB{hint}); use fewer points or a sweep "
+                             "(brakesqueal sweep), which writes chunks to a store")
 
 
 def classify_grid(space: object, x: Axis, y: Axis) -> tuple[np.ndarray, str, str]:

@@ -88,7 +88,7 @@ def map_(
                                                               "no max_real or frequency.")] = False,
     progress: ProgressOpt = None,
 ) -> None:
-    """Stability map over two parameters of any model: NetCDF with stable, status, max_real, frequency; optional plot."""
+    """Stability map over two parameters of any model: NetCDF (stable, status, max_real, frequency); optional plot."""
     from ..analysis.maps import parse_axis, stability_map
     from ..outputs import atomic_write, check_output
     from ._progress import progress as _progress
