@@ -231,3 +231,22 @@ def test_fig3_critical_speed_and_restabilisation_are_unchanged():
     assert round(r.Omega_crit, 2) == 35.60
     restab = [v for v, d in r.crossings if d == "stabilizing"]
     assert restab and 8300 < restab[0] < 8500
+
+
+@pytest.mark.parametrize("model", list(CASES))
+def test_grouped_validity_equals_the_roles_table(model):
+    """``points.valid_points`` (conditions grouped per array shape) equals ``ParameterSpace.valid`` element-wise."""
+    from brakesqueal.analysis.points import valid_points
+
+    space = resolve_space(model)
+    rng = np.random.default_rng(7)
+    names = list(space.settable())
+    for _ in range(20):
+        a, b = rng.choice(len(names), 2, replace=False)
+        va = space.value(names[a]) * rng.choice([-1.0, 0.0, 0.5, 1.0, 2.0, 1e120, np.nan], 6)
+        vb = space.value(names[b]) * rng.choice([-1.0, 0.0, 0.5, 1.0, 2.0, np.inf], 5)
+        with np.errstate(all="ignore"):
+            arr = space.arrays({names[a]: va[:, None], names[b]: vb[None, :]})
+        want = np.broadcast_to(space.valid(arr), (6, 5))
+        got = np.broadcast_to(valid_points(space, arr), (6, 5))
+        np.testing.assert_array_equal(got, want)

@@ -141,6 +141,13 @@ def compact(a: Any) -> np.ndarray:
 def valid_points(space: Any, arr: Mapping[str, Any]) -> np.ndarray:
     """Validity of broadcast parameter arrays, evaluated on their compact forms (cheap for grids).
 
+    The same conditions as :meth:`ParameterSpace.valid
+    <brakesqueal.model.parameters.ParameterSpace.valid>` (every role's
+    interval, the disk thickness, pads on the disk, caliper stiffnesses, from
+    :func:`brakesqueal.model.roles.parameter_roles`), but combined per array
+    shape first, so that a grid whose parameters each depend on one axis costs
+    only a few full-size operations.
+
     Parameters
     ----------
     space : ParameterSpace
@@ -153,7 +160,32 @@ def valid_points(space: Any, arr: Mapping[str, Any]) -> np.ndarray:
     ndarray of bool
         Broadcastable to the arrays' shape.
     """
-    return np.asarray(space.valid({k: compact(v) for k, v in arr.items()}))
+    roles = space.model.roles()
+    parts: dict[tuple[int, ...], np.ndarray] = {}
+
+    def add(c: Any) -> None:
+        c = np.asarray(c)
+        parts[c.shape] = parts[c.shape] & c if c.shape in parts else c
+
+    def value(v: Any) -> np.ndarray:
+        return compact(np.asarray(arr[v], dtype=float)) if isinstance(v, str) else np.asarray(float(v))
+
+    with np.errstate(invalid="ignore"):
+        for name, uses in roles.uses.items():
+            v = value(name)
+            for role, _ in uses:
+                add(role.contains(v))
+        hu, hl = roles.thickness
+        add(value(hu) + value(hl) > 0)
+        Rv = value(roles.disk_radius)
+        for _, r in roles.pad_radii:
+            add(value(r) <= Rv)
+        for _, _, k in roles.caliper_dofs:
+            add(value(k) > 0)
+    ok: Any = np.True_
+    for shape in sorted(parts, key=lambda sh: (math.prod(sh), sh)):
+        ok = ok & parts[shape]
+    return np.asarray(ok)
 
 
 def closed_form_route(space: Any, names: tuple[str, ...]) -> bool:
@@ -456,25 +488,28 @@ def evaluate_arrays(space: Any, arr: Mapping[str, Any], *, eigen: bool = True, c
     """
     shape = np.broadcast_shapes(*(np.shape(v) for v in arr.values()))
     model = _Model.of(space.model)
-    status = np.full(shape, int(PointStatus.INVALID), dtype=np.int8)
-    stable = np.zeros(shape, dtype=bool)
-    mr = np.full(shape, np.nan)
-    fr = np.full(shape, np.nan)
     ok = np.broadcast_to(valid_points(space, arr) if valid is None else valid, shape)
     if closed and model.form is not None and codes is not None and not eigen:
         # verdict-only closed-form route: the kernel's certified codes; recompute only its uncertain points
         kc = np.broadcast_to(codes, shape)
-        status[ok] = int(PointStatus.OK)
-        np.logical_and(ok, kc == STABLE, out=stable)
-        flat = np.flatnonzero(ok & (kc == UNDECIDED))
-        if flat.size:
+        status = np.where(ok, np.int8(PointStatus.OK), np.int8(PointStatus.INVALID))
+        stable = ok & (kc == STABLE)
+        und = kc == UNDECIDED
+        und &= ok
+        nan = np.broadcast_to(np.float64(np.nan), shape)  # not computed (read-only)
+        if und.any():
+            flat = np.flatnonzero(und)
             ix = np.unravel_index(flat, shape)
             vecs = space.vectors({k: compact(v) for k, v in arr.items()})
             P = np.stack([np.broadcast_to(v, shape)[ix] for v in vecs], axis=1)
-            st, c, m, f = _trivial_batch(model, P, False, None)
+            st, c, _, _ = _trivial_batch(model, P, False, None)
             status[ix] = st
             stable[ix] = (c == STABLE) & (st == int(PointStatus.OK))
-        return Points(status, stable, mr, fr)
+        return Points(status, stable, nan, nan)
+    status = np.full(shape, int(PointStatus.INVALID), dtype=np.int8)
+    stable = np.zeros(shape, dtype=bool)
+    mr = np.full(shape, np.nan)
+    fr = np.full(shape, np.nan)
     flat = np.flatnonzero(ok)
     if flat.size == 0:
         return Points(status, stable, mr, fr)

@@ -231,8 +231,8 @@ def compute_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, n
     codes = _kernel_codes(spec, space, coords, shape) if (spec.kind == "grid" and closed) else None
     full = {k: np.broadcast_to(v, shape) for k, v in arr.items()}
     res = evaluate_arrays(space, full, eigen=eig, codes=codes, closed=closed, valid=valid_points(space, arr))
-    stable = np.array(res.stable, dtype=bool)
-    status = np.array(res.status, dtype=np.int8)
+    stable = np.asarray(res.stable, dtype=bool)
+    status = np.asarray(res.status, dtype=np.int8)
     out: dict[str, np.ndarray] = {q: np.full(shape, np.nan) for q in floats}
     if eig:
         s = _summary(res.max_real, res.frequency)
