@@ -70,6 +70,14 @@ def reference(space, values):
         lm = linearize(space.resolve(values))
     except BrakesquealError:
         return None
+    if lm.pad_states and np.any(np.all(lm.descriptor[0] == 0.0, axis=1)):
+        # a kept pad without rate terms (rigid support): algebraic; the finite eigenvalues of the pencil (QZ)
+        import scipy.linalg
+
+        E, A = lm.descriptor
+        lam = scipy.linalg.eigvals(A, E)
+        lam = lam[np.isfinite(lam)]
+        return float(lam.real.max()), float(lam.real.max() / np.abs(lam).max()), lm.silent.trivial
     S, desc = _first_order(lm)
     lam = np.linalg.eigvals(S)
     mr = float(lam.real.max())
@@ -250,3 +258,23 @@ def test_grouped_validity_equals_the_roles_table(model):
         want = np.broadcast_to(space.valid(arr), (6, 5))
         got = np.broadcast_to(valid_points(space, arr), (6, 5))
         np.testing.assert_array_equal(got, want)
+
+
+def test_critical_speeds_many_batches_trivial_sets_and_routes_the_others_point_by_point():
+    """Sets with a trivial silent motion go through the compiled kernel, the others through critical_speeds."""
+    from brakesqueal.analysis.crossings import critical_speeds_many
+    from brakesqueal.status import PointStatus
+
+    space = resolve_space("paper", sets={"k_ip1": "inf", "k_ip2": "inf"})
+    mu1 = np.array([0.5, 0.52])
+    roots, dirs, counts, start, status = critical_speeds_many(space, {"mu1": mu1}, 10.0, 100.0, return_status=True)
+    for i, m1 in enumerate(mu1):
+        single = critical_speeds(space.with_values({"mu1": float(m1)}), 10.0, 100.0)
+        assert counts[i] == len(single.crossings) and bool(start[i]) == single.stable_at_start
+        for k, (v, d) in enumerate(single.crossings):
+            assert math.isclose(roots[i, k], v, rel_tol=1e-9) and dirs[i, k] == (1 if d == "stabilizing" else -1)
+        assert status[i] == (PointStatus.OK if single.complete else PointStatus.UNDECIDED)
+    assert status[0] == PointStatus.OK and status[1] == PointStatus.UNDECIDED  # mu1 != mu2: a grid search
+    assert counts[0] == 1 and counts[1] >= 1  # the onset of squeal near 35 rad/s in both
+    _check_path(space.with_values({"mu1": 0.52}), critical_speeds(space.with_values({"mu1": 0.52}), 10.0, 100.0),
+                "Omega", True)
