@@ -146,3 +146,21 @@ def test_trivial_silent_motion_has_preload_forces():
     assert np.allclose(sm.normal_forces, params.N0, rtol=1e-12)
     assert np.allclose(sm.sliding_speeds, params.Omega * params.r, rtol=1e-12)
     assert math.isfinite(linearize(params).max_real)
+
+
+def test_descriptor_eigenvalues_match_60_digit_arithmetic():
+    """The kept pad rates give a badly scaled pencil (G_dl ~ 1e-13 G_l): equilibrated QZ keeps every digit that matters."""
+    import mpmath
+
+    base = get_preset("paper-fig3").resolve()
+    lm = linearize(base.replace(h10=base.h10 * 1.3))
+    assert lm.pad_states
+    E, A = lm.descriptor
+    with mpmath.workdps(60):
+        S = mpmath.inverse(mpmath.matrix(E.tolist())) * mpmath.matrix(A.tolist())
+        ref = np.array([complex(z) for z in mpmath.eig(S, left=False, right=False)])
+    got = lm.eigenvalues
+    for z in ref:
+        nearest = got[np.argmin(np.abs(got - z))]
+        assert abs(nearest - z) <= 1e-8 * abs(z)
+        assert abs(nearest.real - z.real) <= 1e-6 * abs(z.real) + 1e-12 * abs(z)

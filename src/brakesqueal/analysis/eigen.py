@@ -36,7 +36,8 @@ class Verdict:
     Attributes
     ----------
     status : str
-        ``"stable"``, ``"unstable"`` or ``"undecided"`` (within the error bound).
+        ``"stable"``, ``"unstable"`` or ``"undecided"`` (not certifiable), the
+        certified verdict shared by every route.
     max_real : float
         Largest real part [1/s].
     error_bound : float
@@ -110,12 +111,22 @@ class EigenAnalysis:
         return {"D_s": (D + D.T) / 2, "G": (D - D.T) / 2, "K_s": (K + K.T) / 2, "N": (K - K.T) / 2}
 
     def verdict(self, safety: float = 100.0) -> Verdict:
-        """Stability verdict; ``"undecided"`` if ``|max Re λ| <= safety · κ · ε · ‖A‖``."""
+        """Stability verdict: the certified one of every route (:func:`~.points.linear_verdict`).
+
+        ``status`` and ``max_real`` come from the certified verdict (interval
+        Routh for 2-DOF models, eigenvalues with condition bounds otherwise),
+        the same as maps, sweeps and the command line report; ``error_bound``
+        is the first-order estimate ``safety · κ · ε · ‖A‖`` of the least-stable
+        eigenvalue's error (for information).
+        """
+        from .points import linear_verdict
+        from .robust import STABLE, UNSTABLE
+
+        code, mr, _ = linear_verdict(self.model)
         A = self.model.A
         i = int(np.argmax(self.eigenvalues.real))
         bound = safety * float(self.condition[i]) * _EPS * float(np.linalg.norm(A, 2))
-        mr = float(self.eigenvalues[i].real)
-        status = "undecided" if abs(mr) <= bound else "stable" if mr < 0 else "unstable"
+        status = "stable" if code == STABLE else "unstable" if code == UNSTABLE else "undecided"
         return Verdict(status, mr, bound, mr / abs(self.eigenvalues[i]))
 
     # -------------------------------------------------------------- sensitivities

@@ -48,6 +48,44 @@ def state_matrix(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
     return np.concatenate([top, bottom], axis=0)
 
 
+def pencil_eigenvalues(E: np.ndarray, A: np.ndarray, sweeps: int = 20) -> np.ndarray:
+    """Finite eigenvalues of the pencil ``lambda E - A`` by QZ after power-of-two equilibration.
+
+    Rows and columns of ``(E, A)`` are scaled jointly by powers of two (the
+    eigenvalues are unchanged, exactly) until their largest entries are near
+    one.  A massless pad's tangential rate coefficient can be 1e-13 of its
+    stiffness term; without the scaling the QZ algorithm loses digits of both
+    the huge pad mode and the slow structural modes (measured against 60-digit
+    arithmetic in the tests).
+
+    Parameters
+    ----------
+    E, A : ndarray, shape (m, m)
+        The pencil (e.g. :attr:`LinearModel.descriptor`).
+    sweeps : int
+        Row/column scaling sweeps.
+
+    Returns
+    -------
+    ndarray of complex
+        The finite generalized eigenvalues (infinite ones dropped).
+    """
+    import scipy.linalg
+
+    E, A = np.array(E, dtype=float), np.array(A, dtype=float)
+    for _ in range(sweeps):
+        for axis in (1, 0):
+            mag = np.maximum(np.abs(E).max(axis=axis), np.abs(A).max(axis=axis))
+            mag[~(mag > 0)] = 1.0
+            scale = np.exp2(-np.round(np.log2(mag)))
+            if axis == 1:
+                E, A = E * scale[:, None], A * scale[:, None]
+            else:
+                E, A = E * scale[None, :], A * scale[None, :]
+    lam = scipy.linalg.eigvals(A, E)
+    return lam[np.isfinite(lam)]
+
+
 def _sort(lam: np.ndarray) -> np.ndarray:
     return lam[np.lexsort((-lam.imag, -lam.real))]
 
@@ -177,11 +215,7 @@ class LinearModel(ModalMixin):
             if not self.pad_states:
                 lam = np.linalg.eigvals(self.A)
             else:
-                import scipy.linalg
-
-                E, A = self.descriptor
-                lam = scipy.linalg.eigvals(A, E)
-                lam = lam[np.isfinite(lam)]
+                lam = pencil_eigenvalues(*self.descriptor)
             self._eig.append(_sort(lam))
         return self._eig[0]
 

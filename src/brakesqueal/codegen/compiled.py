@@ -198,6 +198,7 @@ def _generate(spec: Any) -> str:
     zero = {s: 0 for s in eq.x}
     res0 = _structural_zeros([se.sympify(e).subs(zero) for e in res], eq.params)
     jac0 = _structural_zeros([se.sympify(e).subs(zero) for e in jac], eq.params)
+    jac0 = _simplified_rate_columns(jac0, eq)
     scale0 = []
     for e in res0:
         terms = [se.Abs(pk * e.diff(pk)) for pk in eq.params]
@@ -224,6 +225,39 @@ def _generate(spec: Any) -> str:
         FunctionSpec("zero_residual_scale", (pa,), scale0, "Sum_k |p_k d(R, G)/dp_k| at x = 0, per row."),
     ]
     return generate_module(specs, header) + f"META = {meta!r}\n"
+
+
+def _simplified_rate_columns(jac0: list[Any], eq: Any) -> list[Any]:
+    """Zero-state Jacobian entries of the pads' rates (``Ldot`` columns, ``Qddot`` columns of ``G``), simplified.
+
+    These entries decide whether a pad keeps its tangential rate
+    (:func:`brakesqueal.analysis.linear.linearize`).  As generated they are
+    differences of terms that cancel analytically (e.g. ``1/|Omega r| -
+    Omega^2 r^2/|Omega r|^3``), whose rounding noise would otherwise pose as a
+    tiny non-zero rate coefficient and a spurious pad mode of order
+    ``1/noise``; simplified with SymPy (parameters positive, except the disk
+    faces' distances) the cancellation is done exactly.
+    """
+    n, m = len(eq.coords), len(eq.algebraic)
+    nx = 3 * n + 2 * m
+    cols = set(range(3 * n + m, nx))
+    todo = [k for k, e in enumerate(jac0) if not e.is_Number
+            and (k % nx in cols or (k // nx >= n and 2 * n <= k % nx < 3 * n))]
+    if not todo:
+        return jac0
+    import sympy as sp
+    import symengine as se
+
+    spec = eq.spec
+    real = {v for v in (spec.disk.h_upper, spec.disk.h_lower) if isinstance(v, str)}
+    pos = {sp.Symbol(str(p)): (sp.Symbol(str(p), real=True) if name in real else sp.Symbol(str(p), positive=True))
+           for p, name in zip(eq.params, spec.parameters)}
+    back = {v: k for k, v in pos.items()}
+    out = list(jac0)
+    for k in todo:
+        v = sp.factor_terms(sp.cancel(sp.sympify(str(jac0[k])).xreplace(pos))).xreplace(back)
+        out[k] = se.sympify(v)
+    return out
 
 
 def _structural_zeros(exprs: list[Any], params: list[Any], points: int = 2) -> list[Any]:
