@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["StabilityMap", "CrossingResult", "CriticalSpeedResult", "open_map"]
+__all__ = ["StabilityMap", "CrossingResult", "CriticalSpeedResult", "open_map", "MapFile"]
 
 _AUX_UNITS = {"mu": "", "k_ip": "N/m", "h": "m", "R_disk": "m"}
 
@@ -37,6 +37,93 @@ def _status_attrs() -> dict[str, Any]:
     from .status import STATUS_MEANINGS, PointStatus
 
     return {"flag_values": np.array([int(s) for s in PointStatus], dtype=np.int8), "flag_meanings": STATUS_MEANINGS}
+
+
+def _map_attrs(space: Any, method: str) -> dict[str, Any]:
+    """Global attributes of a stability map (Dataset and NetCDF file)."""
+    return {"model": space.model.name, "space": space.label,
+            "settings": json.dumps({k: str(v) for k, v in space.definitions().items()}),
+            "tied": json.dumps(dict(space.tied)), "method": method,
+            "criterion": "certified verdict from every eigenvalue of the linear model about the silent motion "
+                         "(Lienard-Chipart on the exact quartic where the closed form applies)"}
+
+
+_VAR_ATTRS = {
+    "max_real": {"units": "1/s", "long_name": "largest real part of the eigenvalues"},
+    "stable": {"long_name": "silent motion asymptotically stable (certified)"},
+    "frequency": {"units": "Hz", "long_name": "frequency of the least-stable mode"},
+}
+_STABLE_FLAGS = {"flag_values": np.array([0, 1], dtype=np.int8), "flag_meanings": "unstable stable"}
+
+
+def _coord_attrs(ax: Any, space: Any) -> dict[str, Any]:
+    return {"units": _units(ax.name, space), "scale": "log" if ax.log else "linear"}
+
+
+class MapFile:
+    """A stability map's NetCDF3 file whose variables are filled in place, row block by row block.
+
+    The file has the layout :meth:`StabilityMap.to_netcdf` writes and is read
+    back by :func:`open_map`.  It is a :func:`scipy.io.netcdf_file` whose
+    variables' arrays (attributes ``stable``, ``status``, ``max_real``,
+    ``frequency``) are the map's result arrays, so no second copy of the map
+    (an xarray Dataset, a converted copy per variable) is built; the data
+    are written when the file is closed.
+
+    Parameters
+    ----------
+    path : str
+        The file (created or truncated).
+    space : ParameterSpace
+        The map's parameter space.
+    outer, inner : Axis
+        The axes (dimension order).
+    eigen : bool
+        Whether ``max_real`` and ``frequency`` are stored.
+    float_dtype : numpy dtype
+        Type of ``max_real`` and ``frequency`` (float32 or float64).
+    """
+
+    def __init__(self, path: str, space: Any, outer: Any, inner: Any, *, eigen: bool,
+                 float_dtype: Any = np.float64) -> None:
+        from scipy.io import netcdf_file
+
+        self.space = space
+        self._f = netcdf_file(path, "w", version=2, maskandscale=False)
+        ft = np.dtype(float_dtype)
+        dims = (outer.name, inner.name)
+        for ax in (outer, inner):
+            self._f.createDimension(ax.name, ax.num)
+            v = self._f.createVariable(ax.name, "d", (ax.name,))
+            v[:] = ax.values()
+            self._attrs(v, {**_coord_attrs(ax, space), "_FillValue": np.float64(np.nan)})
+        self.max_real = self.frequency = None
+        if eigen:
+            self.max_real = self._var("max_real", ft, dims, {**_VAR_ATTRS["max_real"], "_FillValue": ft.type(np.nan)})
+        self.stable = self._var("stable", np.int8, dims, {**_VAR_ATTRS["stable"], **_STABLE_FLAGS})
+        if eigen:
+            self.frequency = self._var("frequency", ft, dims,
+                                       {**_VAR_ATTRS["frequency"], "_FillValue": ft.type(np.nan)})
+        self.status = self._var("status", np.int8, dims, _status_attrs())
+
+    @staticmethod
+    def _attrs(v: Any, attrs: dict[str, Any]) -> None:
+        for k, a in attrs.items():
+            setattr(v, k, a)
+
+    def _var(self, name: str, dtype: Any, dims: tuple[str, str], attrs: dict[str, Any]) -> np.ndarray:
+        v = self._f.createVariable(name, np.dtype(dtype), dims)
+        self._attrs(v, attrs)
+        return v.data  # type: ignore[no-any-return]
+
+    def close(self, method: str) -> None:
+        """Set the global attributes (``method`` names the route), write the file and close it."""
+        self._attrs(self._f, _map_attrs(self.space, method))
+        self._f.close()
+
+    def abort(self) -> None:
+        """Close without meaningful content (the caller removes the file)."""
+        self._f.fp.close()
 
 
 @dataclass
@@ -98,25 +185,15 @@ class StabilityMap:
         dims = (outer.name, inner.name)
         coords = {}
         for ax in (outer, inner):
-            coords[ax.name] = xr.DataArray(ax.values(), dims=(ax.name,),
-                                           attrs={"units": _units(ax.name, space),
-                                                  "scale": "log" if ax.log else "linear"})
+            coords[ax.name] = xr.DataArray(ax.values(), dims=(ax.name,), attrs=_coord_attrs(ax, space))
         data: dict[str, Any] = {}
         if max_real is not None:
-            data["max_real"] = (dims, max_real, {"units": "1/s", "long_name": "largest real part of the eigenvalues"})
-        data["stable"] = (dims, stable, {"long_name": "silent motion asymptotically stable (certified)"})
+            data["max_real"] = (dims, max_real, dict(_VAR_ATTRS["max_real"]))
+        data["stable"] = (dims, stable, dict(_VAR_ATTRS["stable"]))
         if frequency is not None:
-            data["frequency"] = (dims, frequency, {"units": "Hz", "long_name": "frequency of the least-stable mode"})
+            data["frequency"] = (dims, frequency, dict(_VAR_ATTRS["frequency"]))
         data["status"] = (dims, status, _status_attrs())
-        ds = xr.Dataset(
-            data, coords=coords,
-            attrs={"model": space.model.name, "space": space.label,
-                   "settings": json.dumps({k: str(v) for k, v in space.definitions().items()}),
-                   "tied": json.dumps(dict(space.tied)), "method": method,
-                   "criterion": "certified verdict from every eigenvalue of the linear model about the silent motion "
-                                "(Lienard-Chipart on the exact quartic where the closed form applies)"},
-        )
-        return cls(ds)
+        return cls(xr.Dataset(data, coords=coords, attrs=_map_attrs(space, method)))
 
     @property
     def dims(self) -> tuple[str, str]:
@@ -131,7 +208,7 @@ class StabilityMap:
         """Write NetCDF3 (scipy engine); ``stable`` is stored as int8 flags."""
         ds = self.data.copy()
         ds["stable"] = ds["stable"].astype(np.int8)
-        ds["stable"].attrs.update(flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="unstable stable")
+        ds["stable"].attrs.update(_STABLE_FLAGS)
         ds.to_netcdf(path, engine="scipy")
 
     def to_csv(self, path: str) -> None:

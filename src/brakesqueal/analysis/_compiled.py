@@ -24,7 +24,8 @@ import numba
 import numpy as np
 
 __all__ = ["peval", "real_roots", "routh_interval", "routh_batch", "quartic_interval_batch", "horner_interval",
-           "descartes", "isolate_roots", "critical_batch", "UNSTABLE", "STABLE", "UNDECIDED"]
+           "descartes", "isolate_roots", "critical_batch", "quartic_factor", "quartic_top_grid", "quartic_top_rows",
+           "UNSTABLE", "STABLE", "UNDECIDED"]
 
 _JIT = dict(cache=True, error_model="numpy")
 
@@ -803,6 +804,211 @@ def critical_batch(E_all, R_all, bounds, roots_out, dirs_out, counts, start_stab
                 break
         counts[n] = m
         flags[n] = flag
+
+
+# ---------------------------------------------------------------- quartic roots (max Re λ and its frequency)
+#: Newton on the factorization stops when every relative step is below this (the error is then ~ its square).
+_QTOL = 1e-10
+
+
+@numba.njit(**_JIT)
+def _factor_newton(b0, b1, b2, b3, g):  # type: ignore[no-untyped-def]
+    """Newton's method for ``μ⁴ + b3 μ³ + b2 μ² + b1 μ + b0 = (μ² + u1 μ + v1)(μ² + u2 μ + v2)``.
+
+    ``g = (u1, v1, u2, v2)`` is the start and receives the result.  The
+    Jacobian's determinant is the resultant of the two factors, so the
+    iteration is regular unless they share a root.  Returns True when every
+    relative step fell below ``_QTOL`` within 12 iterations (each factor on its
+    own scale ``max(|u|, sqrt|v|)``, so a small root keeps its relative
+    accuracy next to a large one).
+    """
+    u1, v1, u2, v2 = g[0], g[1], g[2], g[3]
+    for _ in range(12):
+        r0 = u1 + u2 - b3
+        r1 = v1 + u1 * u2 + v2 - b2
+        r2 = u1 * v2 + u2 * v1 - b1
+        r3 = v1 * v2 - b0
+        a11 = u2 - u1
+        a21 = v2 - v1
+        s1 = r1 - u1 * r0
+        s2 = r2 - v1 * r0
+        m1 = u2 * v1 - u1 * v2
+        det = a11 * m1 + a21 * a21
+        if not (det != 0.0 and math.isfinite(det)):
+            return False
+        inv = 1.0 / det
+        du1 = (s1 * m1 - (s2 * v1 - u1 * r3) + (s2 * v2 - u2 * r3)) * inv
+        dv1 = (a11 * (s2 * v1 - u1 * r3) - s1 * a21 * v1 + a21 * r3) * inv
+        dv2 = (a11 * (u2 * r3 - s2 * v2) - a21 * r3 + s1 * a21 * v2) * inv
+        du2 = r0 - du1
+        u1 -= du1
+        v1 -= dv1
+        u2 -= du2
+        v2 -= dv2
+        if not (math.isfinite(u1) and math.isfinite(v1) and math.isfinite(u2) and math.isfinite(v2)):
+            return False
+        sc1 = max(abs(u1), math.sqrt(abs(v1)))
+        sc2 = max(abs(u2), math.sqrt(abs(v2)))
+        if (abs(du1) <= _QTOL * sc1 and abs(dv1) <= _QTOL * sc1 * sc1
+                and abs(du2) <= _QTOL * sc2 and abs(dv2) <= _QTOL * sc2 * sc2):
+            g[0], g[1], g[2], g[3] = u1, v1, u2, v2
+            return True
+    return False
+
+
+@numba.njit(**_JIT)
+def _aberth_start(b0, b1, b2, b3, g):  # type: ignore[no-untyped-def]
+    """Cold start: the four roots by the Ehrlich–Aberth iteration, paired into real quadratic factors ``g``."""
+    R = abs(b0) ** 0.25
+    for c in (abs(b1) ** (1.0 / 3.0), math.sqrt(abs(b2)), abs(b3)):
+        if not R > 0.0:
+            R = c
+    if not (R > 0.0 and math.isfinite(R)):
+        R = 1.0
+    z = np.empty(4, dtype=np.complex128)
+    for k in range(4):
+        ang = 0.4 + 0.5 * math.pi * k
+        z[k] = R * complex(math.cos(ang), math.sin(ang))
+    for _ in range(200):
+        big = 0.0
+        for i in range(4):
+            x = z[i]
+            p = (((x + b3) * x + b2) * x + b1) * x + b0
+            dp = ((4.0 * x + 3.0 * b3) * x + 2.0 * b2) * x + b1
+            if p == 0:
+                continue
+            nt = p / dp
+            sm = 0j
+            for j in range(4):
+                if j != i:
+                    sm += 1.0 / (x - z[j])
+            w = nt / (1.0 - nt * sm)
+            z[i] = x - w
+            big = max(big, abs(w) / max(abs(z[i]), 1e-300))
+        if not big < 1e300:
+            return False
+        if big < 1e-13:
+            break
+    # pair by imaginary part: (lowest, highest) and the middle two are both real-coefficient pairs
+    order = np.argsort(z.imag)
+    za, zb, zc, zd = z[order[0]], z[order[1]], z[order[2]], z[order[3]]
+    g[0] = -(za + zd).real
+    g[1] = (za * zd).real
+    g[2] = -(zb + zc).real
+    g[3] = (zb * zc).real
+    return True
+
+
+@numba.njit(**_JIT)
+def _factor_top(u, v):  # type: ignore[no-untyped-def]
+    """Largest real part of the roots of ``μ² + u μ + v`` and ``|Im|`` of that root (stable formulas)."""
+    disc = u * u - 4.0 * v
+    if disc < 0.0:
+        return -0.5 * u, 0.5 * math.sqrt(-disc)
+    q = -0.5 * (u + math.copysign(math.sqrt(disc), u))
+    r2 = v / q if q != 0.0 else 0.0
+    return max(q, r2), 0.0
+
+
+@numba.njit(**_JIT)
+def quartic_factor(b0, b1, b2, b3, g, warm):  # type: ignore[no-untyped-def]
+    """Factor the monic quartic into ``g`` (warm start from ``g`` if ``warm``, else or on failure Aberth).
+
+    Returns True when the factorization converged.
+    """
+    if warm and _factor_newton(b0, b1, b2, b3, g):
+        return True
+    if not _aberth_start(b0, b1, b2, b3, g):
+        return False
+    return _factor_newton(b0, b1, b2, b3, g)
+
+
+@numba.njit(**_JIT)
+def _top(a0, a1, a2, a3, a4, sc, g, warm, out):  # type: ignore[no-untyped-def]
+    """Rightmost root of ``Σ a_k μ^k`` times ``sc``: ``out = (Re, |Im|/2π)``; False if not found cleanly."""
+    if not (a4 != 0.0 and math.isfinite(a4) and math.isfinite(a0) and math.isfinite(a1) and math.isfinite(a2)
+            and math.isfinite(a3)):
+        return False
+    inv = 1.0 / a4
+    if not quartic_factor(a0 * inv, a1 * inv, a2 * inv, a3 * inv, g, warm):
+        return False
+    r1, i1 = _factor_top(g[0], g[1])
+    r2, i2 = _factor_top(g[2], g[3])
+    if r2 > r1:
+        r1, i1 = r2, i2
+    out[0] = r1 * sc
+    out[1] = i1 * sc / (2.0 * math.pi)
+    return math.isfinite(out[0]) and math.isfinite(out[1])
+
+
+@numba.njit(**_JIT)
+def quartic_top_grid(A, lam_e, mr, fr, ok):  # type: ignore[no-untyped-def]
+    """Max Re λ and its frequency on a grid of quartics ``A[k, row, j]`` (ascending ``k``).
+
+    The roots of row ``row`` are scaled by ``2^lam_e[row]``.
+
+    Neighbouring points warm-start each other: along a row from the factors
+    of the two previous points (extrapolated), a row's first point from the
+    previous row's first point; a start that does not converge falls back to
+    the Aberth cold start.  ``ok[row, j] = 0`` where no clean factorization
+    was found (the caller recomputes those points by a robust route).
+    """
+    rows, n = A.shape[1], A.shape[2]
+    g = np.empty(4)
+    p1 = np.empty(4)
+    p2 = np.empty(4)
+    first = np.empty(4)
+    out = np.empty(2)
+    have_first = False
+    for r in range(rows):
+        sc = math.ldexp(1.0, lam_e[r])
+        hv = 0
+        for j in range(n):
+            warm = True
+            if hv >= 2:
+                for k in range(4):
+                    g[k] = 2.0 * p1[k] - p2[k]
+            elif hv == 1:
+                g[:] = p1
+            elif have_first:
+                g[:] = first
+            else:
+                warm = False
+            good = _top(A[0, r, j], A[1, r, j], A[2, r, j], A[3, r, j], A[4, r, j], sc, g, warm, out)
+            if good:
+                mr[r, j] = out[0]
+                fr[r, j] = out[1]
+                ok[r, j] = 1
+                if hv == 0:
+                    first[:] = g
+                    have_first = True
+                p2[:] = p1
+                p1[:] = g
+                hv += 1
+            else:
+                mr[r, j] = np.nan
+                fr[r, j] = np.nan
+                ok[r, j] = 0
+                hv = 0
+
+
+@numba.njit(**_JIT)
+def quartic_top_rows(A, mr, fr, ok):  # type: ignore[no-untyped-def]
+    """Max Re λ and its frequency for quartics ``A[i, k]`` (ascending ``k``); each row warm-starts the next."""
+    g = np.empty(4)
+    out = np.empty(2)
+    warm = False
+    for i in range(A.shape[0]):
+        good = _top(A[i, 0], A[i, 1], A[i, 2], A[i, 3], A[i, 4], 1.0, g, warm, out)
+        if good:
+            mr[i] = out[0]
+            fr[i] = out[1]
+            ok[i] = 1
+        else:
+            mr[i] = np.nan
+            fr[i] = np.nan
+            ok[i] = 0
+        warm = good
 
 
 def _guard() -> None:

@@ -24,7 +24,7 @@ _POW2 = np.ldexp(1.0, -np.arange(1075))
 
 
 @numba.njit(cache=True, error_model="numpy")
-def rows_eval(exps, slot, mant, e2, Um, Qe, nops, C, EC, pow2=_POW2):  # type: ignore[no-untyped-def]
+def rows_eval(exps, slot, mant, e2, Um, Qe, nops, C, EC):  # type: ignore[no-untyped-def]
     """Fill ``C[r, s]`` (values) and ``EC[r, s]`` (absolute error bounds) for every row ``r``.
 
     ``nops[s]`` bounds the number of rounded operations per term plus the
@@ -32,6 +32,7 @@ def rows_eval(exps, slot, mant, e2, Um, Qe, nops, C, EC, pow2=_POW2):  # type: i
     (standard summation / product error analysis) plus the magnitude of any
     term that underflows.
     """
+    pow2 = _POW2  # a global array (frozen into the compiled code; a default argument defeated numba's cache)
     nt = exps.shape[0]
     nx = exps.shape[1]
     ncol = C.shape[1]
@@ -69,8 +70,11 @@ def rows_eval(exps, slot, mant, e2, Um, Qe, nops, C, EC, pow2=_POW2):  # type: i
 
 
 @numba.njit(cache=True, error_model="numpy")
-def normalise_rows(C, EC, degrees):  # type: ignore[no-untyped-def]
-    """Balance ``λ -> 2^e λ`` per row (``|N_0| ~ |N_4|``) and scale the row by a power of two (exact)."""
+def normalise_rows(C, EC, degrees, lam_e):  # type: ignore[no-untyped-def]
+    """Balance ``λ -> 2^e λ`` per row (``|N_0| ~ |N_4|``) and scale the row by a power of two (exact).
+
+    ``lam_e[r]`` receives the row's ``e`` (the roots of the scaled quartic times ``2^e`` are the ``λ``).
+    """
     offs = np.zeros(6, dtype=np.int64)
     for i in range(5):
         offs[i + 1] = offs[i] + degrees[i] + 1
@@ -84,6 +88,7 @@ def normalise_rows(C, EC, degrees):  # type: ignore[no-untyped-def]
         e = 0
         if m0 > 0.0 and m4 > 0.0 and math.isfinite(m0) and math.isfinite(m4):
             e = int(round((math.log2(m0) - math.log2(m4)) / 4.0))
+        lam_e[r] = e
         if e != 0:
             for i in range(5):
                 for k in range(offs[i], offs[i + 1]):

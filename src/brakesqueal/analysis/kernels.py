@@ -67,6 +67,7 @@ __all__ = [
     "quartic_numerators", "GridKernel", "grid_kernel", "MapKernel", "map_kernel", "classify_numpy", "real_roots",
     "trivial_entries", "RateBlocks", "zero_rate_blocks", "omega_entries", "omega_coefficients",
     "omega_kernel_available", "omega_subranges", "inner_exponent", "kernel_segments", "run_classify", "kernel_scaling",
+    "form_info", "has_model_form", "closed_route", "kernel_eigen",
 ]
 
 _U = 2.0 ** -53
@@ -182,6 +183,54 @@ def _key(spec: Any) -> str:
     from ..codegen import model_key
 
     return model_key(spec)
+
+
+def _disk_json(kind: str, ident: str, build: Callable[[], Any]) -> Any:
+    """A JSON-able value built once and kept in the on-disk cache (so that warm starts need no SymPy).
+
+    Keyed by ``kind`` and a hash of ``ident`` (model key, space key, axes); the
+    cache's fingerprint covers this module, so editing a generator rebuilds it.
+    """
+    import json
+
+    from ..numeric import cache
+
+    name = f"{kind}-{hashlib.sha256(ident.encode()).hexdigest()[:24]}.json"
+    return json.loads(cache.cached_text("stability-tables", name, lambda: json.dumps(build())))
+
+
+def form_info(spec: Any) -> dict[str, Any]:
+    """What the closed-form routes of a model need to know, without SymPy on a warm start.
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+
+    Returns
+    -------
+    dict
+        ``{"form": bool, "omega_kernel": bool}``: whether :func:`model_form`
+        applies and whether :func:`omega_kernel_available`; built once per
+        model (:func:`~brakesqueal.codegen.model_key`) and kept on disk.
+    """
+    def build() -> dict[str, Any]:
+        form = model_form(spec)
+        ok = False
+        if form is not None and form.omega is not None and form.omega_free:
+            try:
+                ok = bool(_omega_source(spec))
+            except NotImplementedError:
+                ok = False
+        return {"form": form is not None, "omega_kernel": ok}
+
+    key = _key(spec)
+    return _memo(("form-info", key), lambda: _disk_json("form", key, build))  # type: ignore[no-any-return]
+
+
+def has_model_form(spec: Any) -> bool:
+    """Whether :func:`model_form` applies to a model (cached on disk: no SymPy on a warm start)."""
+    return bool(form_info(spec)["form"])
 
 
 def model_form(spec: Any) -> ModelForm | None:
@@ -580,6 +629,19 @@ class GridKernel:
             each row multiplied by one positive power of two (balanced with
             ``λ -> 2^e λ`` and normalised); ``EC`` bounds their errors.
         """
+        C, EC, _ = self.row_tables(outer, inner_exp)
+        return C, EC
+
+    def row_tables(self, outer: list[np.ndarray], inner_exp: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`row_coefficients` and, per row, the exponent ``e`` of its balancing ``λ = 2^e ν``.
+
+        Returns
+        -------
+        C, EC : ndarray
+            As :meth:`row_coefficients`.
+        lam_e : ndarray of int64, shape (rows,)
+            The roots ``ν`` of a row's scaled quartic times ``2^lam_e`` are the eigenvalues ``λ`` [1/s].
+        """
         from ._rows import normalise_rows, rows_eval
 
         n_rows = int(np.size(outer[0])) if outer else 1
@@ -593,13 +655,14 @@ class GridKernel:
         e2 = self.e2 + inner_exp * self.ipow
         C = np.zeros((n_rows, ncol))
         EC = np.zeros((n_rows, ncol))
+        lam_e = np.zeros(n_rows, dtype=np.int64)
         rows_eval(self.exps, self.slot, self.mant, e2, Um, Qe, self.nops, C, EC)
-        normalise_rows(C, EC, np.array(self.degrees, dtype=np.int64))
+        normalise_rows(C, EC, np.array(self.degrees, dtype=np.int64), lam_e)
         bad = ~(np.all(np.isfinite(C), axis=1) & np.all(np.isfinite(EC), axis=1))
         if bad.any():  # such rows are classified uncertain (a4 = 0 with an infinite bound)
             C[bad] = 0.0
             EC[bad] = np.inf
-        return C, EC
+        return C, EC, lam_e
 
 
 def _kernel_source(degrees: tuple[int, ...]) -> str:
@@ -719,6 +782,13 @@ def _load_generated(source: str, tag: str) -> Any:
     return cache.load_module("stability-kernels", f"brakesqueal_kernel_{tag}_{digest}.py", lambda: source)
 
 
+def _load_keyed(tag: str, spec: Any, generate: Callable[[], str]) -> Any:
+    """Import a generated module named by the model's key; ``generate`` (SymPy) only runs on a cache miss."""
+    from ..numeric import cache
+
+    return cache.load_module("stability-kernels", f"brakesqueal_kernel_{tag}_{_key(spec)}.py", generate)
+
+
 #: Kernels are refused (callers use the per-point route) above these inner / outer degrees.
 MAX_INNER_DEGREE = 12
 MAX_OUTER_DEGREE = 40
@@ -749,9 +819,56 @@ def grid_kernel(space: ParameterSpace, names: tuple[str, ...]) -> GridKernel | N
     return _memo(("grid", _key(space.model), space.key(), names), lambda: _grid_kernel(space, names))
 
 
+def _space_ident(space: ParameterSpace, names: tuple[str, ...]) -> str:
+    return f"{_key(space.model)}|{space.key()}|{tuple(names)!r}"
+
+
+def closed_route(space: ParameterSpace, names: tuple[str, ...]) -> bool:
+    """Whether :func:`quartic_numerators` applies (the closed form, trivial on the whole grid), cached on disk.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space (any model).
+    names : tuple of str
+        The axes.
+
+    Returns
+    -------
+    bool
+        ``quartic_numerators(space, names) is not None``, decided once per
+        model, space and axes with SymPy and then read from the on-disk cache.
+    """
+    names = tuple(names)
+    if not has_model_form(space.model):
+        return False
+    ident = _space_ident(space, names)
+    return bool(_memo(("closed", ident),
+                      lambda: _disk_json("closed", ident, lambda: quartic_numerators(space, names) is not None)))
+
+
 def _grid_kernel(space: ParameterSpace, names: tuple[str, ...]) -> GridKernel | None:
+    if not closed_route(space, names):
+        return None
+    tab = _disk_json("grid", _space_ident(space, names), lambda: _grid_table(space, names))
+    if tab is None:
+        return None
+    degrees = tuple(int(d) for d in tab["degrees"])
+    source = _kernel_source(degrees)
+    mod = _load_generated(source, "map")
+    nt = len(tab["slot"])
+    return GridKernel(names=tuple(names), inner=int(tab["inner"]), degrees=degrees,
+                      exps=np.array(tab["exps"], dtype=np.int64).reshape(nt, len(names) - 1),
+                      ipow=np.array(tab["ipow"], dtype=np.int64), slot=np.array(tab["slot"], dtype=np.int64),
+                      mant=np.array([float.fromhex(v) for v in tab["mant"]]), e2=np.array(tab["e2"], dtype=np.int64),
+                      nops=np.array(tab["nops"], dtype=float), classify=mod.classify, coefficients=mod.coefficients,
+                      source=source)
+
+
+def _grid_table(space: ParameterSpace, names: tuple[str, ...]) -> dict[str, Any] | None:
+    """The coefficient table of a grid kernel as JSON-able data (exact mantissas as hex), or ``None``."""
     qn = quartic_numerators(space, tuple(names))
-    if qn is None:
+    if qn is None or not names:
         return None
     nax = len(names)
     terms = [numeric_terms(p, nax, qn.constants) for p in qn.N]
@@ -768,27 +885,23 @@ def _grid_kernel(space: ParameterSpace, names: tuple[str, ...]) -> GridKernel | 
             if v == 0:
                 continue
             m, e = _frexp_mp(v)
-            outer_exp = [mon[j] for j in range(nax) if j != inner]
+            outer_exp = [int(mon[j]) for j in range(nax) if j != inner]
             if sum(outer_exp) > MAX_OUTER_DEGREE:
                 return None
             rows_e.append(outer_exp)
-            rows_k.append(mon[inner])
+            rows_k.append(int(mon[inner]))
             rows_s.append(int(offs[i] + mon[inner]))
             rows_m.append(m)
-            rows_x.append(e)
+            rows_x.append(int(e))
     ncol = int(offs[-1])
     nterms = np.bincount(np.array(rows_s, dtype=np.int64), minlength=ncol)
     tdeg = np.zeros(ncol, dtype=np.int64)
     for s, ex in zip(rows_s, rows_e):
         tdeg[s] = max(tdeg[s], sum(ex))
     nops = (nterms + tdeg + 4).astype(float)
-    exps = np.array(rows_e, dtype=np.int64).reshape(len(rows_s), nax - 1)
-    source = _kernel_source(degrees)
-    mod = _load_generated(source, "map")
-    return GridKernel(names=tuple(names), inner=inner, degrees=degrees, exps=exps,
-                      ipow=np.array(rows_k, dtype=np.int64), slot=np.array(rows_s, dtype=np.int64),
-                      mant=np.array(rows_m), e2=np.array(rows_x, dtype=np.int64), nops=nops,
-                      classify=mod.classify, coefficients=mod.coefficients, source=source)
+    return {"inner": int(inner), "degrees": [int(d) for d in degrees], "exps": rows_e, "ipow": rows_k,
+            "slot": rows_s, "mant": [float(m).hex() for m in rows_m], "e2": rows_x,
+            "nops": [float(v) for v in nops]}
 
 
 def kernel_scaling(kern: GridKernel | MapKernel | None, inner_values: np.ndarray) -> tuple[int, np.ndarray] | None:
@@ -914,9 +1027,54 @@ class MapKernel:
         """``(C, EC)`` per outer value for ``t = inner / 2^inner_exp`` (see :meth:`GridKernel.row_coefficients`)."""
         return self.grid.row_coefficients([np.asarray(outer_values, dtype=float)], inner_exp)
 
+    def row_tables(self, outer_values: np.ndarray, inner_exp: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(C, EC, lam_e)`` per outer value (see :meth:`GridKernel.row_tables`)."""
+        return self.grid.row_tables([np.asarray(outer_values, dtype=float)], inner_exp)
+
     def verdicts(self, outer_values: np.ndarray, inner_values: np.ndarray) -> np.ndarray:
         """Verdict codes ``(n_outer, n_inner)``: 0 unstable, 1 stable, 2 uncertain."""
         return classify_grid_values(self.grid, [np.asarray(outer_values, dtype=float)], inner_values)
+
+
+def kernel_eigen(kern: GridKernel | MapKernel, C: np.ndarray, t: np.ndarray, lam_e: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Max Re λ and its frequency at every point of a kernel's rows (compiled roots of the quartic).
+
+    The quartic's coefficients come from the same row tables as the verdict
+    (:meth:`GridKernel.row_tables`); its roots from Newton's method on the
+    factorization into two real quadratics, warm-started from the neighbouring
+    points (:func:`~._compiled.quartic_top_grid`).
+
+    Parameters
+    ----------
+    kern : GridKernel or MapKernel
+        The kernel.
+    C : ndarray, shape (rows, ncol)
+        Row tables.
+    t : ndarray
+        Scaled inner values.
+    lam_e : ndarray of int64
+        Per row, the exponent of its balancing (``λ = 2^lam_e ν``).
+
+    Returns
+    -------
+    max_real, frequency : ndarray, shape (rows, t.size)
+        ``max Re λ`` [1/s] and ``|Im λ| / 2π`` [Hz] of that root.
+    ok : ndarray of uint8
+        0 where the roots were not found cleanly (NaN there; the caller recomputes those points).
+    """
+    from ._compiled import quartic_top_grid
+
+    t = np.ascontiguousarray(t, dtype=float)
+    rows = C.shape[0]
+    A = np.empty((5, rows, t.size))
+    kern.coefficients(C, t, A)
+    mr = np.empty((rows, t.size))
+    fr = np.empty((rows, t.size))
+    ok = np.empty((rows, t.size), dtype=np.uint8)
+    with np.errstate(all="ignore"):
+        quartic_top_grid(A, np.ascontiguousarray(lam_e, dtype=np.int64), mr, fr, ok)
+    return mr, fr, ok
 
 
 def map_kernel(space: ParameterSpace, x: str, y: str) -> MapKernel | None:
@@ -1135,15 +1293,16 @@ def _paper() -> Any:
 
 
 def _entries_generated(spec: Any) -> Any:
-    form = _form(spec)
+    if not has_model_form(spec):
+        _form(spec)  # raises the error naming the model
 
-    def build() -> Any:
+    def source() -> str:
+        form = _form(spec)
         args = list(form.symbols)
         slots = [_terms(X[i, j], args) for X in (form.M, form.D, form.K) for i in range(2) for j in range(2)]
-        return _load_generated(_bounded_source("entries_batch", slots, "Mbar, Dbar, Kbar entries (row-major)",
-                                               len(args)), "entries")
+        return _bounded_source("entries_batch", slots, "Mbar, Dbar, Kbar entries (row-major)", len(args))
 
-    return _memo(("entries", form.key), build)
+    return _memo(("entries", _key(spec)), lambda: _load_keyed("entries", spec, source))
 
 
 def trivial_entries(P: np.ndarray, spec: Any = None) -> tuple[np.ndarray, np.ndarray]:
@@ -1176,45 +1335,40 @@ def trivial_entries(P: np.ndarray, spec: Any = None) -> tuple[np.ndarray, np.nda
 # ---------------------------------------------------------------- Omega: Laurent coefficients
 def omega_kernel_available(spec: Any) -> bool:
     """Whether the critical-speed kernel applies to a model (closed form, spin a named parameter, Laurent form)."""
-    form = model_form(spec)
-    if form is None or form.omega is None or not form.omega_free:
-        return False
-    try:
-        return _omega_generated(spec) is not None
-    except NotImplementedError:
-        return False
+    return bool(form_info(spec)["omega_kernel"])
 
 
-def _omega_generated(spec: Any) -> Any:
-    """Generate and compile ``entries_batch(P, V, R)``: coefficients of ``Ω·entry`` in powers Ω^0..Ω^3 with bounds."""
+def _omega_source(spec: Any) -> str:
+    """Source of ``entries_batch(P, V, R)``: coefficients of ``Ω·entry`` in powers Ω^0..Ω^3 with bounds (SymPy)."""
     form = _form(spec)
+    if form.omega is None:
+        raise NotImplementedError(f"model '{spec.name}': the disk's spin is a number, not a parameter")
+    args = list(form.symbols)
+    iw = form.names.index(form.omega)
+    W = args[iw]
+    slots = []
+    for m in (form.M, form.D, form.K):
+        for i in range(2):
+            for j in range(2):
+                groups: list[list[tuple[Any, dict[int, int]]]] = [[], [], [], []]
+                for c, powers in _terms(m[i, j] * W, args):
+                    k = powers.pop(iw, 0)
+                    if not 0 <= k <= 3:
+                        raise NotImplementedError("closed form is not a Laurent polynomial in Omega of "
+                                                  "degree <= 2")
+                    groups[k].append((c, powers))
+                slots.extend(groups)
+    return _bounded_source("entries_batch", slots, "Laurent coefficients in Omega", len(args))
 
-    def build() -> Any:
-        if form.omega is None:
-            raise NotImplementedError(f"model '{spec.name}': the disk's spin is a number, not a parameter")
-        args = list(form.symbols)
-        iw = form.names.index(form.omega)
-        W = args[iw]
-        slots = []
-        for m in (form.M, form.D, form.K):
-            for i in range(2):
-                for j in range(2):
-                    groups: list[list[tuple[Any, dict[int, int]]]] = [[], [], [], []]
-                    for c, powers in _terms(m[i, j] * W, args):
-                        k = powers.pop(iw, 0)
-                        if not 0 <= k <= 3:
-                            raise NotImplementedError("closed form is not a Laurent polynomial in Omega of "
-                                                      "degree <= 2")
-                        groups[k].append((c, powers))
-                    slots.extend(groups)
-        return _load_generated(_bounded_source("entries_batch", slots, "Laurent coefficients in Omega", len(args)),
-                               "omega")
 
-    try:
-        return _memo(("omega", form.key), build)
-    except NotImplementedError:
-        _MEMO[("omega", form.key)] = None
-        raise
+def _omega_module(spec: Any) -> Any:
+    """The compiled Ω kernel of a model whose :func:`form_info` says it applies (no SymPy on a warm start)."""
+    key = ("omega", _key(spec))
+    if key not in _MEMO:
+        if not form_info(spec)["omega_kernel"]:
+            return None
+        _memo(key, lambda: _load_keyed("omega", spec, lambda: _omega_source(spec)))
+    return _MEMO[key]
 
 
 def omega_entries(P: np.ndarray, spec: Any = None) -> tuple[np.ndarray, np.ndarray]:
@@ -1233,7 +1387,7 @@ def omega_entries(P: np.ndarray, spec: Any = None) -> tuple[np.ndarray, np.ndarr
         ``entry = Σ_k E[.., e, k] Ω^(k-1)`` and the rounding bounds.
     """
     spec = spec if spec is not None else _paper()
-    mod = _omega_generated(spec)
+    mod = _omega_module(spec)
     if mod is None:
         raise NotImplementedError(f"model '{spec.name}' has no Laurent form in its spin")
     P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)

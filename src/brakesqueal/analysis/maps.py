@@ -30,18 +30,19 @@ bounded by ``chunk_points``.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import ParameterError
 from ..status import PointStatus
-from .kernels import kernel_scaling, kernel_segments, map_kernel
+from .robust import STABLE, UNDECIDED, UNSTABLE
+from .kernels import kernel_eigen, kernel_scaling, kernel_segments, map_kernel
 from .points import ROUTES, closed_form_route, evaluate_arrays, valid_points
 
-__all__ = ["Axis", "parse_axis", "stability_map", "classify_grid", "STATUS", "MAX_POINTS", "MAX_MAP_BYTES",
-           "map_bytes"]
+__all__ = ["Axis", "parse_axis", "stability_map", "write_map", "MapSummary", "classify_grid", "STATUS", "MAX_POINTS",
+           "MAX_MAP_BYTES", "map_bytes"]
 
 #: Meaning of the ``status`` codes of a map (:class:`~brakesqueal.status.PointStatus`).
 STATUS = {int(s): s.meaning for s in PointStatus}
@@ -209,8 +210,92 @@ def classify_grid(space: object, x: Axis, y: Axis) -> tuple[np.ndarray, str, str
     return kern.verdicts(outer.values(), inner.values()), kern.outer, kern.inner
 
 
+@dataclass(frozen=True)
+class _Plan:
+    """How a map is computed: the kernel (if any), the axes in dimension order, the route's name."""
+
+    kern: object
+    outer: Axis
+    inner: Axis
+    scaled: tuple[int, np.ndarray] | None
+    seg_T: tuple[np.ndarray, np.ndarray] | None
+    closed: bool
+    method: str
+    ftype: type
+
+
+def _plan(space: object, x: Axis, y: Axis, force: bool, eigen: bool) -> _Plan:
+    _check_axes(space, [x, y], force, eigen)
+    space.resolve({})  # type: ignore[attr-defined]
+    closed = closed_form_route(space, (x.name, y.name))
+    kern = map_kernel(space, x.name, y.name) if closed else None  # type: ignore[arg-type]
+    ax = {x.name: x, y.name: y}
+    outer, inner = (ax[kern.outer], ax[kern.inner]) if kern else (y, x)
+    scaled = kernel_scaling(kern, inner.values())
+    seg_T = kernel_segments(scaled[1]) if scaled is not None else None
+    if closed:
+        method = ("closed form: certified compiled Hurwitz kernel of the exact quartic + robust per-point route"
+                  if scaled is not None else ROUTES["closed"])
+    else:
+        method = ROUTES["points"]
+    ftype = np.float32 if outer.num * inner.num > _FLOAT32_ABOVE else np.float64
+    return _Plan(kern, outer, inner, scaled, seg_T, closed, method, ftype)
+
+
+_Rows = tuple[int, int, np.ndarray, np.ndarray, "np.ndarray | None", "np.ndarray | None"]
+
+
+def _rows(space: object, plan: _Plan, eigen: bool, chunk_points: int) -> Iterator[_Rows]:
+    """Yield ``(r0, r1, stable, status, max_real, frequency)`` for blocks of outer rows (bounded memory).
+
+    With a kernel, the verdicts are its certified codes and, with ``eigen``,
+    ``max_real``/``frequency`` are the compiled roots of the same quartic
+    (:func:`~.kernels.kernel_eigen`); only points the kernel leaves uncertain,
+    whose roots were not found cleanly or whose ``max_real`` contradicts the
+    certified verdict go through :func:`~.points.evaluate_arrays` (robust
+    per-point route, exact arithmetic where needed).
+    """
+    kern, outer, inner = plan.kern, plan.outer, plan.inner
+    ov, iv = outer.values(), inner.values()
+    n_o, n_i = ov.size, iv.size
+    rows = max(1, chunk_points // n_i)
+    buf = np.empty((min(rows, n_o), n_i), dtype=np.uint8)
+    for r0 in range(0, n_o, rows):
+        r1 = min(n_o, r0 + rows)
+        arr = space.arrays({outer.name: ov[r0:r1, None], inner.name: iv[None, :]})  # type: ignore[attr-defined]
+        valid = np.broadcast_to(valid_points(space, arr), (r1 - r0, n_i))
+        if kern is None or plan.scaled is None or plan.seg_T is None:
+            res = evaluate_arrays(space, arr, eigen=eigen, closed=plan.closed, valid=valid)
+            yield r0, r1, res.stable, res.status, (res.max_real if eigen else None), (res.frequency if eigen else None)
+            continue
+        codes = buf[: r1 - r0]
+        C, EC, lam_e = kern.row_tables(ov[r0:r1], plan.scaled[0])  # type: ignore[attr-defined]
+        kern.classify(C, EC, plan.scaled[1], plan.seg_T[0], plan.seg_T[1], codes)  # type: ignore[attr-defined]
+        mr = fr = None
+        if eigen:
+            mr, fr, found = kernel_eigen(kern, C, plan.scaled[1], lam_e)  # type: ignore[arg-type]
+            good = valid & found.view(bool) & (((codes == STABLE) & (mr < 0)) | ((codes == UNSTABLE) & (mr >= 0)))
+            mr[~valid] = np.nan
+            fr[~valid] = np.nan
+        else:
+            good = valid & (codes != UNDECIDED)
+        stable = good & (codes == STABLE)
+        status = np.where(valid, np.int8(PointStatus.OK), np.int8(PointStatus.INVALID))
+        redo = np.nonzero(valid & ~good)
+        if redo[0].size:
+            sub = space.arrays({outer.name: ov[r0:r1][redo[0]], inner.name: iv[redo[1]]})  # type: ignore[attr-defined]
+            res = evaluate_arrays(space, sub, eigen=eigen, codes=codes[redo], closed=True,
+                                  valid=np.ones(redo[0].size, dtype=bool))
+            stable[redo] = res.stable
+            status[redo] = res.status
+            if mr is not None and fr is not None:
+                mr[redo] = res.max_real
+                fr[redo] = res.frequency
+        yield r0, r1, stable, status, mr, fr
+
+
 def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen: bool = True,
-                  chunk_points: int = 1 << 20, progress: Callable[[float], None] | None = None) -> object:
+                  chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None) -> object:
     """Compute a stability map over two settable parameters of ``space``.
 
     Parameters
@@ -249,43 +334,95 @@ def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen
     """
     from ..results import StabilityMap
 
-    _check_axes(space, [x, y], force, eigen)
-    space.resolve({})  # type: ignore[attr-defined]
-    closed = closed_form_route(space, (x.name, y.name))
-    kern = map_kernel(space, x.name, y.name) if closed else None  # type: ignore[arg-type]
-    ax = {x.name: x, y.name: y}
-    outer, inner = (ax[kern.outer], ax[kern.inner]) if kern else (y, x)
-    ov, iv = outer.values(), inner.values()
-    n_o, n_i = ov.size, iv.size
-    scaled = kernel_scaling(kern, iv)
-    seg_T = kernel_segments(scaled[1]) if scaled is not None else None
-    ftype = np.float32 if n_o * n_i > _FLOAT32_ABOVE else np.float64
+    plan = _plan(space, x, y, force, eigen)
+    n_o, n_i = plan.outer.num, plan.inner.num
     stable = np.zeros((n_o, n_i), dtype=bool)
     status = np.zeros((n_o, n_i), dtype=np.int8)
-    max_real = np.full((n_o, n_i), np.nan, dtype=ftype) if eigen else None
-    freq = np.full((n_o, n_i), np.nan, dtype=ftype) if eigen else None
-    rows = max(1, chunk_points // n_i)
-    buf = np.empty((rows, n_i), dtype=np.uint8)
-    for r0 in range(0, n_o, rows):
-        r1 = min(n_o, r0 + rows)
-        arr = space.arrays({outer.name: ov[r0:r1, None], inner.name: iv[None, :]})  # type: ignore[attr-defined]
-        codes = None
-        if kern is not None and scaled is not None and seg_T is not None:
-            codes = buf[: r1 - r0]
-            C, EC = kern.row_coefficients(ov[r0:r1], scaled[0])
-            kern.classify(C, EC, scaled[1], seg_T[0], seg_T[1], codes)
-        res = evaluate_arrays(space, arr, eigen=eigen, codes=codes, closed=closed, valid=valid_points(space, arr))
-        stable[r0:r1] = res.stable
-        status[r0:r1] = res.status
+    max_real = np.full((n_o, n_i), np.nan, dtype=plan.ftype) if eigen else None
+    freq = np.full((n_o, n_i), np.nan, dtype=plan.ftype) if eigen else None
+    for r0, r1, st, ss, mr, fr in _rows(space, plan, eigen, chunk_points):
+        stable[r0:r1] = st
+        status[r0:r1] = ss
         if max_real is not None and freq is not None:
-            max_real[r0:r1] = res.max_real
-            freq[r0:r1] = res.frequency
+            max_real[r0:r1] = mr
+            freq[r0:r1] = fr
         if progress is not None:
             progress(r1 / n_o)
-    if closed:
-        method = ("closed form: certified compiled Hurwitz kernel of the exact quartic + robust per-point route"
-                  if scaled is not None else ROUTES["closed"])
-    else:
-        method = ROUTES["points"]
-    return StabilityMap.from_arrays(space, outer, inner, stable=stable, status=status, max_real=max_real,
-                                    frequency=freq, method=method)
+    return StabilityMap.from_arrays(space, plan.outer, plan.inner, stable=stable, status=status, max_real=max_real,
+                                    frequency=freq, method=plan.method)
+
+
+@dataclass(frozen=True)
+class MapSummary:
+    """What :func:`write_map` reports about the map it wrote.
+
+    Attributes
+    ----------
+    points : int
+        Number of grid points.
+    stable_fraction : float
+        Fraction of points certified stable.
+    method : str
+        The route (the file's ``method`` attribute).
+    outer, inner : Axis
+        The axes in the file's dimension order.
+    """
+
+    points: int
+    stable_fraction: float
+    method: str
+    outer: Axis
+    inner: Axis
+
+
+def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False, eigen: bool = True,
+              chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None) -> MapSummary:
+    """Compute a stability map and write it to a NetCDF3 file without holding it as an xarray Dataset.
+
+    Same results and file as ``stability_map(...).to_netcdf(path)`` (read
+    back with :func:`brakesqueal.results.open_map`), with less time and memory:
+    the result arrays are the file's variables (:class:`brakesqueal.results.MapFile`),
+    filled chunk by chunk, and neither xarray nor a copy of the map is needed.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space.
+    x, y : Axis
+        The axes.
+    path : str
+        The NetCDF file to write (the caller makes it atomic).
+    force, eigen, chunk_points, progress
+        As :func:`stability_map`.
+
+    Returns
+    -------
+    MapSummary
+
+    Raises
+    ------
+    ParameterError
+        As :func:`stability_map`.
+    """
+    from ..results import MapFile
+
+    plan = _plan(space, x, y, force, eigen)
+    n_o = plan.outer.num
+    f = MapFile(path, space, plan.outer, plan.inner, eigen=eigen, float_dtype=plan.ftype)
+    n_stable = 0
+    try:
+        for r0, r1, st, ss, mr, fr in _rows(space, plan, eigen, chunk_points):
+            f.stable[r0:r1] = st
+            f.status[r0:r1] = ss
+            n_stable += int(np.count_nonzero(st))
+            if f.max_real is not None and f.frequency is not None:
+                f.max_real[r0:r1] = mr
+                f.frequency[r0:r1] = fr
+            if progress is not None:
+                progress(r1 / n_o)
+    except BaseException:
+        f.abort()
+        raise
+    f.close(plan.method)
+    n = n_o * plan.inner.num
+    return MapSummary(n, n_stable / n, plan.method, plan.outer, plan.inner)

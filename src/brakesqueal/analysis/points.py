@@ -205,9 +205,9 @@ def closed_form_route(space: Any, names: tuple[str, ...]) -> bool:
         silent motion is identically trivial on the axes (every zero-state
         residual vanishes under the space's ties).
     """
-    from .kernels import quartic_numerators
+    from .kernels import closed_route
 
-    return quartic_numerators(space, tuple(names)) is not None
+    return closed_route(space, tuple(names))
 
 
 class _Model:
@@ -217,11 +217,11 @@ class _Model:
 
     def __init__(self, spec: Any) -> None:
         from ..codegen import compile_model
-        from .kernels import model_form
+        from .kernels import has_model_form
 
         self.spec = spec
         self.cm = compile_model(spec)
-        self.form = model_form(spec)
+        self.has_form = has_model_form(spec)  # read from the on-disk cache: no SymPy on a warm start
         self.rate_free = all(self.cm.rate_free_at_zero)
 
     @classmethod
@@ -422,7 +422,7 @@ def _trivial_batch(model: _Model, P: np.ndarray, eigen: bool, codes: np.ndarray 
     fr = np.full(N, np.nan)
     if N == 0:
         return status, out, mr, fr
-    if model.form is not None:
+    if model.has_form:
         for b0 in range(0, N, _BATCH_CLOSED):
             sl = slice(b0, min(N, b0 + _BATCH_CLOSED))
             c, m, f = trivial_verdicts(P[sl], eigen=eigen, codes=None if codes is None else codes[sl],
@@ -489,7 +489,7 @@ def evaluate_arrays(space: Any, arr: Mapping[str, Any], *, eigen: bool = True, c
     shape = np.broadcast_shapes(*(np.shape(v) for v in arr.values()))
     model = _Model.of(space.model)
     ok = np.broadcast_to(valid_points(space, arr) if valid is None else valid, shape)
-    if closed and model.form is not None and codes is not None and not eigen:
+    if closed and model.has_form and codes is not None and not eigen:
         # verdict-only closed-form route: the kernel's certified codes; recompute only its uncertain points
         kc = np.broadcast_to(codes, shape)
         status = np.where(ok, np.int8(PointStatus.OK), np.int8(PointStatus.INVALID))
@@ -516,7 +516,7 @@ def evaluate_arrays(space: Any, arr: Mapping[str, Any], *, eigen: bool = True, c
     ix = np.unravel_index(flat, shape)
     vecs = space.vectors({k: compact(v) for k, v in arr.items()})
     P = np.stack([np.broadcast_to(v, shape)[ix] for v in vecs], axis=1) if vecs else np.zeros((flat.size, 0))
-    if closed and model.form is not None:
+    if closed and model.has_form:
         triv = np.ones(flat.size, dtype=bool)
     else:
         triv = _is_trivial(model, P)

@@ -89,7 +89,7 @@ def map_(
     progress: ProgressOpt = None,
 ) -> None:
     """Stability map over two parameters of any model: NetCDF (stable, status, max_real, frequency); optional plot."""
-    from ..analysis.maps import parse_axis, stability_map
+    from ..analysis.maps import parse_axis, write_map
     from ..outputs import atomic_write, check_output
     from ._progress import progress as _progress
 
@@ -98,16 +98,15 @@ def map_(
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     space = space_from(model, preset, params, set_)
-    with _progress("map", progress) as cb:
-        m = stability_map(space, ax_x, ax_y, force=force, eigen=not no_eigen, progress=cb)
-    with atomic_write(out, what="--out") as tmp:
-        m.to_netcdf(str(tmp))  # type: ignore[attr-defined]
+    with _progress("map", progress) as cb, atomic_write(out, what="--out") as tmp:
+        s = write_map(space, ax_x, ax_y, str(tmp), force=force, eigen=not no_eigen, progress=cb)
     msg = f"wrote {out}"
     if plot:
-        _write_plot(m.plot(x=ax_x.name), plot)  # type: ignore[attr-defined]
+        from ..results import open_map
+
+        _write_plot(open_map(out).plot(x=ax_x.name), plot)
         msg += f" and {plot}"
-    st = m.data["stable"].values  # type: ignore[attr-defined]
-    sys.stdout.write(f"{msg} ({st.size} points, {100 * st.mean():.1f}% stable; {m.data.attrs['method']})\n")  # type: ignore[attr-defined]
+    sys.stdout.write(f"{msg} ({s.points} points, {100 * s.stable_fraction:.1f}% stable; {s.method})\n")
 
 
 def reproduce(
