@@ -1,40 +1,47 @@
-"""Analysis layer: silent motion, linear models, eigen-analysis, stability maps, crossings, critical speeds."""
+"""Analysis layer: silent motion, linear models, eigen-analysis, stability maps, crossings, critical speeds.
 
-from .equilibrium import SilentMotion, silent_motion
-from .linear import LinearModel, linearize, pad_rate_eigenvalues
-from .stability import (
-    Axis,
-    EigenAnalysis,
-    ParameterSpace,
-    PointVerdict,
-    Points,
-    Verdict,
-    critical_speeds,
-    critical_speeds_many,
-    crossings,
-    eigen_analysis,
-    evaluate,
-    evaluate_point,
-    stability_map,
-)
+The names are loaded on first use (PEP 562), so that importing one light
+module (e.g. :mod:`.linear` for ``brakesqueal linearize``) does not import the
+compiled stability kernels (numba).
+"""
 
-__all__ = [
-    "SilentMotion",
-    "silent_motion",
-    "LinearModel",
-    "linearize",
-    "pad_rate_eigenvalues",
-    "Axis",
-    "EigenAnalysis",
-    "ParameterSpace",
-    "PointVerdict",
-    "Points",
-    "Verdict",
-    "critical_speeds",
-    "critical_speeds_many",
-    "crossings",
-    "eigen_analysis",
-    "evaluate",
-    "evaluate_point",
-    "stability_map",
-]
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+#: Public name -> submodule that defines it.
+_WHERE = {
+    "SilentMotion": "equilibrium",
+    "silent_motion": "equilibrium",
+    "LinearModel": "linear",
+    "linearize": "linear",
+    "pad_rate_eigenvalues": "linear",
+    "Axis": "stability",
+    "EigenAnalysis": "stability",
+    "ParameterSpace": "stability",
+    "PointVerdict": "stability",
+    "Points": "stability",
+    "Verdict": "stability",
+    "critical_speeds": "stability",
+    "critical_speeds_many": "stability",
+    "crossings": "stability",
+    "eigen_analysis": "stability",
+    "evaluate": "stability",
+    "evaluate_point": "stability",
+    "stability_map": "stability",
+}
+
+__all__ = list(_WHERE)
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _WHERE:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
