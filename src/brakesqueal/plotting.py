@@ -51,8 +51,9 @@ def plot_map(m: Any, ax: Any = None, *, x: str | None = None, title: str | None 
     ax.set_ylabel(_label(yn, ds[yn].attrs.get("units", "")))
     from matplotlib.patches import Patch
 
+    # a fixed place beside the axes: loc="best" tests every cell of the mesh (minutes for 1e6 cells)
     ax.legend(handles=[Patch(color="#c8e6c9", label="stable"), Patch(color="#f4c7c3", label="unstable (squeal)")],
-              loc="best", fontsize=8)
+              loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8)
     ax.set_title(title or f"stability map ({ds.attrs.get('space', '')})")
     return fig
 
