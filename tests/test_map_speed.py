@@ -190,3 +190,20 @@ def test_lazy_imports(tmp_path):
     args = ["map", "--x", "k_ip=1e5:1e10:30:log", "--y", "mu=0.05:1:20", "--out", str(tmp_path / "m.nc")]
     assert _modules_after(args, env) == ["numba"]
     assert (tmp_path / "m.nc").exists()
+
+
+@pytest.mark.parametrize("x", ["k_ip", "mu"])
+def test_plot_map_file_same_image_as_dataset_plot(tmp_path, x):
+    """The CLI's plot from the file (no xarray) is pixel for pixel the StabilityMap.plot figure."""
+    import matplotlib.image as mimage
+
+    from brakesqueal.results import open_map, plot_map_file
+
+    space = ParameterSpace.from_preset("paper-fig2")
+    path = str(tmp_path / "m.nc")
+    write_map(space, Axis("k_ip", -1e6, 1e9, 40), Axis("mu", -0.1, 1.0, 30), path)  # invalid points: hatched
+    plot_map_file(path, x=x).savefig(tmp_path / "a.png", dpi=80)
+    open_map(path).plot(x=x).savefig(tmp_path / "b.png", dpi=80)
+    a, b = mimage.imread(tmp_path / "a.png"), mimage.imread(tmp_path / "b.png")
+    assert a.shape == b.shape and np.array_equal(a, b)
+    assert np.unique(a.reshape(-1, a.shape[-1]), axis=0).shape[0] > 10  # something was drawn

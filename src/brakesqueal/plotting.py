@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["new_figure", "plot_map", "plot_path", "plot_critical_curves", "save"]
+__all__ = ["new_figure", "plot_map", "plot_map_arrays", "plot_path", "plot_critical_curves", "save"]
 
 
 def new_figure(ax: Any = None, size: tuple[float, float] = (6.4, 4.8)) -> tuple[Any, Any]:
@@ -27,34 +27,58 @@ def _label(name: str, units: str) -> str:
 
 def plot_map(m: Any, ax: Any = None, *, x: str | None = None, title: str | None = None) -> Any:
     """Plot a :class:`~brakesqueal.results.StabilityMap`: stable region, boundary, invalid points."""
-    from matplotlib.colors import ListedColormap
-
-    fig, ax = new_figure(ax)
     outer, inner = m.dims
     ds = m.data
     xn = x or inner
     yn = outer if xn == inner else inner
-    st = ds["stable"].transpose(yn, xn).values.astype(float)
-    status = ds["status"].transpose(yn, xn).values
-    xs, ys = ds[xn].values, ds[yn].values
-    z = np.where(status >= 2, np.nan, st)
+    axes = [(n, ds[n].values, ds[n].attrs.get("units", ""), ds[n].attrs.get("scale") == "log") for n in (xn, yn)]
+    return plot_map_arrays(axes[0], axes[1], ds["stable"].transpose(yn, xn).values,
+                           ds["status"].transpose(yn, xn).values, ax=ax,
+                           title=title or f"stability map ({ds.attrs.get('space', '')})")
+
+
+def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, np.ndarray, str, bool],
+                    stable: np.ndarray, status: np.ndarray, *, ax: Any = None, title: str = "") -> Any:
+    """Plot a stability map given as arrays (what :func:`plot_map` draws, without xarray).
+
+    Parameters
+    ----------
+    xaxis, yaxis : tuple
+        ``(name, values, units, log)`` of the horizontal and vertical axes.
+    stable, status : ndarray, shape (len(y values), len(x values))
+        Certified verdicts and :class:`~brakesqueal.status.PointStatus` codes.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into (default: a new figure).
+    title : str
+        Axes title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    fig, ax = new_figure(ax)
+    (xn, xs, xu, xlog), (yn, ys, yu, ylog) = xaxis, yaxis
+    status = np.asarray(status)
+    z = np.where(status >= 2, np.nan, np.asarray(stable, dtype=float))
     ax.pcolormesh(xs, ys, z, cmap=ListedColormap(["#f4c7c3", "#c8e6c9"]), vmin=0, vmax=1, shading="nearest",
                   rasterized=True)
     if np.any(status >= 2):
         ax.contourf(xs, ys, (status >= 2).astype(float), levels=[0.5, 1.5], colors="none", hatches=["xx"])
     if 0 < np.nanmean(z) < 1:
         ax.contour(xs, ys, np.nan_to_num(z, nan=0.0), levels=[0.5], colors="k", linewidths=1.2)
-    for name, setter in ((xn, ax.set_xscale), (yn, ax.set_yscale)):
-        if ds[name].attrs.get("scale") == "log":
-            setter("log")
-    ax.set_xlabel(_label(xn, ds[xn].attrs.get("units", "")))
-    ax.set_ylabel(_label(yn, ds[yn].attrs.get("units", "")))
-    from matplotlib.patches import Patch
-
+    if xlog:
+        ax.set_xscale("log")
+    if ylog:
+        ax.set_yscale("log")
+    ax.set_xlabel(_label(xn, xu))
+    ax.set_ylabel(_label(yn, yu))
     # a fixed place beside the axes: loc="best" tests every cell of the mesh (minutes for 1e6 cells)
     ax.legend(handles=[Patch(color="#c8e6c9", label="stable"), Patch(color="#f4c7c3", label="unstable (squeal)")],
               loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8)
-    ax.set_title(title or f"stability map ({ds.attrs.get('space', '')})")
+    ax.set_title(title)
     return fig
 
 

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["StabilityMap", "CrossingResult", "CriticalSpeedResult", "open_map", "MapFile"]
+__all__ = ["StabilityMap", "CrossingResult", "CriticalSpeedResult", "open_map", "MapFile", "plot_map_file"]
 
 _AUX_UNITS = {"mu": "", "k_ip": "N/m", "h": "m", "R_disk": "m"}
 
@@ -257,6 +257,45 @@ def open_map(path: str) -> StabilityMap:
     ds = xr.open_dataset(path, engine="scipy").load()
     ds["stable"] = ds["stable"].astype(bool)
     return StabilityMap(ds)
+
+
+def plot_map_file(path: str, *, x: str | None = None, title: str | None = None) -> Any:
+    """Plot a map file written by :class:`MapFile` or :meth:`StabilityMap.to_netcdf` without xarray.
+
+    Parameters
+    ----------
+    path : str
+        The NetCDF3 file (read with :func:`scipy.io.netcdf_file`).
+    x : str, optional
+        The horizontal axis (default the inner dimension).
+    title : str, optional
+        Axes title (default names the space, as :meth:`StabilityMap.plot`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The same figure :meth:`StabilityMap.plot` draws for the map.
+    """
+    from scipy.io import netcdf_file
+
+    from .plotting import plot_map_arrays
+
+    with netcdf_file(path, "r", mmap=False, maskandscale=False) as f:
+        outer, inner = f.variables["stable"].dimensions
+        xn = x or inner
+        yn = outer if xn == inner else inner
+        st, ss = np.asarray(f.variables["stable"].data), np.asarray(f.variables["status"].data)
+        if xn == outer:
+            st, ss = st.T, ss.T
+
+        def axis(n: str) -> tuple[str, np.ndarray, str, bool]:
+            v = f.variables[n]
+            text = {k: (a.decode() if isinstance(a, bytes) else a) for k, a in v._attributes.items()}
+            return n, np.array(v.data, dtype=float), str(text.get("units", "")), text.get("scale") == "log"
+
+        space = f._attributes.get("space", b"")
+        space = space.decode() if isinstance(space, bytes) else str(space)
+        return plot_map_arrays(axis(xn), axis(yn), st.astype(bool), ss, title=title or f"stability map ({space})")
 
 
 @dataclass(frozen=True)

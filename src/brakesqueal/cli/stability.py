@@ -102,9 +102,9 @@ def map_(
         s = write_map(space, ax_x, ax_y, str(tmp), force=force, eigen=not no_eigen, progress=cb)
     msg = f"wrote {out}"
     if plot:
-        from ..results import open_map
+        from ..results import plot_map_file
 
-        _write_plot(open_map(out).plot(x=ax_x.name), plot)
+        _write_plot(plot_map_file(out, x=ax_x.name), plot)
         msg += f" and {plot}"
     sys.stdout.write(f"{msg} ({s.points} points, {100 * s.stable_fraction:.1f}% stable; {s.method})\n")
 
