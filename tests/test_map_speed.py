@@ -183,10 +183,12 @@ def _modules_after(args, env):
 
 
 def test_lazy_imports(tmp_path):
-    """``--help`` imports none of numba/xarray/dask/matplotlib; ``map`` without ``--plot`` no xarray/matplotlib/dask."""
+    """``--help`` and warm ``linearize`` import none of numba/xarray/dask/matplotlib; ``map`` (no plot) only numba."""
     env = dict(os.environ, PYTHONPATH=os.path.abspath(SRC))
     assert _modules_after(["--help"], env) == []
     assert _modules_after(["map", "--help"], env) == []
+    _modules_after(["linearize"], env)  # warms the cache
+    assert _modules_after(["linearize"], env) == []
     args = ["map", "--x", "k_ip=1e5:1e10:30:log", "--y", "mu=0.05:1:20", "--out", str(tmp_path / "m.nc")]
     assert _modules_after(args, env) == ["numba"]
     assert (tmp_path / "m.nc").exists()
@@ -207,3 +209,51 @@ def test_plot_map_file_same_image_as_dataset_plot(tmp_path, x):
     a, b = mimage.imread(tmp_path / "a.png"), mimage.imread(tmp_path / "b.png")
     assert a.shape == b.shape and np.array_equal(a, b)
     assert np.unique(a.reshape(-1, a.shape[-1]), axis=0).shape[0] > 10  # something was drawn
+
+
+def _random_quartics(rng, n):
+    """Interval quartics of every kind: random scales over the whole range, zeros, tiny/huge radii, inf/nan."""
+    A = rng.normal(size=(n, 5)) * 10.0 ** rng.integers(-150, 150, size=(n, 1)) * 10.0 ** rng.uniform(-3, 3, (n, 5))
+    A[rng.random((n, 5)) < 0.05] = 0.0
+    pos = rng.random(n) < 0.5  # many all-positive rows (where the Routh test has work to do)
+    A[pos] = np.abs(A[pos])
+    R = np.abs(A) * 10.0 ** rng.uniform(-17, -2, (n, 5))
+    A[rng.random((n, 5)) < 0.01] = np.inf
+    A[rng.random((n, 5)) < 0.01] = np.nan
+    return A, R
+
+
+def test_pure_python_twin_bit_for_bit():
+    """The plain-Python twin of the interval kernels gives exactly the compiled results (random, extreme input)."""
+    from brakesqueal.analysis import _compiled
+    from brakesqueal.analysis._pure import call, twin
+
+    rng = np.random.default_rng(5)
+    n = 3000
+    A, R = _random_quartics(rng, n)
+    E = rng.normal(size=(n, 12)) * 10.0 ** rng.integers(-100, 100, size=(n, 1)) * 10.0 ** rng.uniform(-4, 4, (n, 12))
+    RE = np.abs(E) * 10.0 ** rng.uniform(-17, -3, (n, 12))
+    E[rng.random((n, 12)) < 0.005] = np.inf
+    py = twin()
+    for i in range(n):
+        a, r = A[i:i + 1], R[i:i + 1]
+        o1, o2 = np.empty(1, np.uint8), np.empty(1, np.uint8)
+        _compiled.routh_batch(a, r, o1)
+        call("routh_batch", 1, a, r, o2)  # twin, or the compiled kernel where Python raised
+        assert o1[0] == o2[0], (a, r)
+        q1, rq1, q2, rq2 = (np.empty((1, 5)) for _ in range(4))
+        _compiled.quartic_interval_batch(E[i:i + 1], RE[i:i + 1], q1, rq1)
+        call("quartic_interval_batch", 1, E[i:i + 1], RE[i:i + 1], q2, rq2)
+        assert np.array_equal(q1, q2, equal_nan=True) and np.array_equal(rq1, rq2, equal_nan=True)
+    # most rows really ran as Python (not the fallback), and the verdicts are not all the same
+    ran, codes = 0, []
+    for i in range(200):
+        o = np.empty(1, np.uint8)
+        try:
+            with np.errstate(all="ignore"):
+                py.routh_batch(A[i:i + 1], R[i:i + 1], o)
+            ran += 1
+            codes.append(int(o[0]))
+        except (ArithmeticError, ValueError):
+            pass
+    assert ran > 150 and len(set(codes)) == 3

@@ -107,13 +107,13 @@ def routh_verdicts(coeffs: np.ndarray, radii: np.ndarray | None = None) -> np.nd
     only when its interval excludes zero.  Rows are rescaled by powers of two
     and ``λ -> 2^e λ`` balances the outer coefficients, both exact.
     """
-    from ._compiled import routh_batch
+    from ._pure import call
 
     A = np.ascontiguousarray(np.atleast_2d(np.asarray(coeffs, dtype=float)))
     R = np.zeros_like(A) if radii is None else np.ascontiguousarray(np.broadcast_to(
         np.atleast_2d(np.asarray(radii, dtype=float)), A.shape))
     out = np.empty(A.shape[0], dtype=np.uint8)
-    routh_batch(A, R, out)
+    call("routh_batch", A.shape[0], A, R, out)  # a few rows: plain Python (no numba import)
     return out
 
 
@@ -292,13 +292,13 @@ def quartic_interval(E: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarr
     ``E`` holds the 12 entries of ``M, D, K`` (row-major, shape ``(n, 12)``),
     ``R`` their absolute error bounds; returns ``(A, RA)`` of shape ``(n, 5)``.
     """
-    from ._compiled import quartic_interval_batch
+    from ._pure import call
 
     E = np.ascontiguousarray(np.atleast_2d(E), dtype=float)
     R = np.ascontiguousarray(np.broadcast_to(np.atleast_2d(R), E.shape), dtype=float)
     A = np.empty((E.shape[0], 5))
     RA = np.empty((E.shape[0], 5))
-    quartic_interval_batch(E, R, A, RA)
+    call("quartic_interval_batch", E.shape[0], E, R, A, RA)  # a few rows: plain Python (no numba import)
     return A, RA
 
 
