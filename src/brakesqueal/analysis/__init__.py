@@ -8,6 +8,8 @@ compiled stability kernels (numba).
 from __future__ import annotations
 
 import importlib
+import sys
+import types
 from typing import Any
 
 #: Public name -> submodule that defines it.
@@ -45,3 +47,15 @@ def __getattr__(name: str) -> Any:
 
 def __dir__() -> list[str]:
     return sorted(set(globals()) | set(__all__))
+
+
+class _Package(types.ModuleType):
+    """Keeps public functions named like a submodule (``crossings``) when the import system binds the submodule."""
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in _WHERE and isinstance(value, types.ModuleType):
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
