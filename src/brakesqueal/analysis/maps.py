@@ -156,9 +156,11 @@ def map_bytes(points: int, eigen: bool) -> int:
         Twice the result arrays (``stable`` and ``status``, 1 byte each, and
         two float arrays, 8 bytes each or 4 above 2e7 points: the NetCDF3
         writer holds a converted copy of every variable until the file is
-        closed) plus 256 MiB for the chunk buffers and the interpreter.
-        Measured: 0.86 GiB for a 1e8-point verdict-only map, 2.7 GiB with
-        ``max_real`` and ``frequency``.
+        closed) plus 256 MiB for the chunk buffers and the interpreter: a bound
+        for :func:`stability_map` followed by ``to_netcdf``.  :func:`write_map`
+        (the ``map`` command) holds the result arrays once plus one variable's
+        copy while writing: measured 1.5 GiB peak RSS for a 1e8-point map with
+        ``max_real`` and ``frequency`` (float32).
     """
     per = 2 + (2 * (4 if points > _FLOAT32_ABOVE else 8) if eigen else 0)
     return 2 * per * points + 2**28
