@@ -31,12 +31,13 @@ Test functions, evaluated at every point and located by the Illinois
 label     test function                                               event
 ========  ==========================================================  ==========================
 ``LPC``   p-component of the tangent                                  fold of cycles
-``PD``    ``prod (1 + mu_i)`` over non-trivial multipliers              period doubling (mu = -1)
-``NS``    ``prod_{i<j} (mu_i mu_j - 1)``, kept if a complex pair is on  Neimark-Sacker (torus)
-          the unit circle (else a neutral saddle, discarded)
-``BPC``   ``prod (mu_i - 1)`` when the tangent test does not change   branch point of cycles
-``GR``    the multiset of switching events per period changes (by      grazing / contact change
-          bisection)                                                  (piecewise systems)
+``PD``    ``prod (1 + mu_i)`` over non-trivial multipliers            period doubling (mu = -1)
+``NS``    ``prod_{i<j} (mu_i mu_j - 1)``, kept if a complex           Neimark-Sacker (torus)
+          pair is on the unit circle (else a neutral saddle)
+``BPC``   ``prod (mu_i - 1)`` when the tangent test does not          branch point of cycles
+          change
+``GR``    the multiset of switching events per period changes         grazing / contact change
+          (located by bisection)                                      (piecewise systems)
 ``EP``    the end of the parameter range                              end point
 ========  ==========================================================  ==========================
 """
