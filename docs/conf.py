@@ -63,7 +63,10 @@ html_static_path: list[str] = []
 
 # The README's ``console`` blocks hold comments with apostrophes, which Pygments' console lexer
 # cannot tokenize; Sphinx then falls back to plain text.  Only the colouring is affected.
-suppress_warnings = ["misc.highlighting_failure"]
+# Attribute fields named ``n``/``m`` (sizes) exist on several classes; napoleon's ``:ivar:`` turns each
+# into an unqualified cross-reference that Sphinx calls ambiguous ("ref.python").  The link resolves to
+# one of the candidates; the text is right either way.
+suppress_warnings = ["misc.highlighting_failure", "ref.python"]
 
 # Pages placed by hand in index.md; every other top-level page is listed under "Guides".
 bsdocs_fixed_pages = ["index", "getting-started", "theory", "paper-errata", "api", "cli", "benchmarks", "gallery"]

@@ -272,6 +272,10 @@ BAD = [
     ('preset = "paper-fig3"\n[tied]\nmu2 = "1 - mu1"\n[axes]\nmu2 = "0.1:0.9:3"', "key 'axes.mu2': cannot vary"),
     ('preset = "paper-fig2"\n[axes]\nmu = "0.1:1:5"\n[samples]\nn = 3', "exactly one of [axes]"),
     ('preset = "paper-fig2"\n[axes]\nmu = "0.1:1:5', "is not valid TOML"),
+    ('preset = "paper-fig3"\n[tied]\nk_ip1 = "k_ip2"\nk_ip2 = "2 * k_ip1"\n[axes]\nmu = "0.1:1:3"',
+     "key 'tied.k_ip1': preset 'paper-fig3+ties': the definitions form a cycle"),
+    ('preset = "paper-fig3"\n[tied]\nh10 = "h20"\nh20 = "k_ip2"\nk_ip2 = "h10 * 1e9"\n[axes]\nmu = "0.1:1:3"',
+     "key 'tied.h10'"),
 ]
 
 

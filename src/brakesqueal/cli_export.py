@@ -57,8 +57,8 @@ def describe_source(space: Any, model: str | None, params: str | None, sets: lis
 
 
 def _export_cmd(
-    to: Annotated[Target, typer.Option("--to", help="Output language: latex, octave (also MATLAB), c, julia or python.")],
-    out: Annotated[str, typer.Option("--out", help="Output file ('-' for stdout); its stem names the Octave function.")],
+    to: Annotated[Target, typer.Option("--to", help="Output language: latex, octave (MATLAB), c, julia or python.")],
+    out: Annotated[str, typer.Option("--out", help="Output file ('-' for stdout); its stem names the function.")],
     what: Annotated[
         What,
         typer.Option(
@@ -71,7 +71,7 @@ def _export_cmd(
     ] = None,
     preset: Annotated[
         Optional[str],
-        typer.Option("--preset", help="Named parameter template for parameters() (default: the model's, or paper-fig2)."),
+        typer.Option("--preset", help="Named parameter template for parameters() (default: the model's)."),
     ] = None,
     params: Annotated[Optional[str], typer.Option("--params", help="TOML parameter file for parameters().")] = None,
     set_: Annotated[

@@ -61,7 +61,9 @@ def _simulate_cmd(
     model: Annotated[
         Optional[str], typer.Option("--model", help="Model TOML file or built-in model (default: the paper's model).")
     ] = None,
-    preset: Annotated[Optional[str], typer.Option("--preset", help="Named parameter template (default paper-fig2).")] = None,
+    preset: Annotated[
+        Optional[str], typer.Option("--preset", help="Named parameter template (default paper-fig2).")
+    ] = None,
     params: Annotated[Optional[str], typer.Option("--params", help="TOML parameter file.")] = None,
     set_: Annotated[
         Optional[list[str]], typer.Option("--set", help="Override NAME=VALUE (repeatable; VALUE may be 'inf').")
@@ -80,13 +82,18 @@ def _simulate_cmd(
     ] = None,
     method: Annotated[str, typer.Option("--method", help="DOP853-jit (default) or a solve_ivp method.")] = "DOP853-jit",
     rtol: Annotated[float, typer.Option("--rtol", help="Relative tolerance, in [1e-13, 1e-2].")] = 1e-9,
-    atol: Annotated[Optional[float], typer.Option("--atol", help="Absolute tolerance (default scaled from rtol).")] = None,
-    events: Annotated[str, typer.Option("--events", help="stop | continue | off (contact loss, sliding reversal).")] = "stop",
+    atol: Annotated[Optional[float], typer.Option("--atol", help="Absolute tolerance (default from rtol).")] = None,
+    events: Annotated[
+        str, typer.Option("--events", help="stop | continue | off (contact loss, sliding reversal).")
+    ] = "stop",
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Output samples per second [Hz].")] = 44100.0,
     out: Annotated[Optional[str], typer.Option("--out", help="Write the trajectory to this NetCDF file.")] = None,
-    plot: Annotated[Optional[str], typer.Option("--plot", help="Write the plot (time history, phase, spectrum).")] = None,
+    plot: Annotated[Optional[str], typer.Option("--plot", help="Write the plot (time history, phase, spectrum).")] = (
+        None
+    ),
     wav: Annotated[
-        Optional[str], typer.Option("--wav", help="Write the rim's normal velocity (a belt: the pad's) as 44.1 kHz audio.")
+        Optional[str],
+        typer.Option("--wav", help="Write the rim's normal velocity (a belt: the pad's) as 44.1 kHz audio."),
     ] = None,
     fmt: Annotated[str, typer.Option("--format", help="Summary format: text | json.")] = "text",
     progress: Annotated[bool, typer.Option("--progress/--no-progress", help="Show a progress bar on stderr.")] = True,

@@ -1417,7 +1417,7 @@ def omega_coefficients(p: np.ndarray, spec: Any = None) -> np.ndarray:
 
 
 def omega_subranges(lo: float, hi: float, decades: float = 6.0) -> np.ndarray:
-    """Sub-range limits ``lo = b_0 < ... < b_J = hi`` with internal limits powers of two, ratio ≤ ~``10^decades``."""
+    """Sub-range limits ``lo = b_0 < b_1 < … < b_J = hi`` with internal limits powers of two, ratio ≲ ``10^decades``."""
     if not (0 < lo < hi and math.isfinite(hi)):
         from ..errors import ParameterError
 

@@ -320,7 +320,7 @@ def linearize(params: Any, *, model: Any = None, pad_rates: str = "kept", use_ca
     sm = silent_motion(params, model=cm)
     p = parameter_vector(params)
     b = _blocks(cm, None if sm.trivial else sm.state(), p)
-    n, m = cm.n, cm.m
+    m = cm.m
     M, D, K = b["R_ddQ"].copy(), b["R_dQ"].copy(), b["R_Q"].copy()
     if m == 0:
         return LinearModel(params=params, silent=sm, M=M, D=D, K=K, pad_rates=pad_rates)

@@ -62,7 +62,7 @@ class Axis:
     ----------
     name : str
         The parameter the axis varies: a settable name of the
-                :class:`~brakesqueal.model.parameters.ParameterSpace` (a model parameter such as ``Omega`` or
+        :class:`~brakesqueal.model.parameters.ParameterSpace` (a model parameter such as ``Omega`` or
         a preset's auxiliary name such as ``mu`` or ``k_ip``).
     start, stop : float
         Range of the axis in the SI unit of ``name`` (e.g. rad/s for

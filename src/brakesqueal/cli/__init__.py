@@ -121,7 +121,7 @@ def eigen(
     mode: Annotated[int, typer.Option("--mode", help="Mode whose Re(lambda) is attributed to matrix entries "
                                       "(0 = least stable).", min=0)] = 0,
 ) -> None:
-    """Eigen-analysis at one point: frequencies, damping ratios, mode shapes, sensitivities, attribution of Re(lambda)."""
+    """Eigen-analysis at one point: frequencies, damping ratios, mode shapes, sensitivities, attribution of Re λ."""
     from ..analysis.eigen import eigen_analysis
     from ..render import render_eigen
 
@@ -189,8 +189,10 @@ def show(name: Annotated[str, typer.Argument(help="A preset or a model (built-in
             from ..model.library import MODELS, preset_names
             from ..suggest import did_you_mean
 
-            raise ParameterError(f"'{name}' is neither a preset nor a model{did_you_mean(name, [*preset_names(), *MODELS])}"
-                                 f"; see brakesqueal list presets / list models") from None
+            raise ParameterError(
+                f"'{name}' is neither a preset nor a model{did_you_mean(name, [*preset_names(), *MODELS])}"
+                f"; see brakesqueal list presets / list models"
+            ) from None
     if fmt == OutFormat.json:
         sys.stdout.write(json.dumps({
             "name": pr.name, "model": pr.model.name, "description": pr.description, "reference": pr.reference,

@@ -82,7 +82,10 @@ def _helpers(model: ExportModel) -> list[str]:
                       f"        if (brakesqueal_solve_linear({m}, J, s)) return 1;",
                       f"        for (int j = 0; j < {m}; ++j) {{", "            const double step = s[j];"]
         else:
-            lines += [f"        for (int j = 0; j < {m}; ++j) {{", f"            const double step = g[j] / g[{m} + j];"]
+            lines += [
+                f"        for (int j = 0; j < {m}; ++j) {{",
+                f"            const double step = g[j] / g[{m} + j];",
+            ]
         lines += ["            if (!isfinite(step)) return 1;", f"            {za}[j] -= step;",
                   f"            if (!(fabs(step) <= {RTOL} * fabs({za}[j]))) done = 0;", "        }",
                   "        if (done) return 0; /* converged steps */", "    }", "    return 1;", "}", ""]
@@ -139,7 +142,9 @@ def print_c(model: ExportModel, out_name: str = "brakesqueal_model") -> str:
         return ccode(e, standard="c99")
 
     head = [ln.replace("*/", "* /") for ln in model.header_lines()]
-    lines = ["/*"] + comment(head, " *") + [" *", f" * Compile: gcc -std=c99 -O2 -c {out_name}.c (link with -lm)", " */"]
+    lines = (
+        ["/*"] + comment(head, " *") + [" *", f" * Compile: gcc -std=c99 -O2 -c {out_name}.c (link with -lm)", " */"]
+    )
     lines += ["#include <math.h>", ""]
     for fn in model.functions:
         sig = ", ".join([f"const double *{a}" for a, _ in fn.inputs] + [f"double *{o}" for o, *_ in fn.outputs])

@@ -45,8 +45,10 @@ def _tuple(items: list[str]) -> str:
 def _helpers(model: ExportModel) -> list[str]:
     n, m, za = model.n, model.m, model.z_arg
     lines = [_SOLVE, ""]
-    lines += ["def solve_pads(y, p):",
-              f'    """Newton\'s method for G(y, {za}) = 0 from {za} = 0; returns the pad unknowns {za} (see the header)."""']
+    lines += [
+        "def solve_pads(y, p):",
+        f'    """Newton\'s method for G(y, {za}) = 0 from {za} = 0; returns the pad unknowns {za} (see the header)."""',
+    ]
     if m == 0:
         lines += ["    return ()", "", ""]
     else:

@@ -47,7 +47,9 @@ def _is_name(v: object) -> bool:
     return isinstance(v, str)
 
 
-def _check_value(component: str, field_name: str, v: object, *, allow_inf: bool = False, optional: bool = False) -> None:
+def _check_value(
+    component: str, field_name: str, v: object, *, allow_inf: bool = False, optional: bool = False
+) -> None:
     if v is None and optional:
         return
     if isinstance(v, str):
@@ -272,7 +274,11 @@ class Pad:
             raise ParameterError(f"{c}: a component name must be letters, digits or '_'")
         if self.face not in FACES:
             raise ParameterError(f"{c}: face must be 'upper' or 'lower'; got {self.face!r}")
-        if isinstance(self.angle_deg, bool) or not isinstance(self.angle_deg, (int, float)) or not math.isfinite(self.angle_deg):
+        if (
+            isinstance(self.angle_deg, bool)
+            or not isinstance(self.angle_deg, (int, float))
+            or not math.isfinite(self.angle_deg)
+        ):
             raise ParameterError(f"{c}: angle_deg must be a finite number of degrees; got {self.angle_deg!r}")
         for f in ("radius", "k", "d", "preload", "d_ip", "d_c"):
             _check_value(c, f, getattr(self, f))
@@ -439,7 +445,11 @@ class ModelSpec:
         for p in self.pads:
             if p.mount is not None and p.mount not in calipers:
                 raise ParameterError(f"{p.label}: mount '{p.mount}' is not a caliper of the model")
-        n = (2 if self.disk.tilting else 0) + sum(len(p.dofs) for p in self.pads) + sum(len(c.dofs) for c in self.calipers)
+        n = (
+            (2 if self.disk.tilting else 0)
+            + sum(len(p.dofs) for p in self.pads)
+            + sum(len(c.dofs) for c in self.calipers)
+        )
         if n == 0:
             raise ParameterError(f"{where}: has no degree of freedom (a non-tilting disk needs a pad with mass)")
         if n > MAX_COORDINATES:

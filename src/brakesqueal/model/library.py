@@ -28,7 +28,7 @@ from ..errors import ParameterError
 from .components import Caliper, Disk, FrictionLaw, ModelSpec, Pad
 from .parameters import Preset
 
-__all__ = ["MODELS", "ALIASES", "get_model", "paper_parameters", "resolve_model", "get_preset", "PRESETS",
+__all__ = ["MODELS", "ALIASES", "get_model", "paper_parameters", "resolve_model", "get_preset", "PRESETS",  # noqa: F822
            "preset_names"]
 
 
@@ -172,8 +172,19 @@ def _six_dof() -> ModelSpec:
 
 
 def _eight_dof() -> ModelSpec:
-    par = {**paper_parameters(), **_pad_values(), "m_p": 0.5, "k_c": 1e9, "d_c": 20.0, "d_ip": 10.0, "m_c": 3.0, "k_cn": 5e7,
-           "k_ct": 5e7, "d_cn": 100.0, "d_ct": 100.0}
+    par = {
+        **paper_parameters(),
+        **_pad_values(),
+        "m_p": 0.5,
+        "k_c": 1e9,
+        "d_c": 20.0,
+        "d_ip": 10.0,
+        "m_c": 3.0,
+        "k_cn": 5e7,
+        "k_ct": 5e7,
+        "d_cn": 100.0,
+        "d_ct": 100.0,
+    }
     cal = Caliper("caliper", mass="m_c", k_n="k_cn", d_n="d_cn", k_t="k_ct", d_t="d_ct")
     return ModelSpec("eight-dof", Disk(), _paper_pads(mass=True, mount="caliper"), calipers=(cal,), parameters=par,
                      description="six-dof with both pads' supports on a floating caliper of mass m_c that moves "

@@ -110,7 +110,9 @@ class CompiledFlow:
 
     def __post_init__(self) -> None:
         if not isinstance(self.system, SmoothSystem):
-            raise ParameterError(f"CompiledFlow: 'system' must be a SmoothSystem (no events); got {type(self.system).__name__}")
+            raise ParameterError(
+                f"CompiledFlow: 'system' must be a SmoothSystem (no events); got {type(self.system).__name__}"
+            )
         if self.kernels is None:
             self.kernels = getattr(self.system, "_kernels", None)
         if self.kernels is None or len(self.kernels) != 3:
@@ -157,7 +159,11 @@ class CompiledFlow:
         if self.atol is not None:
             ax = np.broadcast_to(np.asarray(self.atol, dtype=float), (n,)).copy()
         else:
-            s = np.asarray(scale, dtype=float) if scale is not None else np.full(n, max(float(np.max(np.abs(x0))), 1e-300))
+            s = (
+                np.asarray(scale, dtype=float)
+                if scale is not None
+                else np.full(n, max(float(np.max(np.abs(x0))), 1e-300))
+            )
             ax = 1e-3 * self.rtol * np.maximum(s, 1e-300)
         if sensitivities:
             y = np.concatenate([x0, np.hstack([np.eye(n), np.zeros((n, 1))]).ravel()])

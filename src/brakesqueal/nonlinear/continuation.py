@@ -31,12 +31,13 @@ Test functions, evaluated at every point and located by the Illinois
 label     test function                                               event
 ========  ==========================================================  ==========================
 ``LPC``   p-component of the tangent                                  fold of cycles
-``PD``    ``prod (1 + mu_i)`` over non-trivial multipliers              period doubling (mu = -1)
-``NS``    ``prod_{i<j} (mu_i mu_j - 1)``, kept if a complex pair is on  Neimark-Sacker (torus)
-          the unit circle (else a neutral saddle, discarded)
-``BPC``   ``prod (mu_i - 1)`` when the tangent test does not change   branch point of cycles
-``GR``    the multiset of switching events per period changes (by      grazing / contact change
-          bisection)                                                  (piecewise systems)
+``PD``    ``prod (1 + mu_i)`` over non-trivial multipliers            period doubling (mu = -1)
+``NS``    ``prod_{i<j} (mu_i mu_j - 1)``, kept if a complex           Neimark-Sacker (torus)
+          pair is on the unit circle (else a neutral saddle)
+``BPC``   ``prod (mu_i - 1)`` when the tangent test does not          branch point of cycles
+          change
+``GR``    the multiset of switching events per period changes         grazing / contact change
+          (located by bisection)                                      (piecewise systems)
 ``EP``    the end of the parameter range                              end point
 ========  ==========================================================  ==========================
 """
@@ -612,9 +613,11 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
     if hopf is not None:
         if hopf.side == 0:
             raise ParameterError(f"cannot continue cycles from a {hopf.criticality} or non-transversal Hopf point "
-                                 f"(l1 = {hopf.l1:.3g} +- {hopf.l1_error:.2g}, dRe_lambda_dp = {hopf.dRe_lambda_dp:.3g})")  # fmt: skip
+                                 f"(l1 = {hopf.l1:.3g} +- {hopf.l1_error:.2g}, "
+                                 f"dRe_lambda_dp = {hopf.dRe_lambda_dp:.3g})")  # fmt: skip
         if not (lo <= hopf.p0 <= hi):
-            raise ParameterError(f"The option 'p_range' must contain the Hopf point {hopf.parameter_name} = {hopf.p0:.12g}; "
+            raise ParameterError(f"The option 'p_range' must contain the Hopf point "
+                                 f"{hopf.parameter_name} = {hopf.p0:.12g}; "
                                  f"got {p_range!r}")  # fmt: skip
         reach = (hi - hopf.p0) if hopf.side > 0 else (hopf.p0 - lo)
         if reach <= 0:
@@ -659,7 +662,9 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
         if direction not in (-1, 1):
             raise ParameterError(f"The option 'direction' must be +1 or -1; got {direction!r}")
         if not (lo <= start.p <= hi):
-            raise ParameterError(f"The option 'p_range' must contain the start orbit's p = {start.p:.12g}; got {p_range!r}")
+            raise ParameterError(
+                f"The option 'p_range' must contain the start orbit's p = {start.p:.12g}; got {p_range!r}"
+            )
         X0 = np.array(start.x, dtype=float, ndmin=2)
         if X0.shape[0] != m:
             fr = flow(X0[0], start.period, start.p, sensitivities=False, n_samples=m)
@@ -791,8 +796,11 @@ def _build(eng: _Engine, points: list[_Point], special_rows: list[tuple[str, int
             "period": ("point", T, {"units": "s"}),
             "frequency": ("point", 1.0 / T, {"units": "Hz"}),
             "omega": ("point", 2 * np.pi / T, {"units": "rad/s"}),
-            "amplitude": (("point", "coord"), np.array([o.amplitude for o in orbits]),
-                          {"long_name": "first-harmonic amplitude"}),
+            "amplitude": (
+                ("point", "coord"),
+                np.array([o.amplitude for o in orbits]),
+                {"long_name": "first-harmonic amplitude"},
+            ),
             "mean": (("point", "coord"), np.array([o.mean for o in orbits])),
             "x_max": (("point", "coord"), np.array([o.x_max for o in orbits])),
             "x_min": (("point", "coord"), np.array([o.x_min for o in orbits])),
@@ -811,11 +819,20 @@ def _build(eng: _Engine, points: list[_Point], special_rows: list[tuple[str, int
             "special_index": ("special", np.array([i for _, i, _ in special_rows], dtype=int)),
             "special_p": ("special", np.array([p[i] for _, i, _ in special_rows])),
             "special_period": ("special", np.array([T[i] for _, i, _ in special_rows])),
-            "special_amplitude": (("special", "coord"), np.array([orbits[i].amplitude for _, i, _ in special_rows]).reshape(-1, n)),
+            "special_amplitude": (
+                ("special", "coord"),
+                np.array([orbits[i].amplitude for _, i, _ in special_rows]).reshape(-1, n),
+            ),
             "special_description": ("special", np.array([d for _, _, d in special_rows], dtype=object).astype(str)),
         },  # fmt: skip
-        coords={"point": np.arange(P), "coord": names, "p": ("point", p), "phase": np.arange(ns) / ns,
-                "floquet": np.arange(n - 1), "special": np.arange(len(special_rows))},  # fmt: skip
+        coords={
+            "point": np.arange(P),
+            "coord": names,
+            "p": ("point", p),
+            "phase": np.arange(ns) / ns,
+            "floquet": np.arange(n - 1),
+            "special": np.arange(len(special_rows)),
+        },  # fmt: skip
     )
     if pn != "p":
         ds[pn] = ("point", p)
@@ -825,7 +842,8 @@ def _build(eng: _Engine, points: list[_Point], special_rows: list[tuple[str, int
         "message": message,
         "n_segments": eng.m,
         "monodromy_method": orbits[-1].monodromy_method if orbits else "",
-        "integrator": type(eng.flow).__name__ + (f" {getattr(eng.flow, 'method', '')} rtol={getattr(eng.flow, 'rtol', '')}"),
+        "integrator": f"{type(eng.flow).__name__} {getattr(eng.flow, 'method', '')} "
+        f"rtol={getattr(eng.flow, 'rtol', '')}",
         "newton_tol": eng.tol,
         "stable_definition": "all non-trivial Floquet multipliers strictly inside the unit circle",
         "hopf_point_row": "label H: zero amplitude, multipliers exp(lambda_i T0) with the critical pair as 1; "

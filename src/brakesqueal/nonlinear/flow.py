@@ -41,7 +41,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ..errors import BrakesquealError, ParameterError
-from .system import PiecewiseSystem, SmoothSystem
+from .system import PiecewiseSystem, SmoothSystem, Transition
 
 __all__ = ["Flow", "FlowResult", "ScipyFlow", "FlowError", "Event"]
 
@@ -185,11 +185,15 @@ class ScipyFlow:
 
     def __post_init__(self) -> None:
         if not isinstance(self.system, (SmoothSystem, PiecewiseSystem)):
-            raise ParameterError(f"ScipyFlow: 'system' must be a SmoothSystem or PiecewiseSystem; got {type(self.system).__name__}")
+            raise ParameterError(
+                f"ScipyFlow: 'system' must be a SmoothSystem or PiecewiseSystem; got {type(self.system).__name__}"
+            )
         if not (isinstance(self.rtol, (int, float)) and 1e-13 <= self.rtol <= 1e-3):
             raise ParameterError(f"The option 'rtol' must be in [1e-13, 1e-3]; got {self.rtol!r}")
         if self.monodromy not in ("variational", "finite-difference"):
-            raise ParameterError(f"The option 'monodromy' must be 'variational' or 'finite-difference'; got {self.monodromy!r}")
+            raise ParameterError(
+                f"The option 'monodromy' must be 'variational' or 'finite-difference'; got {self.monodromy!r}"
+            )
         self._pw = self.system.as_piecewise()
 
     # ------------------------------------------------------------------ API
@@ -231,7 +235,11 @@ class ScipyFlow:
         if self.atol is not None:
             ax = np.broadcast_to(np.asarray(self.atol, dtype=float), (n,)).copy()
         else:
-            s = np.asarray(scale, dtype=float) if scale is not None else np.full(n, max(float(np.max(np.abs(x0))), 1e-300))
+            s = (
+                np.asarray(scale, dtype=float)
+                if scale is not None
+                else np.full(n, max(float(np.max(np.abs(x0))), 1e-300))
+            )
             ax = 1e-3 * self.rtol * np.maximum(s, 1e-300)
         if not sens:
             return ax

@@ -244,7 +244,8 @@ def _sampled(flow: Any, X: np.ndarray, T: float, p: float, scale: np.ndarray, n_
                             transversality=e.transversality, x=e.x) for e in fr.events)  # fmt: skip
     if s_list:
         S = np.vstack(s_list)
-        out = {"t": np.concatenate(t_list), "samples": S, "amplitude": 2 * np.abs(np.fft.rfft(S, axis=0)[1]) / S.shape[0],
+        out = {"t": np.concatenate(t_list), "samples": S,
+               "amplitude": 2 * np.abs(np.fft.rfft(S, axis=0)[1]) / S.shape[0],
                "mean": S.mean(axis=0), "x_max": S.max(axis=0), "x_min": S.min(axis=0)}  # fmt: skip
     else:
         nan = np.full(n, np.nan)

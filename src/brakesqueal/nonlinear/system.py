@@ -81,7 +81,9 @@ def _first_dir(jac: Fun, x: np.ndarray, p: float, d: np.ndarray, h: float) -> tu
     return nrm * (d1 + (d1 - d2) / 15), nrm * err
 
 
-def _second_dir(jac: Fun, x: np.ndarray, p: float, d: np.ndarray, h: float, J0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _second_dir(
+    jac: Fun, x: np.ndarray, p: float, d: np.ndarray, h: float, J0: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """``(D^2 J[d, d], error estimate)`` for a real direction ``d``."""
     dh, nrm = _unit(d)
     if nrm == 0.0:
@@ -269,7 +271,9 @@ class SmoothSystem:
         if self.state_names is None:
             object.__setattr__(self, "state_names", tuple(f"x{i + 1}" for i in range(self.n)))
         elif len(self.state_names) != self.n:
-            raise ParameterError(f"SmoothSystem: 'state_names' must have n = {self.n} names; got {len(self.state_names)}")
+            raise ParameterError(
+                f"SmoothSystem: 'state_names' must have n = {self.n} names; got {len(self.state_names)}"
+            )
 
     # ------------------------------------------------------------- evaluation
     @property
@@ -573,7 +577,8 @@ class PiecewiseSystem:
             raise ParameterError(f"PiecewiseSystem: all modes must have the same dimension n; got {sorted(ns)}")
         if len(self.transitions) != len(modes):
             raise ParameterError(
-                f"PiecewiseSystem: 'transitions' must have one tuple per mode ({len(modes)}); got {len(self.transitions)}"
+                f"PiecewiseSystem: 'transitions' must have one tuple per mode ({len(modes)}); "
+                f"got {len(self.transitions)}"
             )
         for i, ts in enumerate(self.transitions):
             for t in ts:

@@ -91,7 +91,8 @@ class SimulationModel:
 
     @property
     def coords(self) -> tuple[str, ...]:
-        """Coordinates ``Q`` (the names of :attr:`LinearModel.coords <brakesqueal.analysis.linear.LinearModel.coords>`)."""
+        """Coordinates ``Q`` (the names of
+        :attr:`LinearModel.coords <brakesqueal.analysis.linear.LinearModel.coords>`)."""
         return tuple(self.kernels.META["coords"])
 
     @property
@@ -267,7 +268,7 @@ class SimulationModel:
 
 
 def _own_linear_matrix(model: SimulationModel, params: Any, sm: Any) -> np.ndarray:
-    """State matrix of ``E xi' = A xi``, ``xi = (dQ, dQdot, dL_dyn)``: quasi-static pads eliminated with ``ldot = 0``."""
+    """State matrix of ``E xi' = A xi``, ``xi = (dQ, dQdot, dL_dyn)``; quasi-static pads eliminated (``ldot = 0``)."""
     cm = model.compiled
     p = list(map(float, params.vector()))
     n, m = cm.n, cm.m
@@ -754,9 +755,9 @@ class _Run:
                 break
             w0 = time.perf_counter()
             status, t, h, i_out, i_est, n_ev, k_event, t_event = k.dop853(
-                y, f, l, dl, ev_old, ev_prev, self.p, st.ztol, st.vr0, t, self.t1, h, self.rtol, self.atol, self.max_step,
-                self.t_out, i_out, Y, est.t0, est.dt, i_est, est.buf, mode, ev_t, ev_k, n_ev, chunk, stats,
-                y_event, *tables)  # fmt: skip
+                y, f, l, dl, ev_old, ev_prev, self.p, st.ztol, st.vr0, t, self.t1, h, self.rtol, self.atol,
+                self.max_step, self.t_out, i_out, Y, est.t0, est.dt, i_est, est.buf, mode, ev_t, ev_k, n_ev, chunk,
+                stats, y_event, *tables)  # fmt: skip
             dt = time.perf_counter() - w0
             check_interrupt()
             est.count = int(i_est)

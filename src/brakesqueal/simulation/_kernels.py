@@ -437,7 +437,7 @@ def _bisect(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb):
 
 @njit(cache=True)
 def _golden(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb):
-    """Minimum of event k on [a, b] (golden-section search, 48 steps): returns (x, value); stops early at a value <= 0."""
+    """Minimum of event k on [a, b] (48 golden-section steps): returns (x, value); stops early at a value <= 0."""
     lb[:] = l0
     dlb[:] = dl0
     r = 0.6180339887498949

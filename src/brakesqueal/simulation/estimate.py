@@ -47,8 +47,8 @@ import numpy as np
 from ..errors import ParameterError
 
 __all__ = [
-    "LinearModes", "ModalFit", "ModeEstimate", "PencilModes", "linear_modes", "modal_coordinate", "fit_modal_coordinate",
-    "modal_projection", "matrix_pencil", "dominant_mode", "points_per_period",
+    "LinearModes", "ModalFit", "ModeEstimate", "PencilModes", "linear_modes", "modal_coordinate",
+    "fit_modal_coordinate", "modal_projection", "matrix_pencil", "dominant_mode", "points_per_period",
 ]  # fmt: skip
 
 #: Relative threshold below which samples of ``|z|`` are left out of the fit (noise floor of the integration).

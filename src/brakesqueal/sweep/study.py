@@ -494,11 +494,27 @@ def _preset_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str | No
     try:
         space = build_space(preset_name, tuple(values.items()), tuple(tied_tab.items()), model_json)
     except ParameterError as exc:
-        bad = next((f"parameters.{k}" for k in values if f"'{k}'" in str(exc)), None)
-        bad = bad or next((f"tied.{k}" for k in tied_tab if f"'{k}'" in str(exc)), "parameters")
+        bad = _offending_key(str(exc), values, tied_tab)
         raise ctx.err(bad, str(exc)) from None
 
     return preset_name, values, tied_tab, space, model_json
+
+
+def _offending_key(msg: str, values: dict[str, Value], tied: dict[str, Any]) -> str:
+    """The study-file key an error message of the parameter layer is about (a tie cycle: the first tie in it)."""
+    import re
+
+    def named(k: str) -> bool:
+        return re.search(rf"(?<![\w.]){re.escape(k)}(?![\w])", msg) is not None
+
+    if "cycle" in msg:
+        cyc = next((f"tied.{k}" for k in tied if named(k)), None)
+        if cyc:
+            return cyc
+    return (next((f"parameters.{k}" for k in values if f"'{k}'" in msg), None)
+            or next((f"tied.{k}" for k in tied if f"'{k}'" in msg), None)
+            or next((f"tied.{k}" for k in tied if named(k)), None)
+            or "parameters")
 
 
 def _model_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str, dict[str, Value], Any]:
