@@ -43,9 +43,13 @@ def test_2d_grid_equals_stability_map():
     assert ds["stable"].dims == ("mu", "k_ip") and load_study(study).n_chunks > 1
     m = stability_map(ParameterSpace.from_preset("paper-fig2"), parse_axis("k_ip=1e5:1e10:31:log"),
                       parse_axis("mu=0.05:1:23")).data.transpose("mu", "k_ip")
-    for v in ("stable", "status", "max_real", "frequency"):
+    for v in ("stable", "status"):
         np.testing.assert_array_equal(ds[v].values, m[v].values)
     mr, fr = ds["max_real"].values, ds["frequency"].values
+    # the map's compiled quartic roots and the sweep's companion eigenvalues agree to rounding of |λ|
+    lam = np.hypot(mr, 2 * np.pi * fr)
+    assert np.all(np.abs(mr - m["max_real"].values) <= 1e-12 * lam)
+    assert np.all(2 * np.pi * np.abs(fr - m["frequency"].values) <= 1e-12 * lam)
     np.testing.assert_allclose(ds["margin"].values, -mr / np.hypot(mr, 2 * np.pi * fr))
     assert 0.2 < ds["stable"].values.mean() < 0.8
 
