@@ -523,3 +523,19 @@ def test_fingerprint_changes_with_every_generator_file(tmp_path, monkeypatch):
         assert cache.source_fingerprint() == base
     finally:
         cache.source_fingerprint.cache_clear()
+
+
+def test_every_module_with_numba_disk_caching_guards_it():
+    """A module with ``njit(cache=True)`` functions must guard them (damaged or unwritable cache files are misses)."""
+    unguarded = []
+    for rel, path in _modules().items():
+        text = path.read_text(encoding="utf-8")
+        tree = ast.parse(text)
+        decorated = any(
+            isinstance(d, ast.Call) and any(k.arg == "cache" and getattr(k.value, "value", None) is True
+                                            for k in d.keywords)
+            for node in ast.walk(tree) if isinstance(node, ast.FunctionDef) for d in node.decorator_list
+        )
+        if decorated and "guard_numba_caches(" not in text:
+            unguarded.append(rel)
+    assert not unguarded, f"numba disk caches not guarded (call guard_numba_caches): {unguarded}"

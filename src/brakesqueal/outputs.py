@@ -124,9 +124,6 @@ def atomic_write(path: str | os.PathLike[str], *, what: str = "output file") -> 
         raise OutputError(f"{what}: cannot write '{path}': {describe_oserror(exc)}") from None
     os.close(fd)
     tmp = Path(tmp_name)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the file the usual permissions
     try:
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; the result gets the permissions of a plain open()
         yield tmp

@@ -102,3 +102,12 @@ def normalise_rows(C, EC, degrees, lam_e):  # type: ignore[no-untyped-def]
             for k in range(C.shape[1]):
                 C[r, k] = math.ldexp(C[r, k], sh)
                 EC[r, k] = math.ldexp(EC[r, k], sh)
+
+
+def _guard() -> None:
+    from ..numeric.cache import guard_numba_caches
+
+    guard_numba_caches(globals())  # a damaged or unwritable numba cache file is recompiled, never an error
+
+
+_guard()

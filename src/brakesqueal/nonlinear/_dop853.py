@@ -180,3 +180,12 @@ def dop853(f, jac, dfdp, y0, p, th, T, rtol, atol, sens, t_samples, samples, h0,
         if steps > max_steps:
             return -2, nfev, h
     return 0, nfev, h
+
+
+def _guard() -> None:
+    from ..numeric.cache import guard_numba_caches
+
+    guard_numba_caches(globals())  # a damaged or unwritable numba cache file is recompiled, never an error
+
+
+_guard()
