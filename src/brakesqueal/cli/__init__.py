@@ -220,6 +220,37 @@ def _register_plugins() -> None:
 
 _register_plugins()
 
+#: One complete sentence per command for the command list of ``brakesqueal --help`` (Click would cut the
+#: docstring's first sentence at 45 characters); the command's own ``--help`` shows its whole docstring.
+SUMMARIES: dict[str, str] = {
+    "derive": "Symbolic M, D, K about the zero state (eqs. 51-61).",
+    "linearize": "Silent motion, M, D, K, eigenvalues and verdict at one point.",
+    "eigen": "Modes, damping, sensitivities and attribution of Re λ at one point.",
+    "list": "List the built-in models or presets.",
+    "show": "Parameters of a preset or components of a model.",
+    "crossings": "Exact stability changes along a parameter path.",
+    "critical-speed": "Onsets and re-stabilisations of squeal along Omega.",
+    "map": "Stability map over two parameters (NetCDF and figure).",
+    "reproduce": "Reproduce the paper's Figures 2 and 3.",
+    "modes": "Mode-coupling diagram: every mode along a parameter path.",
+    "sweep": "Resumable N-D parameter study into a Zarr store.",
+    "simulate": "Integrate the nonlinear equations; summary, NetCDF, WAV.",
+    "export": "Write equations as LaTeX, Octave, C, Julia or Python.",
+    "bench": "Measure speed against a baseline run in the same process.",
+    "cache": "Inspect or clear the code cache.",
+}
+
+
+def _apply_summaries() -> None:
+    """Give every registered command and group its complete one-line summary."""
+    for info in [*app.registered_commands, *app.registered_groups]:
+        name = info.name or (info.callback.__name__ if getattr(info, "callback", None) else None)
+        if name in SUMMARIES:
+            info.short_help = SUMMARIES[name]
+
+
+_apply_summaries()
+
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point: run the CLI, turning user errors into one stderr line (exit 2) and interrupts into exit 130.
