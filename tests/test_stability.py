@@ -75,7 +75,7 @@ def test_map_dataset_consistent_with_linearize():
     m = stability_map(FIG2, Axis("k_ip", 1e5, 1e10, 9, True), Axis("mu", 0.1, 1.0, 7))
     ds = m.to_xarray()
     assert set(ds.data_vars) >= {"max_real", "stable", "frequency", "status"}
-    assert set(ds.dims) == {"k_ip", "mu"}
+    assert set(ds["stable"].dims) == {"k_ip", "mu"}
     for kv in ds["k_ip"].values[::3]:
         for mv in ds["mu"].values[::3]:
             lm = linearize(FIG2.resolve({"k_ip": float(kv), "mu": float(mv)}))

@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Callable, TypeVar
 
 import numpy as np
 
-__all__ = ["new_figure", "plot_map", "plot_map_arrays", "plot_path", "plot_critical_curves", "save"]
+__all__ = ["new_figure", "styled", "plot_map", "plot_map_arrays", "map_title", "MAP_COLORS", "plot_path",
+           "plot_critical_curves", "save"]
+
+F = TypeVar("F", bound=Callable[..., Any])
 
 
-def new_figure(ax: Any = None, size: tuple[float, float] = (6.4, 4.8)) -> tuple[Any, Any]:
-    """A new ``(figure, axes)`` pair on the Agg canvas, or the figure of ``ax``."""
+def new_figure(ax: Any = None, size: tuple[float, float] = (3.5, 2.6)) -> tuple[Any, Any]:
+    """A new ``(figure, axes)`` pair on the Agg canvas (single journal column by default), or the figure of ``ax``."""
     if ax is not None:
         return ax.figure, ax
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -21,24 +24,79 @@ def new_figure(ax: Any = None, size: tuple[float, float] = (6.4, 4.8)) -> tuple[
     return fig, fig.add_subplot()
 
 
+def styled(func: F) -> F:
+    """Draw inside the one figure style of the package (:data:`brakesqueal.labels.STYLE`)."""
+    import functools
+
+    @functools.wraps(func)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        import matplotlib
+
+        from .labels import STYLE
+
+        with matplotlib.rc_context(STYLE):
+            return func(*args, **kwargs)
+
+    return wrapper  # type: ignore[return-value]
+
+
 def _label(name: str, units: str) -> str:
-    return f"{name} [{units}]" if units else name
+    from .labels import axis_label
+
+    return axis_label(name, units)
 
 
-def plot_map(m: Any, ax: Any = None, *, x: str | None = None, title: str | None = None) -> Any:
-    """Plot a :class:`~brakesqueal.results.StabilityMap`: stable region, boundary, invalid points."""
+#: Colourings of a map: the certified verdict, or a continuous field with the verdict's boundary on top.
+MAP_COLORS = ("verdict", "max_real", "frequency")
+
+
+def plot_map(m: Any, ax: Any = None, *, x: str | None = None, title: str | None = None,
+             color: str = "verdict") -> Any:
+    """Plot a :class:`~brakesqueal.results.StabilityMap`: stable region, boundary, failed points.
+
+    Parameters
+    ----------
+    m : StabilityMap
+        The map.
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+    x : str, optional
+        The horizontal axis (default the inner dimension).
+    title : str, optional
+        Axes title.
+    color : {"verdict", "max_real", "frequency"}
+        What the colours show (see :func:`plot_map_arrays`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from .results import boundary_of
+
     outer, inner = m.dims
     ds = m.data
     xn = x or inner
     yn = outer if xn == inner else inner
     axes = [(n, ds[n].values, ds[n].attrs.get("units", ""), ds[n].attrs.get("scale") == "log") for n in (xn, yn)]
+    field = ds[color].transpose(yn, xn).values if color in ("max_real", "frequency") and color in ds else None
     return plot_map_arrays(axes[0], axes[1], ds["stable"].transpose(yn, xn).values,
                            ds["status"].transpose(yn, xn).values, ax=ax,
-                           title=title or f"stability map ({ds.attrs.get('space', '')})")
+                           title=title if title is not None else map_title(ds.attrs.get("space", ""), xn, yn),
+                           boundary=boundary_of(ds, (xn, yn)), color=color, field=field)
 
 
+def map_title(space: str, xn: str, yn: str) -> str:
+    """Default title of a map: what it shows, over which parameters, for which preset."""
+    from .labels import symbol
+
+    return f"${symbol(yn)}$ vs ${symbol(xn)}$ ({space})"
+
+
+@styled
 def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, np.ndarray, str, bool],
-                    stable: np.ndarray, status: np.ndarray, *, ax: Any = None, title: str = "") -> Any:
+                    stable: np.ndarray, status: np.ndarray, *, ax: Any = None, title: str = "",
+                    boundary: tuple[np.ndarray, np.ndarray] | None = None, color: str = "verdict",
+                    field: np.ndarray | None = None) -> Any:
     """Plot a stability map given as arrays (what :func:`plot_map` draws, without xarray).
 
     Parameters
@@ -51,34 +109,83 @@ def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, 
         Axes to draw into (default: a new figure).
     title : str
         Axes title.
+    boundary : tuple of ndarray, optional
+        The refined stability boundary ``(x values, y values)``, curves
+        separated by NaN (:func:`~brakesqueal.analysis.boundary.stability_boundary`);
+        without it the boundary is the grid contour of ``stable``.
+    color : {"verdict", "max_real", "frequency"}
+        ``verdict`` shades stable and unstable points; ``max_real`` and
+        ``frequency`` colour the points by that field (``field``) with a colour bar.
+    field : ndarray, optional
+        The field for ``color = "max_real"`` or ``"frequency"``.
 
     Returns
     -------
     matplotlib.figure.Figure
+
+    Raises
+    ------
+    ParameterError
+        An unknown ``color``, or a field colouring without the field (a verdict-only map).
     """
-    from matplotlib.colors import ListedColormap
+    from matplotlib.colors import ListedColormap, SymLogNorm
+    from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
+    from .errors import ParameterError
+
+    if color not in MAP_COLORS:
+        raise ParameterError(f"color must be one of {', '.join(MAP_COLORS)}; got {color!r}")
+    if color != "verdict" and field is None:
+        raise ParameterError(f"color = {color!r} needs the map's {color} (a map computed without --no-eigen)")
     fig, ax = new_figure(ax)
     (xn, xs, xu, xlog), (yn, ys, yu, ylog) = xaxis, yaxis
     status = np.asarray(status)
-    z = np.where(status >= 2, np.nan, np.asarray(stable, dtype=float))
-    ax.pcolormesh(xs, ys, z, cmap=ListedColormap(["#f4c7c3", "#c8e6c9"]), vmin=0, vmax=1, shading="nearest",
-                  rasterized=True)
-    if np.any(status >= 2):
-        ax.contourf(xs, ys, (status >= 2).astype(float), levels=[0.5, 1.5], colors="none", hatches=["xx"])
-    if 0 < np.nanmean(z) < 1:
+    failed = status >= 2
+    z = np.where(failed, np.nan, np.asarray(stable, dtype=float))
+    handles = []
+    if color == "verdict":
+        ax.pcolormesh(xs, ys, z, cmap=ListedColormap(["#f4c7c3", "#c8e6c9"]), vmin=0, vmax=1, shading="nearest",
+                      rasterized=True)
+        handles += [Patch(facecolor="#c8e6c9", label="stable"), Patch(facecolor="#f4c7c3", label="unstable (squeal)")]
+    else:
+        from .labels import axis_label
+
+        f = np.where(failed, np.nan, np.asarray(field, dtype=float))
+        if color == "max_real":
+            lim = float(np.nanmax(np.abs(f))) if np.any(np.isfinite(f)) else 1.0
+            thresh = max(lim * 1e-4, 1e-12)
+            norm = SymLogNorm(linthresh=thresh, vmin=-lim, vmax=lim)
+            mesh = ax.pcolormesh(xs, ys, f, cmap="RdBu_r", norm=norm, shading="nearest", rasterized=True)
+            top = np.floor(np.log10(lim))
+            dec = 10.0 ** np.arange(top, np.log10(thresh) + 0.5, -2.0)  # every other decade, none near 0
+            ticks = [*(-dec), 0.0, *dec[::-1]]
+        else:
+            mesh = ax.pcolormesh(xs, ys, f, cmap="viridis", shading="nearest", rasterized=True)
+            ticks = None
+        fig.colorbar(mesh, ax=ax, label=axis_label(color), ticks=ticks)
+    if np.any(failed):
+        ax.contourf(xs, ys, failed.astype(float), levels=[0.5, 1.5], colors="none", hatches=["xxx"])
+        handles.append(Patch(facecolor="white", edgecolor="0.3", hatch="xxx", label="no verdict (see status)"))
+    if boundary is not None and np.any(np.isfinite(boundary[0])):
+        ax.plot(boundary[0], boundary[1], "k-", lw=1.2)
+        handles.append(Line2D([], [], color="k", lw=1.2, label="stability boundary"))
+    elif 0 < np.nanmean(z) < 1:
         ax.contour(xs, ys, np.nan_to_num(z, nan=0.0), levels=[0.5], colors="k", linewidths=1.2)
+        handles.append(Line2D([], [], color="k", lw=1.2, label="stability boundary (grid)"))
     if xlog:
         ax.set_xscale("log")
     if ylog:
         ax.set_yscale("log")
+    ax.set_xlim(xs[0], xs[-1])
+    ax.set_ylim(ys[0], ys[-1])
     ax.set_xlabel(_label(xn, xu))
     ax.set_ylabel(_label(yn, yu))
-    # a fixed place beside the axes: loc="best" tests every cell of the mesh (minutes for 1e6 cells)
-    ax.legend(handles=[Patch(color="#c8e6c9", label="stable"), Patch(color="#f4c7c3", label="unstable (squeal)")],
-              loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8)
-    ax.set_title(title)
+    # outside the axes, above them: never over the data (loc="best" would also test every mesh cell)
+    ax.legend(handles=handles, loc="lower left", bbox_to_anchor=(0.0, 1.02), ncols=2, frameon=False,
+              borderaxespad=0.0, handlelength=1.5)
+    if title:
+        ax.set_title(title, loc="right", fontsize="medium", pad=16)
     return fig
 
 
@@ -114,21 +221,70 @@ def plot_path(r: Any, ax: Any = None) -> Any:
     return fig
 
 
+@styled
 def plot_critical_curves(diff: np.ndarray, curves: dict[str, np.ndarray], ax: Any = None,
-                         restab: dict[str, np.ndarray] | None = None) -> Any:
-    """Ω_crit (and, dotted, the re-stabilising speed) versus μ1 − μ2 for several k_ip."""
+                         restab: dict[str, np.ndarray] | None = None,
+                         tips: dict[str, list[tuple[float, float]]] | None = None, title: str = "") -> Any:
+    """Ω_crit versus μ1 − μ2 for several k_ip (paper Fig. 3), optionally as closed squeal regions.
+
+    Parameters
+    ----------
+    diff : ndarray
+        The grid of ``mu1 - mu2``.
+    curves : dict of str to ndarray
+        Onset speeds per ``k_ip`` label (NaN: stable throughout).
+    ax : matplotlib.axes.Axes, optional
+        Axes to draw into.
+    restab : dict of str to ndarray, optional
+        Re-stabilisation speeds per label: with them each curve is drawn as the
+        closed boundary of the unstable region (onset below, re-stabilisation
+        above, joined at the tips), on a log axis.
+    tips : dict of str to list of (float, float), optional
+        Where onset and re-stabilisation meet (:func:`brakesqueal.reproduce.fig3_tips`):
+        the curves end there instead of at the last grid point.
+    title : str
+        Axes title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from .labels import axis_label, symbol
+
     fig, ax = new_figure(ax)
-    for i, (label, y) in enumerate(curves.items()):
-        line, = ax.plot(diff, y, "-", lw=1.5, label=f"k_ip = {label}")
-        if restab is not None and label in restab:
-            ax.plot(diff, restab[label], ":", lw=1, color=line.get_color())
-    ax.set_xlabel("μ1 − μ2 (μ1 + μ2 = 1)")
-    ax.set_ylabel("Ω_crit [rad/s]")
-    ax.legend(fontsize=8)
+    for label, y in curves.items():
+        fin = np.flatnonzero(np.isfinite(y))
+        if fin.size == 0:
+            continue
+        i0, i1 = fin[0], fin[-1]
+        tl = [t for t in (tips or {}).get(label, []) if t[0] < diff[i0]]
+        tr = [t for t in (tips or {}).get(label, []) if t[0] > diff[i1]]
+        xs = [*([tl[-1][0]] if tl else []), *diff[i0:i1 + 1], *([tr[0][0]] if tr else [])]
+        lo = [*([tl[-1][1]] if tl else []), *y[i0:i1 + 1], *([tr[0][1]] if tr else [])]
+        name = "∞" if label == "inf" else label
+        if restab is not None and label in restab and np.all(np.isfinite(restab[label][i0:i1 + 1])):
+            up = restab[label][i0:i1 + 1]
+            px = np.array([*xs, *diff[i0:i1 + 1][::-1], xs[0]])
+            py = np.array([*lo, *up[::-1], lo[0]])
+            if not tl:  # no tip on this side: leave the region open there
+                px, py = px[:-1], py[:-1]
+            line, = ax.plot(px, py, "-", label=f"${symbol('k_ip')}$ = {name} N/m")
+            ax.fill(px, py, color=line.get_color(), alpha=0.08, lw=0)
+        else:
+            ax.plot(xs, lo, "-", label=f"${symbol('k_ip')}$ = {name} N/m")
+    if restab is not None:
+        ax.set_yscale("log")
+        ax.set_ylabel(axis_label("Omega", "rad/s") + " (shaded: squeal)")
+    else:
+        ax.set_ylabel(axis_label("Omega_crit"))
+    ax.set_xlabel(f"${symbol('mu1')} - {symbol('mu2')}$  (${symbol('mu1')} + {symbol('mu2')} = 1$)")
+    ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.02), ncols=2, frameon=False, borderaxespad=0.0)
+    if title:
+        ax.set_title(title, loc="right", fontsize="medium", pad=30)
     return fig
 
 
-def save(fig: Any, path: str, dpi: int = 150) -> str:
+def save(fig: Any, path: str, dpi: int = 300) -> str:
     """Save a figure (format from the suffix: PNG, SVG, PDF) and return the path."""
     fig.savefig(path, dpi=dpi)
     return path

@@ -80,6 +80,58 @@ def reproduce_fig2(out: str | Path, *, n_kip: int = 301, n_mu: int = 241, mu_lin
     return summary
 
 
+def fig3_tips(space: Any, diff: np.ndarray, onset: np.ndarray, certain: np.ndarray,
+              omega_range: tuple[float, float], iterations: int = 48) -> list[tuple[float, float]]:
+    """Where the squeal region of Fig. 3 closes: ``(mu1 - mu2, Omega)`` at which onset and re-stabilisation meet.
+
+    Between two neighbours of ``diff`` of which one has an onset and the other
+    none (both certain), the friction asymmetry is bisected (``mu1 + mu2 = 1``)
+    until the bracket is ``2^-iterations`` of the grid step; the tip's speed
+    is the mean of the last onset and re-stabilisation speeds found.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The paper-fig3 space at one ``k_ip``.
+    diff : ndarray
+        The grid of ``mu1 - mu2``.
+    onset : ndarray
+        Onset speeds on the grid (NaN: stable throughout).
+    certain : ndarray of bool
+        Whether each grid point's crossings are established.
+    omega_range : tuple of float
+        The Ω range searched.
+    iterations : int
+        Bisection steps.
+
+    Returns
+    -------
+    list of (float, float)
+        The tips, in increasing ``mu1 - mu2``.
+    """
+    from .analysis.crossings import critical_speeds_many
+
+    has = np.isfinite(onset)
+    out = []
+    for i in np.flatnonzero((has[:-1] != has[1:]) & certain[:-1] & certain[1:]):
+        inside, outside = (diff[i], diff[i + 1]) if has[i] else (diff[i + 1], diff[i])
+        w = float("nan")
+        for _ in range(iterations):
+            d = 0.5 * (inside + outside)
+            roots, dirs, counts, _ = critical_speeds_many(space, {"mu1": np.array([(1 + d) / 2]),
+                                                                  "mu2": np.array([(1 - d) / 2])}, *omega_range)
+            r = roots[0, :min(int(counts[0]), roots.shape[1])]
+            down = r[dirs[0, :r.size] < 0]
+            if down.size:
+                up = r[(dirs[0, :r.size] > 0) & (r > down[0])]
+                w = 0.5 * (down[0] + up[0]) if up.size else float(down[0])
+                inside = d
+            else:
+                outside = d
+        out.append((float(0.5 * (inside + outside)), float(w)))
+    return sorted(out)
+
+
 def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[float, float] = (1.0, 1e5),
                    progress: Callable[[float], None] = _noop) -> dict[str, Any]:
     """Write ``fig3.png``, ``fig3.nc``, ``fig3.csv``, ``fig3.json`` to ``out``; returns the summary."""
@@ -95,6 +147,7 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
     diff = np.linspace(-0.98, 0.98, n_diff)
     mu1, mu2 = (1 + diff) / 2, (1 - diff) / 2
     crit, restab, ncross, certain = {}, {}, {}, {}
+    tips: dict[str, list[tuple[float, float]]] = {}
     for q, kip in enumerate(FIG3_KIP):
         space = ParameterSpace.from_preset("paper-fig3", {"k_ip": kip})
         roots, dirs, counts, start, status = critical_speeds_many(space, {"mu1": mu1, "mu2": mu2}, *omega_range,
@@ -110,15 +163,12 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
                 if later:
                     second[i] = roots[i, later[0]]
         crit[kip], restab[kip], ncross[kip] = first, second, counts.copy()
+        tips[kip] = fig3_tips(space, diff, first, certain[kip], omega_range)
         progress((q + 1) / len(FIG3_KIP))
-    fig = plot_critical_curves(diff, crit)
-    ax = fig.axes[0]
-    ax.set_title("Fig. 3: critical speed vs friction asymmetry (paper-fig3)")
+    fig = plot_critical_curves(diff, crit, restab=restab, tips=tips, title="Fig. 3: squeal region (paper-fig3)")
     _write(out / "fig3.png", lambda t: save(fig, str(t)))
-    fig_full = plot_critical_curves(diff, crit, restab=restab)
-    fig_full.axes[0].set_yscale("log")
-    fig_full.axes[0].set_title("onset (solid) and re-stabilisation (dotted) of squeal")
-    _write(out / "fig3_restabilisation.png", lambda t: save(fig_full, str(t)))
+    fig_lin = plot_critical_curves(diff, crit, tips=tips, title="Fig. 3: onset of squeal (paper-fig3)")
+    _write(out / "fig3_onset.png", lambda t: save(fig_lin, str(t)))
     kvals = [math.inf if k == "inf" else float(k) for k in FIG3_KIP]
     ds = xr.Dataset(
         {"Omega_crit": (("k_ip", "mu_diff"), np.array([crit[k] for k in FIG3_KIP]), {"units": "rad/s"}),
@@ -132,7 +182,7 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
     _write(out / "fig3.csv", lambda t: ds.to_dataframe().reset_index().to_csv(str(t), index=False))
     mid = int(np.argmin(np.abs(diff)))
     summary: dict[str, Any] = {"figure": "fig3", "preset": "paper-fig3", "omega_range": list(omega_range),
-                               "files": [str(out / f) for f in ("fig3.png", "fig3_restabilisation.png",
+                               "files": [str(out / f) for f in ("fig3.png", "fig3_onset.png",
                                                                 "fig3.nc", "fig3.csv", "fig3.json")],
                                "curves": {}}
     for k in FIG3_KIP:
@@ -146,6 +196,7 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
                                                         if (~fin & certain[k]).any() else None),
             "undecided_points": int(np.count_nonzero(~certain[k])),
             "Omega_restab_at_equal_mu": float(restab[k][mid]),
+            "tips": [{"mu_diff": d, "Omega": w} for d, w in tips[k]],
         }
     _write(out / "fig3.json", lambda t: t.write_text(json.dumps(summary, indent=2) + "\n"))
     return summary

@@ -60,6 +60,26 @@ def _coord_attrs(ax: Any, space: Any) -> dict[str, Any]:
     return {"units": _units(ax.name, space), "scale": "log" if ax.log else "linear"}
 
 
+#: Dimension of the stored boundary vertices (curves separated by NaN).
+BOUNDARY_DIM = "boundary_vertex"
+
+
+def _boundary_attrs(name: str, space: Any) -> dict[str, Any]:
+    return {"units": _units(name, space),
+            "long_name": f"{name} along the stability boundary (curves separated by NaN; vertices refined "
+                         "onto the boundary by bisection, brakesqueal.analysis.boundary)"}
+
+
+def boundary_of(ds_or_vars: Any, names: tuple[str, str]) -> tuple[np.ndarray, np.ndarray] | None:
+    """The stored boundary ``(values of names[0], values of names[1])`` of a map, or ``None``."""
+    keys = [f"boundary_{n}" for n in names]
+    if not all(k in ds_or_vars for k in keys):
+        return None
+    # xarray variables have .values, scipy.io.netcdf variables .data
+    a, b = (np.array(v.values if hasattr(v, "dims") else v.data, dtype=float) for v in (ds_or_vars[k] for k in keys))
+    return a, b
+
+
 class MapFile:
     """A stability map's NetCDF3 file whose variables are filled in place, row block by row block.
 
@@ -116,6 +136,17 @@ class MapFile:
         self._attrs(v, attrs)
         return v.data  # type: ignore[no-any-return]
 
+    def write_boundary(self, b: Any) -> None:
+        """Add the refined stability boundary (:class:`~brakesqueal.analysis.boundary.Boundary`) before closing."""
+        n = int(b.coords[0].size)
+        if n == 0:
+            return
+        self._f.createDimension(BOUNDARY_DIM, n)
+        for name, values in zip(b.names, b.coords):
+            v = self._f.createVariable(f"boundary_{name}", "d", (BOUNDARY_DIM,))
+            v[:] = values
+            self._attrs(v, {**_boundary_attrs(name, self.space), "_FillValue": np.float64(np.nan)})
+
     def close(self, method: str) -> None:
         """Set the global attributes (``method`` names the route), write the file and close it."""
         self._attrs(self._f, _map_attrs(self.space, method))
@@ -160,7 +191,8 @@ class StabilityMap:
 
     @classmethod
     def from_arrays(cls, space: Any, outer: Any, inner: Any, *, stable: np.ndarray, status: np.ndarray,
-                    max_real: np.ndarray | None, frequency: np.ndarray | None, method: str) -> StabilityMap:
+                    max_real: np.ndarray | None, frequency: np.ndarray | None, method: str,
+                    boundary: Any = None) -> StabilityMap:
         """Build the Dataset from computed arrays (``max_real``/``frequency`` ``None``: not computed, left out).
 
         Parameters
@@ -175,6 +207,9 @@ class StabilityMap:
             Least-stable eigenvalue summary, or ``None``.
         method : str
             The route.
+        boundary : Boundary, optional
+            The refined stability boundary (:func:`~brakesqueal.analysis.boundary.stability_boundary`),
+            stored as ``boundary_<outer>``, ``boundary_<inner>`` along the dimension ``boundary_vertex``.
 
         Returns
         -------
@@ -193,6 +228,9 @@ class StabilityMap:
         if frequency is not None:
             data["frequency"] = (dims, frequency, dict(_VAR_ATTRS["frequency"]))
         data["status"] = (dims, status, _status_attrs())
+        if boundary is not None and boundary.coords[0].size:
+            for name, values in zip(boundary.names, boundary.coords):
+                data[f"boundary_{name}"] = ((BOUNDARY_DIM,), values, _boundary_attrs(name, space))
         return cls(xr.Dataset(data, coords=coords, attrs=_map_attrs(space, method)))
 
     @property
@@ -216,20 +254,33 @@ class StabilityMap:
         self.data.to_dataframe().reset_index().to_csv(path, index=False)
 
     def boundary(self) -> list[np.ndarray]:
-        """Stability boundary as polylines ``(n, 2)`` in (inner, outer) coordinates: the 0.5 contour of ``stable``."""
+        """Stability boundary as polylines ``(n, 2)`` in (inner, outer) coordinates.
+
+        The stored, refined boundary when the map has one (points on the
+        stability boundary to the bisection's precision), else the 0.5 contour
+        of ``stable`` (a staircase at the grid's resolution).
+        """
         import contourpy
 
         o, i = self.dims
+        stored = boundary_of(self.data, (o, i))
+        if stored is not None:
+            bo, bi = stored
+            cut = np.flatnonzero(~np.isfinite(bo))
+            return [np.column_stack([bi[a:b], bo[a:b]])
+                    for a, b in zip([0, *(cut + 1).tolist()], [*cut.tolist(), bo.size]) if b > a]
         z = self.data["stable"].values.astype(float)
         z[self.data["status"].values >= 2] = np.nan
         gen = contourpy.contour_generator(self.data[i].values, self.data[o].values, z)
         return list(gen.lines(0.5))
 
-    def plot(self, ax: Any = None, *, x: str | None = None, title: str | None = None) -> Any:
-        """Stability map: stable region shaded, boundary drawn, invalid points hatched; returns the figure."""
+    def plot(self, ax: Any = None, *, x: str | None = None, title: str | None = None,
+             color: str = "verdict") -> Any:
+        """Stability map: stable region shaded (or ``color = "max_real" | "frequency"``), refined boundary drawn,
+        points without a verdict hatched; returns the figure (:func:`~brakesqueal.plotting.plot_map`)."""
         from .plotting import plot_map
 
-        return plot_map(self, ax=ax, x=x, title=title)
+        return plot_map(self, ax=ax, x=x, title=title, color=color)
 
 
 def open_map(path: str) -> StabilityMap:
@@ -259,7 +310,7 @@ def open_map(path: str) -> StabilityMap:
     return StabilityMap(ds)
 
 
-def plot_map_file(path: str, *, x: str | None = None, title: str | None = None) -> Any:
+def plot_map_file(path: str, *, x: str | None = None, title: str | None = None, color: str = "verdict") -> Any:
     """Plot a map file written by :class:`MapFile` or :meth:`StabilityMap.to_netcdf` without xarray.
 
     Parameters
@@ -269,7 +320,9 @@ def plot_map_file(path: str, *, x: str | None = None, title: str | None = None) 
     x : str, optional
         The horizontal axis (default the inner dimension).
     title : str, optional
-        Axes title (default names the space, as :meth:`StabilityMap.plot`).
+        Axes title (default names the parameters and the space, as :meth:`StabilityMap.plot`).
+    color : {"verdict", "max_real", "frequency"}
+        What the colours show (:func:`~brakesqueal.plotting.plot_map_arrays`).
 
     Returns
     -------
@@ -278,15 +331,19 @@ def plot_map_file(path: str, *, x: str | None = None, title: str | None = None) 
     """
     from scipy.io import netcdf_file
 
-    from .plotting import plot_map_arrays
+    from .plotting import map_title, plot_map_arrays
 
     with netcdf_file(path, "r", mmap=False, maskandscale=False) as f:
         outer, inner = f.variables["stable"].dimensions
         xn = x or inner
         yn = outer if xn == inner else inner
         st, ss = np.asarray(f.variables["stable"].data), np.asarray(f.variables["status"].data)
+        field = None
+        if color in f.variables and color in ("max_real", "frequency"):
+            field = np.asarray(f.variables[color].data, dtype=float)
         if xn == outer:
             st, ss = st.T, ss.T
+            field = None if field is None else field.T
 
         def axis(n: str) -> tuple[str, np.ndarray, str, bool]:
             v = f.variables[n]
@@ -295,7 +352,9 @@ def plot_map_file(path: str, *, x: str | None = None, title: str | None = None) 
 
         space = f._attributes.get("space", b"")
         space = space.decode() if isinstance(space, bytes) else str(space)
-        return plot_map_arrays(axis(xn), axis(yn), st.astype(bool), ss, title=title or f"stability map ({space})")
+        return plot_map_arrays(axis(xn), axis(yn), st.astype(bool), ss,
+                               title=title if title is not None else map_title(space, xn, yn),
+                               boundary=boundary_of(f.variables, (xn, yn)), color=color, field=field)
 
 
 @dataclass(frozen=True)

@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -50,6 +51,10 @@ STATUS = {int(s): s.meaning for s in PointStatus}
 MAX_POINTS = 10**9
 #: Largest memory [bytes] computing and writing one map may take (:func:`map_bytes`); use a sweep beyond.
 MAX_MAP_BYTES = 4 * 2**30
+#: Largest map [points] whose stability boundary is located and stored.
+BOUNDARY_MAX_POINTS = 16 * 10**6
+#: Wall-time budget [s] of the boundary's bisection (vertices keep their bracket when it runs out).
+BOUNDARY_BUDGET = 1.0
 #: Maps with more points than this store ``max_real`` and ``frequency`` as float32.
 _FLOAT32_ABOVE = 2 * 10**7
 
@@ -297,7 +302,8 @@ def _rows(space: object, plan: _Plan, eigen: bool, chunk_points: int) -> Iterato
 
 
 def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen: bool = True,
-                  chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None) -> object:
+                  chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None,
+                  boundary: bool = True) -> object:
     """Compute a stability map over two settable parameters of ``space``.
 
     Parameters
@@ -318,6 +324,11 @@ def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen
         Points per chunk (bounds the temporary memory).
     progress : callable, optional
         Called with the completed fraction after each chunk.
+    boundary : bool
+        Also locate the stability boundary as curves refined onto it by
+        bisection (:func:`~.boundary.stability_boundary`; stored as
+        ``boundary_<name>`` variables; only for maps of at most
+        :data:`BOUNDARY_MAX_POINTS` points, within :data:`BOUNDARY_BUDGET` seconds).
 
     Returns
     -------
@@ -350,8 +361,18 @@ def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen
             freq[r0:r1] = fr
         if progress is not None:
             progress(r1 / n_o)
+    b = _boundary(space, plan, stable, status) if boundary else None
     return StabilityMap.from_arrays(space, plan.outer, plan.inner, stable=stable, status=status, max_real=max_real,
-                                    frequency=freq, method=plan.method)
+                                    frequency=freq, method=plan.method, boundary=b)
+
+
+def _boundary(space: object, plan: _Plan, stable: np.ndarray, status: np.ndarray) -> Any:
+    """The refined stability boundary of a map (``None`` above :data:`BOUNDARY_MAX_POINTS` points)."""
+    from .boundary import stability_boundary
+
+    if plan.outer.num * plan.inner.num > BOUNDARY_MAX_POINTS:
+        return None
+    return stability_boundary(space, plan.outer, plan.inner, stable, status, budget=BOUNDARY_BUDGET)
 
 
 @dataclass(frozen=True)
@@ -378,7 +399,8 @@ class MapSummary:
 
 
 def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False, eigen: bool = True,
-              chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None) -> MapSummary:
+              chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None,
+              boundary: bool = True) -> MapSummary:
     """Compute a stability map and write it to a NetCDF3 file without holding it as an xarray Dataset.
 
     Same results and file as ``stability_map(...).to_netcdf(path)`` (read
@@ -394,7 +416,7 @@ def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False
         The axes.
     path : str
         The NetCDF file to write (the caller makes it atomic).
-    force, eigen, chunk_points, progress
+    force, eigen, chunk_points, progress, boundary
         As :func:`stability_map`.
 
     Returns
@@ -422,6 +444,10 @@ def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False
                 f.frequency[r0:r1] = fr
             if progress is not None:
                 progress(r1 / n_o)
+        if boundary:
+            b = _boundary(space, plan, np.asarray(f.stable, dtype=bool), np.asarray(f.status))
+            if b is not None:
+                f.write_boundary(b)
     except BaseException:
         f.abort()
         raise

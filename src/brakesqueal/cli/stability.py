@@ -16,9 +16,16 @@ from typing import Annotated, Optional
 
 import typer
 
+from ..errors import ParameterError
 from ._options import FormatOpt, ModelOpt, OutFormat, ParamsOpt, PresetOpt, ProgressOpt, SetOpt, space_from
 
 __all__ = ["register"]
+
+
+class _Color(str, Enum):
+    verdict = "verdict"
+    max_real = "max_real"
+    frequency = "frequency"
 
 
 class _Fig(str, Enum):
@@ -35,7 +42,7 @@ def _write_plot(fig: object, plot: str) -> None:
     from ..outputs import atomic_write
 
     with atomic_write(plot, what="--plot") as tmp:
-        fig.savefig(tmp, dpi=150)  # type: ignore[attr-defined]
+        fig.savefig(tmp, dpi=300)  # type: ignore[attr-defined]
 
 
 def crossings(
@@ -87,6 +94,8 @@ def map_(
     no_eigen: Annotated[bool, typer.Option("--no-eigen", help="Only classify: the file has stable and status, "
                                                               "no max_real or frequency.")] = False,
     progress: ProgressOpt = None,
+    color: Annotated[Optional[_Color], typer.Option(
+        "--color", help="What the plot's colours show: the verdict, or max Re λ or the frequency.")] = None,
 ) -> None:
     """Stability map over two parameters of any model: NetCDF (stable, status, max_real, frequency); optional plot."""
     from ..analysis.maps import parse_axis, write_map
@@ -94,6 +103,10 @@ def map_(
     from ._progress import progress as _progress
 
     ax_x, ax_y = parse_axis(x), parse_axis(y)
+    if color is not None and not plot:
+        raise ParameterError("--color only changes the figure: give --plot FILE too")
+    if color not in (None, _Color.verdict) and no_eigen:
+        raise ParameterError(f"--color {color.value} needs max_real and frequency: leave out --no-eigen")
     check_output(out, what="--out", suffixes=(".nc",))
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
@@ -104,7 +117,7 @@ def map_(
     if plot:
         from ..results import plot_map_file
 
-        _write_plot(plot_map_file(out, x=ax_x.name), plot)
+        _write_plot(plot_map_file(out, x=ax_x.name, color=(color or _Color.verdict).value), plot)
         msg += f" and {plot}"
     sys.stdout.write(f"{msg} ({s.points} points, {100 * s.stable_fraction:.1f}% stable; {s.method})\n")
 

@@ -1,0 +1,104 @@
+"""Symbols and units of parameters and quantities for figures: one table for every plot.
+
+Parameter names follow the paper (``mu1``, ``k_ip``, ``h10``, ``Omega``); their
+symbols are derived by one rule (Greek names become Greek letters, trailing
+digits and underscore parts become subscripts), units come from the model's
+roles (:mod:`brakesqueal.model.roles`) through the caller.
+
+>>> symbol("k_ip1")
+'k_{\\\\mathrm{ip}1}'
+>>> axis_label("Omega", "rad/s")
+'$\\\\Omega$ [rad/s]'
+"""
+
+from __future__ import annotations
+
+import re
+
+__all__ = ["symbol", "axis_label", "QUANTITIES", "STYLE"]
+
+_GREEK = {"alpha", "beta", "gamma", "delta", "epsilon", "zeta", "eta", "theta", "iota", "kappa", "lambda", "mu",
+          "nu", "xi", "pi", "rho", "sigma", "tau", "phi", "chi", "psi", "omega", "Gamma", "Delta", "Theta",
+          "Lambda", "Xi", "Pi", "Sigma", "Phi", "Psi", "Omega"}
+
+#: Symbols and units of computed quantities (variables of maps, paths and trajectories).
+QUANTITIES: dict[str, tuple[str, str]] = {
+    "max_real": (r"\max\,\mathrm{Re}\,\lambda", "1/s"),
+    "frequency": (r"f", "Hz"),
+    "growth_rate": (r"\sigma", "1/s"),
+    "damping_ratio": (r"\zeta", ""),
+    "Omega_crit": (r"\Omega_\mathrm{crit}", "rad/s"),
+}
+
+#: Matplotlib style of every figure: sizes for a single journal column (3.5 in), vector-friendly.
+STYLE: dict[str, object] = {
+    "font.size": 8, "axes.labelsize": 8, "axes.titlesize": 8, "legend.fontsize": 7, "xtick.labelsize": 7,
+    "ytick.labelsize": 7, "lines.linewidth": 1.0, "axes.linewidth": 0.6, "savefig.bbox": "tight",
+    "pdf.fonttype": 42, "svg.fonttype": "none", "mathtext.fontset": "cm",
+}
+
+
+def _base(word: str) -> tuple[str, str]:
+    m = re.fullmatch(r"([A-Za-z]+?)(\d*)", word)
+    letters, digits = (m.group(1), m.group(2)) if m else (word, "")
+    if letters in _GREEK:
+        head = "\\" + letters
+    elif len(letters) == 1:
+        head = letters
+    else:
+        head = r"\mathrm{" + letters + "}"
+    return head, digits
+
+
+def symbol(name: str) -> str:
+    """The mathtext symbol of a parameter or quantity name (without ``$``).
+
+    Parameters
+    ----------
+    name : str
+        E.g. ``"mu1"``, ``"k_ip"``, ``"N0"``, ``"Omega"``, ``"max_real"``.
+
+    Returns
+    -------
+    str
+        E.g. ``"\\mu_{1}"``, ``"k_{\\mathrm{ip}}"``, ``"N_{0}"``, ``"\\Omega"``.
+    """
+    if name in QUANTITIES:
+        return QUANTITIES[name][0]
+    first, *rest = name.split("_")
+    head, digits = _base(first) if first else (name, "")
+    sub = ""
+    if rest:
+        parts = []
+        for w in rest:
+            m = re.fullmatch(r"([A-Za-z]*)(\d*)", w)
+            letters, d = (m.group(1), m.group(2)) if m else (w, "")
+            parts.append((r"\mathrm{" + letters + "}" if letters else "") + d)
+        sub = "".join(parts) + digits
+    else:
+        sub = digits
+    return f"{head}_{{{sub}}}" if sub else head
+
+
+def _unit_text(unit: str) -> str:
+    return unit.replace("^2", "²").replace("^3", "³").replace("^-1", "⁻¹")
+
+
+def axis_label(name: str, unit: str | None = None) -> str:
+    """``"$symbol$ [unit]"`` (no brackets for dimensionless quantities).
+
+    Parameters
+    ----------
+    name : str
+        Parameter or quantity name.
+    unit : str, optional
+        SI unit (default: the quantity's own unit from :data:`QUANTITIES`, else none).
+
+    Returns
+    -------
+    str
+    """
+    if unit is None:
+        unit = QUANTITIES.get(name, ("", ""))[1]
+    text = f"${symbol(name)}$"
+    return f"{text} [{_unit_text(unit)}]" if unit else text
