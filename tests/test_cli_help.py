@@ -27,3 +27,25 @@ def test_every_command_has_a_complete_summary(capsys):
 def test_no_arguments_prints_the_help(capsys):
     assert main([]) == 0
     assert "Commands:" in capsys.readouterr().out
+
+
+def test_long_commands_report_progress_on_a_non_terminal(tmp_path):
+    """simulate, map and sweep print one-line progress on a pipe (here every update: the interval set to 0)."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    study = tmp_path / "s.toml"
+    study.write_text('preset = "paper-fig2"\n[axes]\nmu = "0.1:1:8"\nk_ip = "1e6:1e9:8:log"\n'
+                     '[compute]\nquantities = ["stable"]\n[execution]\nchunk_points = 16\n')
+    env = {**os.environ, "BRAKESQUEAL_PROGRESS_EVERY": "0", "MPLBACKEND": "Agg"}
+    for label, args in (("simulate", ["simulate", "--t-end", "0.05"]),
+                        ("map", ["map", "--x", "k_ip=1e5:1e10:30:log", "--y", "mu=0.05:1:30", "--out", "m.nc"]),
+                        ("sweep", ["sweep", str(study), "--out", "s.zarr"])):
+        r = subprocess.run([sys.executable, "-m", "brakesqueal", *args], cwd=tmp_path, env=env, capture_output=True,
+                           text=True, timeout=600)
+        assert r.returncode == 0, r.stderr
+        lines = [ln for ln in r.stderr.splitlines() if ln.startswith(f"brakesqueal: {label}:")]
+        assert lines and "100.0%" in lines[-1], r.stderr
+    assert Path(tmp_path / "m.nc").exists()

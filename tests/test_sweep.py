@@ -42,7 +42,7 @@ def test_2d_grid_equals_stability_map():
     ds = sweep(study)
     assert ds["stable"].dims == ("mu", "k_ip") and load_study(study).n_chunks > 1
     m = stability_map(ParameterSpace.from_preset("paper-fig2"), parse_axis("k_ip=1e5:1e10:31:log"),
-                      parse_axis("mu=0.05:1:23")).data.transpose("mu", "k_ip")
+                      parse_axis("mu=0.05:1:23")).data.transpose("mu", "k_ip", ...)
     for v in ("stable", "status"):
         np.testing.assert_array_equal(ds[v].values, m[v].values)
     mr, fr = ds["max_real"].values, ds["frequency"].values
@@ -62,7 +62,7 @@ def test_3d_grid_slices_equal_maps_and_verdict_only_is_same():
     assert list(ds.data_vars) == ["stable", "status"] and ds["stable"].dims == ("Omega", "k_ip", "mu")
     for i, w in enumerate(om):
         m = stability_map(ParameterSpace.from_preset("paper-fig2", {"Omega": w}), parse_axis("k_ip=1e5:1e10:25:log"),
-                          parse_axis("mu=0.05:1:17"), eigen=False).data.transpose("k_ip", "mu")
+                          parse_axis("mu=0.05:1:17"), eigen=False).data.transpose("k_ip", "mu", ...)
         np.testing.assert_array_equal(ds["stable"].values[i], m["stable"].values)
     full = sweep({**study, "compute": {"quantities": EIGEN}})
     np.testing.assert_array_equal(full["stable"].values, ds["stable"].values)

@@ -96,7 +96,9 @@ def _simulate_cmd(
         typer.Option("--wav", help="Write the rim's normal velocity (a belt: the pad's) as 44.1 kHz audio."),
     ] = None,
     fmt: Annotated[str, typer.Option("--format", help="Summary format: text | json.")] = "text",
-    progress: Annotated[bool, typer.Option("--progress/--no-progress", help="Show a progress bar on stderr.")] = True,
+    progress: Annotated[bool, typer.Option(
+        "--progress/--no-progress",
+        help="Progress on stderr: a bar on a terminal, a line every 10 s otherwise.")] = True,
     no_cache: Annotated[bool, typer.Option("--no-cache", help="Do not read or write the cache.")] = False,
 ) -> None:
     """Integrate the nonlinear equations (44) of any model from a perturbed silent motion; write NetCDF, plot, audio.
@@ -149,15 +151,13 @@ def _run(p: Any, t_end: float, method: str, rtol: float, atol: Any, events: str,
 
     sim = simulation_model(p.model, use_cache=not no_cache)
     check_interrupt()
-    bar = _progress_bar() if progress and sys.stderr.isatty() else None
-    try:
+    from .cli._progress import progress as _progress
+
+    with _progress("simulate", None if progress else False) as cb:
         return simulate(
             sim, p, t_end, method=method, rtol=rtol, atol=atol, events=events,  # type: ignore[arg-type]
-            sample_rate=sample_rate, progress=bar.update if bar else None, **init,
+            sample_rate=sample_rate, progress=cb if progress else None, **init,
         )  # fmt: skip
-    finally:
-        if bar:
-            bar.close()
 
 
 def _write(tr: Any, out: str | None, plot: str | None, wav: str | None) -> None:
@@ -168,41 +168,13 @@ def _write(tr: Any, out: str | None, plot: str | None, wav: str | None) -> None:
         tr.to_netcdf(out, what="--out")
         check_interrupt()
     if plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
         from .outputs import write_with
 
-        fig = tr.plot()
-        try:
-            write_with(plot, lambda tmp: fig.savefig(tmp, dpi=120), what="--plot")
-        finally:
-            plt.close(fig)
+        fig = tr.plot()  # an Agg figure of its own, never managed by pyplot
+        write_with(plot, lambda tmp: fig.savefig(tmp, dpi=300), what="--plot")
         check_interrupt()
     if wav:
         tr.to_wav(wav, what="--wav")
-
-
-class _Bar:
-    def __init__(self) -> None:
-        self.last = -1
-
-    def update(self, frac: float) -> None:
-        pct = int(100 * frac)
-        if pct != self.last:
-            self.last = pct
-            n = pct // 4
-            sys.stderr.write(f"\rsimulating [{'#' * n}{'.' * (25 - n)}] {pct:3d}%")
-            sys.stderr.flush()
-
-    def close(self) -> None:
-        sys.stderr.write("\n")
-
-
-def _progress_bar() -> _Bar:
-    return _Bar()
 
 
 def _bench_cmd(

@@ -11,7 +11,8 @@ __all__ = ["progress"]
 
 
 @contextlib.contextmanager
-def progress(label: str, enabled: bool | None = None, *, every: float = 10.0) -> Iterator[Callable[[float], None]]:
+def progress(label: str, enabled: bool | None = None, *, every: float | None = None
+             ) -> Iterator[Callable[[float], None]]:
     """Yield a callback taking the completed fraction in [0, 1].
 
     Parameters
@@ -22,17 +23,28 @@ def progress(label: str, enabled: bool | None = None, *, every: float = 10.0) ->
         ``None``: a :mod:`rich` progress bar when stderr is a terminal, else one
         line every ``every`` seconds (so scripts and CI logs show progress too).
         ``False``: silent.  ``True``: as ``None``.
-    every : float
-        Seconds between the one-line updates on a non-terminal.
+    every : float, optional
+        Seconds between the one-line updates on a non-terminal (default
+        ``$BRAKESQUEAL_PROGRESS_EVERY``, else 10).
     """
+    if every is None:
+        import os
+
+        try:
+            every = max(float(os.environ.get("BRAKESQUEAL_PROGRESS_EVERY", "10")), 0.0)
+        except ValueError:
+            every = 10.0
     if enabled is False:
         yield lambda frac: None
         return
     if sys.stderr.isatty():
+        from rich.console import Console
         from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
+        # on stderr: stdout carries the command's results (JSON, tables) and may be a pipe
         with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.percentage:>5.1f}%"),
-                      TimeElapsedColumn(), TimeRemainingColumn(), transient=False) as bar:
+                      TimeElapsedColumn(), TimeRemainingColumn(), transient=False,
+                      console=Console(file=sys.stderr)) as bar:
             task = bar.add_task(label, total=1.0)
             yield lambda frac: bar.update(task, completed=min(max(frac, 0.0), 1.0))
         return

@@ -33,8 +33,8 @@ def sweep(
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace an existing store.")] = False,
     status: Annotated[bool, typer.Option("--status", help="Only report completed and missing chunks.")] = False,
     progress: Annotated[Optional[bool], typer.Option("--progress/--no-progress",
-                                                     help="Progress bar with ETA (default: if stderr is a "
-                                                          "terminal).")] = None,
+                                                     help="Progress: a bar on a terminal, a line every "
+                                                          "10 s otherwise (default); --no-progress: none.")] = None,
     fmt: Annotated[_Fmt, typer.Option("--format", help="Output format.")] = _Fmt.text,
 ) -> None:
     """Run a parameter study in chunks (resumable) into a Zarr store; --status reports its progress."""
@@ -53,8 +53,10 @@ def sweep(
     store = Path(out) if out else default_store(st)
     if store is None:  # pragma: no cover - a file study always has a default store
         raise ParameterError("no store: give --out")
-    show = sys.stderr.isatty() if progress is None else progress
-    run = run_sweep(st, store=store, workers=workers, scheduler=scheduler, overwrite=overwrite, progress=show)
+    from ._progress import progress as _progress
+
+    with _progress("sweep", progress) as cb:
+        run = run_sweep(st, store=store, workers=workers, scheduler=scheduler, overwrite=overwrite, progress=cb)
     ds = run.dataset
     stable = float(ds["stable"].mean().compute())
     dims = " x ".join(f"{k}={v}" for k, v in zip(st.dims, st.shape))

@@ -695,54 +695,70 @@ class Trajectory:
         return f, X
 
     def plot(self, fig: Any = None) -> Any:
-        """Time history with envelope, phase portrait and spectrum (squeal frequency marked).
+        """Time history with its envelope, phase portrait of the last periods, and spectrum.
 
         The time history shows the tilt deviations (a non-tilting disk: every
-        coordinate's).  Returns the matplotlib ``Figure`` (never calls ``show``).
+        coordinate's); the envelope joins the peaks of the combined deviation
+        ``sqrt(sum dq_i^2)`` (no edge effects of a transform); the phase
+        portrait shows the last three periods of the squeal frequency (the
+        whole record would fill an annulus).  Returns the matplotlib ``Figure``
+        (never calls ``show``), in the package's figure style (two journal columns wide).
         """
-        import matplotlib.pyplot as plt
+        import matplotlib
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+        from scipy.signal import find_peaks
 
-        if fig is None:
-            fig = plt.figure(figsize=(11, 7), layout="constrained")
-        gs = fig.add_gridspec(2, 2)
-        ax_t = fig.add_subplot(gs[0, :])
-        ax_p = fig.add_subplot(gs[1, 0])
-        ax_s = fig.add_subplot(gs[1, 1])
-        s = self.summary
-        cols = [0, 1] if self.tilting else list(range(self.n))
-        dq = self.dq[:, cols]
-        unit = "rad" if self.tilting else "m"
-        for i, j in enumerate(cols):
-            c = self.coords[j]
-            ax_t.plot(self.t, dq[:, i], lw=0.5, alpha=1.0 if i == 0 else 0.7, label=f"{c} - {c}0")
-        if self.t.size >= 16:
-            env, _ = envelope(dq)
-            ax_t.plot(self.t, env, "k", lw=1, label="envelope")
-            ax_t.plot(self.t, -env, "k", lw=1)
-        ax_t.set_xlabel("t [s]")
-        ax_t.set_ylabel(f"{'tilt' if self.tilting else 'coordinate'} deviation [{unit}]")
-        ax_t.set_title(
-            f"{self.model}, {self.status}: f = {s.frequency_hz:.2f} Hz, growth = {s.growth_rate:.4g} 1/s, "
-            f"final amplitude = {s.amplitude_final:.3g}"
-        )
-        if self.t_event is not None:
-            ax_t.axvline(self.t_event, color="r", ls="--", lw=1, label=self.status)
-        ax_t.legend(loc="upper left", fontsize=8)
-        c0 = self.coords[0]
-        ax_p.plot(self.dq[:, 0], self.Qdot[:, 0], lw=0.3)
-        ax_p.set_xlabel(f"{c0} - {c0}0")
-        ax_p.set_ylabel(f"d{c0}/dt")
-        ax_p.set_title("phase portrait")
-        if self.t.size >= 16:
-            f, X = self.spectrum()
-            ax_s.semilogy(f, X + 1e-300, lw=0.7)
-            if math.isfinite(s.frequency_hz) and s.frequency_hz > 0:
-                ax_s.axvline(s.frequency_hz, color="r", ls="--", lw=1, label=f"squeal {s.frequency_hz:.1f} Hz")
-                ax_s.set_xlim(0, min(f[-1], 4 * s.frequency_hz))
-                ax_s.legend(fontsize=8)
-        ax_s.set_xlabel("frequency [Hz]")
-        ax_s.set_ylabel(f"|{c0}|")
-        ax_s.set_title("spectrum")
+        from ..labels import STYLE
+
+        with matplotlib.rc_context(STYLE):
+            if fig is None:
+                fig = Figure(figsize=(7.0, 4.4), layout="constrained")
+                FigureCanvasAgg(fig)
+            gs = fig.add_gridspec(2, 2)
+            ax_t = fig.add_subplot(gs[0, :])
+            ax_p = fig.add_subplot(gs[1, 0])
+            ax_s = fig.add_subplot(gs[1, 1])
+            s = self.summary
+            cols = [0, 1] if self.tilting else list(range(self.n))
+            dq = self.dq[:, cols]
+            unit = "rad" if self.tilting else "m"
+            for i, j in enumerate(cols):
+                c = self.coords[j]
+                ax_t.plot(self.t, dq[:, i], lw=0.5, alpha=1.0 if i == 0 else 0.7, label=f"{c} − {c}₀")
+            r = np.sqrt(np.sum(dq**2, axis=1))
+            peaks, _ = find_peaks(r)
+            if peaks.size >= 2:
+                ax_t.plot(self.t[peaks], r[peaks], "k", lw=0.8, label="envelope")
+                ax_t.plot(self.t[peaks], -r[peaks], "k", lw=0.8)
+            ax_t.set_xlabel("$t$ [s]")
+            ax_t.set_ylabel(f"{'tilt' if self.tilting else 'coordinate'} deviation [{unit}]")
+            amp = f"{s.amplitude_final:.3g} {unit}" if math.isfinite(s.amplitude_final) else "n/a"
+            ax_t.set_title(
+                f"{self.model}, {self.status}: $f$ = {s.frequency_hz:.2f} Hz, growth rate = {s.growth_rate:.4g} 1/s, "
+                f"final amplitude = {amp}", loc="left")
+            if self.t_event is not None:
+                ax_t.axvline(self.t_event, color="r", ls="--", lw=1, label=self.status)
+            ax_t.legend(loc="lower left", bbox_to_anchor=(1.0, 0.0), frameon=False)
+            c0 = self.coords[0]
+            keep = slice(None)
+            if math.isfinite(s.frequency_hz) and s.frequency_hz > 0 and self.t.size >= 2:
+                keep = self.t >= self.t[-1] - 3.0 / s.frequency_hz
+            ax_p.plot(self.dq[keep, 0], self.Qdot[keep, 0], lw=0.8)
+            ax_p.set_xlabel(f"{c0} − {c0}₀ [{unit}]")
+            ax_p.set_ylabel(f"d{c0}/d$t$ [{unit}/s]")
+            ax_p.set_title("phase portrait, last three periods", loc="left")
+            ax_p.ticklabel_format(style="sci", scilimits=(-2, 3))
+            if self.t.size >= 16:
+                f, X = self.spectrum()
+                ax_s.semilogy(f, X + 1e-300, lw=0.7)
+                if math.isfinite(s.frequency_hz) and s.frequency_hz > 0:
+                    ax_s.axvline(s.frequency_hz, color="r", ls="--", lw=1, label=f"squeal {s.frequency_hz:.1f} Hz")
+                    ax_s.set_xlim(0, min(f[-1], 4 * s.frequency_hz))
+                    ax_s.legend(frameon=False)
+            ax_s.set_xlabel("frequency [Hz]")
+            ax_s.set_ylabel(f"|{c0}| [{unit}]")
+            ax_s.set_title("spectrum", loc="left")
         return fig
 
     # ---------------------------------------------------------------- export

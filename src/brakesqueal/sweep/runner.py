@@ -60,11 +60,13 @@ def _coords(study: Study, chunk: int) -> dict[str, np.ndarray]:
 
 # ---------------------------------------------------------------- progress
 class _Progress:
-    """Text progress bar with rate and ETA on a stream (drawn only when enabled)."""
+    """Reports the completed fraction of a study's chunks to a callback (or draws a text bar on a stream)."""
 
-    def __init__(self, study: Study, todo: list[int], done: int, stream: TextIO | None) -> None:
-        self.stream, self.total = stream, study.n_chunks
-        self.done, self.points_left = done, sum(study.chunk_points(c) for c in todo)
+    def __init__(self, study: Study, todo: list[int], done: int, sink: Any) -> None:
+        self.total, self.done = study.n_chunks, done
+        self.callback = sink if callable(sink) and not hasattr(sink, "write") else None
+        self.stream = sink if self.callback is None else None
+        self.points_left = sum(study.chunk_points(c) for c in todo)
         self.points_done, self.t0 = 0, time.perf_counter()
         self._draw()
 
@@ -75,9 +77,12 @@ class _Progress:
         self._draw()
 
     def _draw(self) -> None:
+        frac = self.done / max(self.total, 1)
+        if self.callback is not None:
+            self.callback(frac)
+            return
         if self.stream is None:
             return
-        frac = self.done / max(self.total, 1)
         el = time.perf_counter() - self.t0
         rate = self.points_done / el if el > 0 and self.points_done else 0.0
         eta = _hms(self.points_left / rate) if rate > 0 else "--:--:--"
@@ -332,8 +337,9 @@ def sweep(study: Any, *, store: str | Path | None = None, workers: int | None = 
     overwrite : bool
         Replace an existing store (otherwise a store of the same study is
         resumed and one of a different study is an error).
-    progress : bool or text stream
-        Draw a progress bar with ETA (on stderr for ``True``).
+    progress : bool, text stream or callable
+        Draw a progress bar with ETA (on stderr for ``True``), or call
+        ``progress(fraction)`` after every chunk.
     scheduler_timeout : float
         Seconds to wait for ``scheduler``.
 
@@ -380,7 +386,7 @@ def run_sweep(study: Any, *, store: str | Path | None = None, workers: int | Non
         As for :func:`sweep`.
     overwrite : bool
         As for :func:`sweep`.
-    progress : bool or text stream
+    progress : bool, text stream or callable
         As for :func:`sweep`.
     scheduler_timeout : float
         As for :func:`sweep`.
