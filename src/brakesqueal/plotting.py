@@ -189,6 +189,7 @@ def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, 
     return fig
 
 
+@styled
 def plot_path(r: Any, ax: Any = None) -> Any:
     """Largest real part along a 1-D path (the result's stored ``profile``) with its crossings marked.
 
@@ -216,8 +217,17 @@ def plot_path(r: Any, ax: Any = None) -> Any:
     if r.log:
         ax.set_xscale("log")
     ax.set_yscale("symlog", linthresh=1e-2)
-    ax.set_xlabel(r.parameter)
-    ax.set_ylabel("max Re λ [1/s]")
+    from .labels import axis_label
+
+    from .results import _units
+
+    ax.set_xlabel(axis_label(r.parameter, _units(r.parameter, getattr(r, "space", None))))
+    ax.set_ylabel(axis_label("max_real"))
+    from matplotlib.lines import Line2D
+
+    ax.legend(handles=[Line2D([], [], color="tab:red", ls="--", label="destabilizing"),
+                       Line2D([], [], color="tab:green", ls="--", label="stabilizing")],
+              loc="lower left", bbox_to_anchor=(0.0, 1.02), ncols=2, frameon=False, borderaxespad=0.0)
     return fig
 
 
@@ -290,6 +300,7 @@ def save(fig: Any, path: str, dpi: int = 300) -> str:
     return path
 
 
+@styled
 def plot_modes(tracks: Any, fig: Any = None) -> Any:
     """Mode-coupling diagram of :class:`~brakesqueal.analysis.modes.ModeTracks`: frequency and Re λ vs the parameter.
 
@@ -301,7 +312,7 @@ def plot_modes(tracks: Any, fig: Any = None) -> Any:
     from matplotlib.figure import Figure
 
     if fig is None:
-        fig = Figure(figsize=(6.4, 5.2), layout="constrained")
+        fig = Figure(figsize=(3.5, 4.0), layout="constrained")
         FigureCanvasAgg(fig)
     ax_f, ax_r = fig.subplots(2, 1, sharex=True)
     x = tracks.values
@@ -318,11 +329,12 @@ def plot_modes(tracks: Any, fig: Any = None) -> Any:
     ax_r.axhline(0.0, color="0.4", lw=0.8)
     if tracks.log:
         ax_r.set_xscale("log")
-    unit = f" [{tracks.units}]" if tracks.units else ""
-    ax_r.set_xlabel(f"{tracks.parameter}{unit}")
-    ax_f.set_ylabel("frequency [Hz]")
+    from .labels import axis_label
+
+    ax_r.set_xlabel(axis_label(tracks.parameter, tracks.units or ""))
+    ax_f.set_ylabel(axis_label("frequency"))
     ax_r.set_ylabel(r"Re $\lambda$ [1/s]")
     ax_r.set_yscale("symlog", linthresh=max(1e-3, float(np.nanmax(np.abs(re))) * 1e-3))
-    ax_f.legend(fontsize=8, loc="best", ncols=2)
-    ax_f.set_title(f"mode coupling along {tracks.parameter} ({tracks.model})")
+    ax_f.legend(loc="lower left", bbox_to_anchor=(0.0, 1.02), ncols=3, frameon=False, borderaxespad=0.0)
+    ax_f.set_title(f"mode coupling ({tracks.model})", loc="right", fontsize="medium", pad=24)
     return fig
