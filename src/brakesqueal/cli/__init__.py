@@ -230,6 +230,7 @@ SUMMARIES: dict[str, str] = {
     "show": "Parameters of a preset or components of a model.",
     "crossings": "Exact stability changes along a parameter path.",
     "critical-speed": "Onsets and re-stabilisations of squeal along Omega.",
+    "hopf": "Hopf criticality (l1, cycle amplitude) at every crossing on a path.",
     "map": "Stability map over two parameters (NetCDF and figure).",
     "reproduce": "Reproduce the paper's Figures 2 and 3.",
     "modes": "Mode-coupling diagram: every mode along a parameter path.",

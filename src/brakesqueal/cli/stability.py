@@ -151,6 +151,48 @@ def reproduce(
         sys.stdout.write("figures and data: " + ", ".join(s["files"]) + "\n")
 
 
+def _hopf_text(points: list) -> str:  # type: ignore[type-arg]
+    lines = []
+    for hp in points:
+        h = hp.hopf
+        head = f"  {hp.parameter} = {hp.value:.12g} ({hp.direction})"
+        if h is None:
+            lines.append(f"{head}: {hp.message}")
+            continue
+        amp = ", ".join(f"{n}: {a:.4g}" for n, a in list(zip(h.state_names, h.amplitude_coefficients))[:4])
+        lines.append(f"{head}: Hopf at {h.omega0 / (2 * 3.141592653589793):.6g} Hz, {h.criticality}, "
+                     f"l1 = {h.l1:.6g} ± {h.l1_error:.2g}")
+        if h.side:
+            lines.append(f"      cycles for {hp.parameter} {'>' if h.side > 0 else '<'} {h.p0:.12g}; first-harmonic "
+                         f"amplitudes A_j ~ a_j sqrt(|{hp.parameter} - p0|), a_j = {amp}")
+        lines += [f"      warning: {w}" for w in h.warnings]
+    notes = {hp.message for hp in points if hp.hopf is not None and hp.message}
+    lines += [f"  note: {n}" for n in notes]
+    return "\n".join(lines) + "\n"
+
+
+def hopf(
+    along: Annotated[str, typer.Option("--along", help="NAME=START:STOP[:log] path to search.")] = "Omega=1:1e5:log",
+    model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
+    fmt: FormatOpt = OutFormat.text,
+) -> None:
+    """Hopf criticality at every stability crossing on a path: l1, sub/supercritical, predicted cycle amplitude."""
+    from ..analysis.crossings import crossings as _crossings
+    from ..analysis.maps import parse_axis
+    from ..nonlinear.models import hopf_points
+
+    axis = parse_axis(along, with_num=False)
+    space = space_from(model, preset, params, set_)
+    r = _crossings(space, axis)
+    pts = hopf_points(space, axis, result=r)
+    if fmt == OutFormat.json:
+        d = r.to_dict()  # type: ignore[attr-defined]
+        d["crossings"] = [hp.to_dict() for hp in pts]
+        sys.stdout.write(json.dumps(d, indent=2, default=float) + "\n")
+    else:
+        sys.stdout.write(r.text() + _hopf_text(pts))  # type: ignore[attr-defined]
+
+
 def register(app: typer.Typer, bench_app: typer.Typer) -> None:
     """Add the stability commands to ``app`` (their benchmarks are scripts in ``benchmarks/``).
 
@@ -163,5 +205,6 @@ def register(app: typer.Typer, bench_app: typer.Typer) -> None:
     """
     app.command("crossings")(crossings)
     app.command("critical-speed")(critical_speed)
+    app.command("hopf")(hopf)
     app.command("map")(map_)
     app.command("reproduce")(reproduce)

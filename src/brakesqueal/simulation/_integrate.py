@@ -15,7 +15,7 @@ from .estimate import LinearModes, linear_modes
 from .trajectory import EstimationRecord, Trajectory
 
 __all__ = ["METHODS", "POINTS_PER_PERIOD", "START_AMPLITUDE", "SimulationModel", "SilentState", "default_model",
-           "simulation_model", "simulate", "estimation_rate"]
+           "simulation_model", "simulate", "estimation_rate", "state_jacobian"]
 
 #: Integration methods: the compiled DOP853 (default) and SciPy's ``solve_ivp`` methods.
 METHODS: tuple[str, ...] = ("DOP853-jit", "DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
@@ -250,6 +250,54 @@ class SimulationModel:
         self.kernels.contact(yy, l, dl, p, cb)
         return cb.reshape(len(self.pads), 7)
 
+    def vector_field(self, params: Any, silent: SilentState | None = None
+                     ) -> tuple[Callable[[np.ndarray], np.ndarray], Callable[[np.ndarray], np.ndarray]]:
+        """``f(y)`` and its exact Jacobian ``f_y(y)`` at fixed parameters (the pad unknowns solved, warm-started).
+
+        ``f`` is the compiled right-hand side the integrator uses; ``f_y`` is
+        :func:`state_jacobian` of the generated ``d(R, G)/dx`` at the state.
+
+        Parameters
+        ----------
+        params : Parameters
+            The parameters.
+        silent : SilentState, optional
+            The silent motion (default: computed).
+
+        Returns
+        -------
+        f, jac : callable
+            ``f(y) -> (2n + k,)`` and ``jac(y) -> (2n + k, 2n + k)``.
+
+        Raises
+        ------
+        ParameterError
+            (from the callables) when the pad equations cannot be solved at a state.
+        """
+        st = silent or self.silent(params)
+        p = self.parameter_vector(params)
+        plist = list(map(float, p))
+        k, cm, n = self.kernels, self.compiled, self.n
+        l, dl = st.l.copy(), st.dl.copy()
+        g, mw = np.empty(2 * len(l) + 1), np.empty(n * n + n)
+        ny = st.y.size
+
+        def f(y: np.ndarray) -> np.ndarray:
+            out = np.empty(ny)
+            k.rhs(np.ascontiguousarray(y, dtype=float), l, dl, p, st.ztol, g, mw, out)
+            if not np.all(np.isfinite(out)):
+                raise ParameterError("the equations of motion cannot be solved at this state (pad equations or "
+                                     "a singular mass matrix)")
+            return out
+
+        def jac(y: np.ndarray) -> np.ndarray:
+            y = np.ascontiguousarray(y, dtype=float)
+            acc = f(y)[n:2 * n]
+            x = [*y[:n], *y[n:2 * n], *acc, *l, *dl]
+            return state_jacobian(self, cm.jacobian_matrix(x, plist))
+
+        return f, jac
+
     def rhs(self, params: Any, silent: SilentState | None = None) -> Callable[[float, np.ndarray], np.ndarray]:
         """``f(t, y)`` for SciPy (the pad unknowns are solved on the way, warm-started)."""
         st = silent or self.silent(params)
@@ -271,8 +319,31 @@ def _own_linear_matrix(model: SimulationModel, params: Any, sm: Any) -> np.ndarr
     """State matrix of ``E xi' = A xi``, ``xi = (dQ, dQdot, dL_dyn)``; quasi-static pads eliminated (``ldot = 0``)."""
     cm = model.compiled
     p = list(map(float, params.vector()))
-    n, m = cm.n, cm.m
     J = cm.zero_jacobian_matrix(p) if sm.trivial else cm.jacobian_matrix(sm.state(), p)
+    return state_jacobian(model, J)
+
+
+def state_jacobian(model: SimulationModel, J: np.ndarray) -> np.ndarray:
+    """Jacobian of the integrator's vector field ``y' = f(y)``, ``y = (Q, Qdot, L_dynamic)``, at one state.
+
+    Implicit differentiation of the residuals ``(R, G)(Q, Qdot, Qddot, L, Ldot) = 0`` (eq. 44 and the pads'
+    tangential balances) for the unknowns ``Qddot``, the quasi-static pads' ``L`` (``Ldot = 0``) and the
+    dynamic pads' ``Ldot``: ``f_y = E^-1 A``.
+
+    Parameters
+    ----------
+    model : SimulationModel
+        The model (its pad treatment).
+    J : ndarray, shape (n + m, 3n + 2m)
+        ``d(R, G)/dx`` at the state (:meth:`CompiledModel.jacobian_matrix
+        <brakesqueal.codegen.compiled.CompiledModel.jacobian_matrix>`), with the pad unknowns solved there.
+
+    Returns
+    -------
+    ndarray, shape (2n + k, 2n + k)
+    """
+    cm = model.compiled
+    n, m = cm.n, cm.m
     R, G = J[:n], J[n:]
     Q, dQ, ddQ, L, dL = (slice(0, n), slice(n, 2 * n), slice(2 * n, 3 * n), slice(3 * n, 3 * n + m),
                          slice(3 * n + m, 3 * n + 2 * m))  # fmt: skip
