@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import BrakesquealError, ParameterError
+from ..errors import BrakesquealError
 from .hopf import HopfResult, first_lyapunov
 from .system import SmoothSystem
 
