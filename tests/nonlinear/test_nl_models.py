@@ -109,3 +109,35 @@ def test_hopf_text_and_bad_parameter(capsys):
     assert "supercritical" in out and "l1 =" in out and "a_j" in out
     assert main(["hopf", "--along", "Omgea=1:10"]) == 2
     assert "did you mean 'Omega'" in capsys.readouterr().err
+
+
+def test_squeal_branch_finds_contact_loss(tmp_path, capsys):
+    """The branch's contact loss is where a periodic orbit (shooting, independent of the branch) grazes F_n = 0."""
+    from brakesqueal.nonlinear.models import squeal_branch
+
+    space = ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5, "k_ip": math.inf})
+    b = squeal_branch(space, Axis("Omega", 30.0, 40.0), max_points=25)
+    ds = b.data
+    assert b.contact_loss is not None and b.hopf.hopf.p0 < b.contact_loss < 37.0  # about 0.5 rad/s past onset
+    ok = ds["in_contact"].values
+    assert ok[0] and not ok[-1] and np.all(np.diff(ok.astype(int)) <= 0)  # in contact up to a point, then not
+    # independent: the orbit at the contact-loss value, by shooting from the nearest branch orbit
+    system = model_system(space, "Omega")
+    sim = system.simulation_model
+    i = int(np.argmin(np.abs(ds["p"].values - b.contact_loss)))
+    o = find_periodic_orbit(system, ds["orbit"].values[i][0], period=float(ds["period"].values[i]),
+                            p=b.contact_loss, tol=1e-8, n_samples=256)
+    params = space.resolve({"Omega": b.contact_loss})
+    st = sim.silent(params)
+    fmin = min(float(sim.contact_at(params, y, st)[:, 0].min()) for y in o.samples)
+    assert abs(fmin) < 0.03 * 3000.0, fmin  # N0 = 3000 N; the branch interpolates linearly between points
+    # the command line
+    out = tmp_path / "b.nc"
+    assert main(["cycles", "--preset", "paper-fig3", "--set", "mu1=0.5", "--set", "mu2=0.5", "--along",
+                 "Omega=30:40", "--max-points", "25", "--format", "json", "--out", str(out)]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["contact_loss"] and d["hopf"]["hopf"]["criticality"] == "supercritical"
+    import xarray as xr
+
+    with xr.open_dataset(out, engine="scipy") as f:
+        assert "F_n_min" in f and f.sizes["point"] == d["points"]

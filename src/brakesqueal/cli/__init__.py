@@ -231,6 +231,7 @@ SUMMARIES: dict[str, str] = {
     "crossings": "Exact stability changes along a parameter path.",
     "critical-speed": "Onsets and re-stabilisations of squeal along Omega.",
     "hopf": "Hopf criticality (l1, cycle amplitude) at every crossing on a path.",
+    "cycles": "Limit-cycle branch from a Hopf point, up to contact loss.",
     "map": "Stability map over two parameters (NetCDF and figure).",
     "reproduce": "Reproduce the paper's Figures 2 and 3.",
     "modes": "Mode-coupling diagram: every mode along a parameter path.",

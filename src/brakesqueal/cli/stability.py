@@ -193,6 +193,59 @@ def hopf(
         sys.stdout.write(r.text() + _hopf_text(pts))  # type: ignore[attr-defined]
 
 
+def cycles(
+    along: Annotated[str, typer.Option("--along", help="NAME=START:STOP[:log]: the first Hopf point in the range is "
+                                       "continued within it.")],
+    model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
+    fmt: FormatOpt = OutFormat.text, plot: _PlotOpt = None,
+    out: Annotated[Optional[str], typer.Option("--out", help="NetCDF file of the branch (.nc).")] = None,
+    max_points: Annotated[int, typer.Option("--max-points", min=2, max=2000,
+                                            help="Largest number of branch points.")] = 60,
+) -> None:
+    """Limit cycles from the first Hopf point on a path: amplitude, frequency, stability, where a pad lifts off."""
+    from ..analysis.maps import parse_axis
+    from ..nonlinear.models import squeal_branch
+    from ..outputs import atomic_write, check_output
+
+    axis = parse_axis(along, with_num=False)
+    if plot:
+        check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
+    if out:
+        check_output(out, what="--out", suffixes=(".nc",))
+    b = squeal_branch(space_from(model, preset, params, set_), axis, max_points=max_points)
+    if out:
+        ds = b.data.copy()
+        ds.attrs = {k: (json.dumps(v) if isinstance(v, (dict, list, tuple)) or v is None else v)
+                    for k, v in ds.attrs.items()}
+        for k in ("label", "special_kind", "special_description"):
+            if k in ds:
+                ds[k] = ds[k].astype("S")
+        ds = ds.assign_coords(coord=ds["coord"].astype("S"), pad=ds["pad"].astype("S"))
+        with atomic_write(out, what="--out") as tmp:
+            ds.to_netcdf(str(tmp), engine="scipy")
+    if plot:
+        _write_plot(b.plot(), plot)
+    d = b.to_dict()
+    if fmt == OutFormat.json:
+        sys.stdout.write(json.dumps(d, indent=2, default=float) + "\n")
+        return
+    h = b.hopf.hopf
+    lines = [f"Hopf point {axis.name} = {h.p0:.12g}: {h.criticality} (l1 = {h.l1:.6g} ± {h.l1_error:.2g}), "
+             f"{h.omega0 / (2 * 3.141592653589793):.6g} Hz",
+             f"{d['points']} branch points ({d['status']}: {d['message']})"]
+    if b.contact_loss is not None:
+        amp = ", ".join(f"{k}: {v:.4g}" for k, v in list(d["amplitude_at_last_contact_point"].items())[:2])
+        lines.append(f"a pad loses contact at {axis.name} = {b.contact_loss:.8g} (first-harmonic amplitude {amp} "
+                     f"at {d['in_contact_up_to']:.8g}; the bilateral equations do not hold beyond)")
+    else:
+        lines.append("the pads stay in contact along the whole branch")
+    lines += [f"special point {sp['kind']} at {axis.name} = {sp['p']:.10g}" for sp in d["special_points"]
+              if sp["kind"] != "H"]
+    if b.hopf.message:
+        lines.append(f"note: {b.hopf.message}")
+    sys.stdout.write("\n".join(lines) + "\n")
+
+
 def register(app: typer.Typer, bench_app: typer.Typer) -> None:
     """Add the stability commands to ``app`` (their benchmarks are scripts in ``benchmarks/``).
 
@@ -206,5 +259,6 @@ def register(app: typer.Typer, bench_app: typer.Typer) -> None:
     app.command("crossings")(crossings)
     app.command("critical-speed")(critical_speed)
     app.command("hopf")(hopf)
+    app.command("cycles")(cycles)
     app.command("map")(map_)
     app.command("reproduce")(reproduce)

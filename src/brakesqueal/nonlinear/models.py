@@ -41,7 +41,7 @@ from ..errors import BrakesquealError
 from .hopf import HopfResult, first_lyapunov
 from .system import SmoothSystem
 
-__all__ = ["model_system", "hopf_points", "HopfPoint"]
+__all__ = ["model_system", "hopf_points", "HopfPoint", "squeal_branch", "SquealBranch"]
 
 
 def model_system(space: Any, name: str, *, use_cache: bool = True) -> SmoothSystem:
@@ -193,3 +193,127 @@ def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = 
                                  f"no Hopf normal form: {exc}"))
     return out
 
+
+
+@dataclass(frozen=True)
+class SquealBranch:
+    """The limit cycles born at a Hopf point of a brake model, with the pads' contact along them.
+
+    Attributes
+    ----------
+    hopf : HopfPoint
+        Where the branch starts.
+    branch : CycleBranch
+        The continued branch (:func:`~.continuation.continue_cycles`); its
+        ``data`` gains ``F_n_min`` (dims ``point, pad``: the smallest normal
+        force over one period [N]) and ``in_contact`` (every pad pressed over
+        the whole period).
+    contact_loss : float or None
+        Parameter value where the first pad's normal force first reaches zero
+        on the orbit (interpolated between branch points); beyond it the
+        bilateral equations do not describe the brake (the pad lifts off).
+    pads : tuple of str
+        Pad names (the ``pad`` dimension).
+    """
+
+    hopf: HopfPoint
+    branch: Any
+    contact_loss: float | None
+    pads: tuple[str, ...]
+
+    @property
+    def data(self) -> Any:
+        """The branch's :class:`xarray.Dataset` (see :attr:`branch`)."""
+        return self.branch.data
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary: Hopf data, contact loss, amplitude and frequency there, folds, status."""
+        ds = self.data
+        p = ds["p"].values
+        ok = ds["in_contact"].values
+        last = int(np.flatnonzero(ok)[-1]) if ok.any() else 0
+        coords = [str(c) for c in ds["coord"].values]
+        return {
+            "hopf": self.hopf.to_dict(), "points": int(p.size), "status": self.branch.status,
+            "message": self.branch.message, "contact_loss": self.contact_loss,
+            "in_contact_up_to": float(p[last]),
+            "amplitude_at_last_contact_point": dict(zip(coords, map(float, ds["amplitude"].values[last]))),
+            "frequency_hz_at_last_contact_point": float(ds["frequency"].values[last]),
+            "special_points": [{"kind": str(k), "p": float(v)} for k, v in
+                               zip(ds["special_kind"].values, ds["special_p"].values)],
+            "hysteresis_range": ds.attrs.get("hysteresis_range"),
+        }
+
+    def plot(self, coord: str | int | None = None) -> Any:
+        """Bifurcation diagram (:meth:`CycleBranch.plot`) with the contact loss marked."""
+        fig = self.branch.plot(coord)
+        if self.contact_loss is not None:
+            for ax in fig.axes:
+                ax.axvline(self.contact_loss, color="tab:red", ls=":", lw=1)
+            fig.axes[0].annotate("contact loss", (self.contact_loss, 0.95), xycoords=("data", "axes fraction"),
+                                 color="tab:red", fontsize="small", ha="left", va="top")
+        return fig
+
+
+def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: bool = True,
+                  tol: float = 1e-8) -> SquealBranch:
+    """Continue the limit cycles from the first Hopf point on a path and find where a pad loses contact.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    axis : Axis
+        The path: the first Hopf point with a cycle prediction in
+        ``(start, stop)`` is continued within that range.
+    max_points : int
+        Largest number of branch points.
+    use_cache : bool
+        Use the on-disk code cache.
+    tol : float
+        Newton tolerance of the shooting (scaled update).
+
+    Returns
+    -------
+    SquealBranch
+
+    Raises
+    ------
+    ParameterError
+        No Hopf point with a cycle prediction on the path.
+    """
+    from ..errors import ParameterError
+    from .continuation import continue_cycles
+
+    pts = [hp for hp in hopf_points(space, axis, use_cache=use_cache) if hp.hopf is not None and hp.hopf.side]
+    if not pts:
+        raise ParameterError(f"no Hopf point with a limit-cycle prediction for {axis.name} in "
+                             f"({axis.start:g}, {axis.stop:g}); see brakesqueal hopf")
+    hp = pts[0]
+    system = model_system(space, axis.name, use_cache=use_cache)
+    sim = system.simulation_model  # type: ignore[attr-defined]
+    br = continue_cycles(system, hp.hopf, (axis.start, axis.stop), max_points=max_points, tol=tol)
+    ds = br.data
+    p = ds["p"].values
+    orbits = ds["orbit"].values
+    fmin = np.full((p.size, len(sim.pads)), np.nan)
+    for i in range(p.size):
+        params = space.resolve({axis.name: float(p[i])})
+        st = sim.silent(params)
+        fmin[i] = np.min([sim.contact_at(params, y, st)[:, 0] for y in orbits[i]], axis=0)
+    worst = fmin.min(axis=1)
+    loss = None
+    bad = np.flatnonzero(~(worst > 0))
+    if bad.size and bad[0] > 0:
+        i = int(bad[0])
+        a, b = worst[i - 1], worst[i]
+        loss = float(p[i - 1] + (p[i] - p[i - 1]) * a / (a - b)) if a != b else float(p[i])
+    import xarray as xr
+
+    ds["F_n_min"] = xr.DataArray(fmin, dims=("point", "pad"), coords={"pad": list(sim.pads)},
+                                 attrs={"units": "N", "long_name": "smallest normal force over one period"})
+    ds["in_contact"] = xr.DataArray(worst > 0, dims=("point",),
+                                    attrs={"long_name": "every pad pressed over the whole period (bilateral "
+                                                        "equations valid)"})
+    ds.attrs["contact_loss"] = np.nan if loss is None else loss
+    return SquealBranch(hp, br, loss, tuple(sim.pads))
