@@ -265,7 +265,8 @@ def _rows(space: object, plan: _Plan, eigen: bool, chunk_points: int) -> Iterato
     kern, outer, inner = plan.kern, plan.outer, plan.inner
     ov, iv = outer.values(), inner.values()
     n_o, n_i = ov.size, iv.size
-    rows = max(1, chunk_points // n_i)
+    # without a compiled kernel points may go one by one: smaller blocks, so progress is reported often
+    rows = max(1, (chunk_points if kern is not None else min(chunk_points, 4096)) // n_i)
     buf = np.empty((min(rows, n_o), n_i), dtype=np.uint8)
     for r0 in range(0, n_o, rows):
         r1 = min(n_o, r0 + rows)
