@@ -10,6 +10,8 @@ just either side of it.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 import scipy.linalg
@@ -137,3 +139,28 @@ def test_boundary_bad_options():
         stability_boundary(space, x, y, st, ss)
     # a uniformly stable map has no boundary
     assert stability_boundary(space, y, x, st | True, ss).vertices == 0
+
+
+def test_fig3_tips_close_the_squeal_region():
+    """At a located tip the onset and the re-stabilisation meet: just inside both exist and are close to the
+    tip's speed, just outside the silent motion is stable on the whole range (exact critical speeds)."""
+    from brakesqueal.analysis.crossings import critical_speeds_many
+    from brakesqueal.reproduce import fig3_tips
+
+    space = ParameterSpace.from_preset("paper-fig3", {"k_ip": math.inf})
+    diff = np.linspace(-0.9, 0.9, 19)
+    roots, dirs, counts, _ = critical_speeds_many(space, {"mu1": (1 + diff) / 2, "mu2": (1 - diff) / 2}, 1.0, 1e5)
+    onset = np.array([r[d < 0][0] if np.any(d < 0) else np.nan for r, d in zip(roots, dirs)])
+    tips = fig3_tips(space, diff, onset, np.ones(diff.size, bool), (1.0, 1e5))
+    assert len(tips) == 2 and tips[0][0] == pytest.approx(-tips[1][0], rel=1e-9)  # symmetric in mu1 - mu2
+    for d_tip, w_tip in tips:
+        inward = -np.sign(d_tip)
+        for d, has in ((d_tip + inward * 1e-6, True), (d_tip - inward * 1e-6, False)):
+            r, dd, c, _ = critical_speeds_many(space, {"mu1": np.array([(1 + d) / 2]),
+                                                       "mu2": np.array([(1 - d) / 2])}, 1.0, 1e5)
+            down = r[0][dd[0] < 0]
+            assert bool(down.size) is has
+            if has:
+                up = r[0][(dd[0] > 0) & (r[0] > down[0])]
+                assert up.size and down[0] < w_tip < up[0]
+                assert (up[0] - down[0]) / w_tip < 0.1  # the region closes at the tip

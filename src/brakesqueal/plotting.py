@@ -85,6 +85,16 @@ def plot_map(m: Any, ax: Any = None, *, x: str | None = None, title: str | None 
                            boundary=boundary_of(ds, (xn, yn)), color=color, field=field)
 
 
+def _title(fig: Any, ax: Any, title: str, own: bool) -> None:
+    """A figure of its own gets a centred title above the legend; axes in a user's figure get an axes title."""
+    if not title:
+        return
+    if own:
+        fig.suptitle(title, fontsize="medium")
+    else:
+        ax.set_title(title, loc="right", fontsize="medium", pad=28)
+
+
 def map_title(space: str, xn: str, yn: str) -> str:
     """Default title of a map: what it shows, over which parameters, for which preset."""
     from .labels import symbol
@@ -138,6 +148,7 @@ def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, 
         raise ParameterError(f"color must be one of {', '.join(MAP_COLORS)}; got {color!r}")
     if color != "verdict" and field is None:
         raise ParameterError(f"color = {color!r} needs the map's {color} (a map computed without --no-eigen)")
+    own = ax is None
     fig, ax = new_figure(ax)
     (xn, xs, xu, xlog), (yn, ys, yu, ylog) = xaxis, yaxis
     status = np.asarray(status)
@@ -184,8 +195,7 @@ def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, 
     # outside the axes, above them: never over the data (loc="best" would also test every mesh cell)
     ax.legend(handles=handles, loc="lower left", bbox_to_anchor=(0.0, 1.02), ncols=2, frameon=False,
               borderaxespad=0.0, handlelength=1.5)
-    if title:
-        ax.set_title(title, loc="right", fontsize="medium", pad=16)
+    _title(fig, ax, title, own)
     return fig
 
 
@@ -261,6 +271,7 @@ def plot_critical_curves(diff: np.ndarray, curves: dict[str, np.ndarray], ax: An
     """
     from .labels import axis_label, symbol
 
+    own = ax is None
     fig, ax = new_figure(ax)
     for label, y in curves.items():
         fin = np.flatnonzero(np.isfinite(y))
@@ -289,8 +300,7 @@ def plot_critical_curves(diff: np.ndarray, curves: dict[str, np.ndarray], ax: An
         ax.set_ylabel(axis_label("Omega_crit"))
     ax.set_xlabel(f"${symbol('mu1')} - {symbol('mu2')}$  (${symbol('mu1')} + {symbol('mu2')} = 1$)")
     ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.02), ncols=2, frameon=False, borderaxespad=0.0)
-    if title:
-        ax.set_title(title, loc="right", fontsize="medium", pad=30)
+    _title(fig, ax, title, own)
     return fig
 
 
