@@ -91,7 +91,7 @@ def _nearest(grid: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def stability_boundary(space: Any, outer: Any, inner: Any, stable: np.ndarray, status: np.ndarray, *,
-                       iterations: int = 40, budget: float = 10.0) -> Boundary:
+                       iterations: int = 40, budget: float | None = None) -> Boundary:
     """Stability boundary of a map, refined onto the boundary by bisection along grid edges.
 
     Parameters
@@ -106,10 +106,11 @@ def stability_boundary(space: Any, outer: Any, inner: Any, stable: np.ndarray, s
         :class:`~brakesqueal.status.PointStatus` codes of the map.
     iterations : int
         Bisection steps per vertex, in ``[0, 60]`` (0: no refinement).
-    budget : float
+    budget : float, optional
         Wall-time budget [s] of the refinement; when it runs out, the
         bisection stops and every vertex keeps its current bracket (its
-        ``width`` says how far it got).
+        ``width`` says how far it got).  The default, no budget, keeps the
+        result independent of the machine's speed.
 
     Returns
     -------
@@ -126,7 +127,7 @@ def stability_boundary(space: Any, outer: Any, inner: Any, stable: np.ndarray, s
 
     if not (isinstance(iterations, (int, np.integer)) and 0 <= iterations <= 60):
         raise ParameterError(f"stability_boundary: 'iterations' must be an integer in [0, 60]; got {iterations!r}")
-    if not (math.isfinite(budget) and budget > 0):
+    if budget is not None and not (math.isfinite(budget) and budget > 0):
         raise ParameterError(f"stability_boundary: 'budget' must be positive [s]; got {budget!r}")
     stable = np.asarray(stable)
     status = np.asarray(status)
@@ -187,7 +188,7 @@ def stability_boundary(space: Any, outer: Any, inner: Any, stable: np.ndarray, s
             lo_t[upd] = np.where(same[good], mid[upd], lo_t[upd])
             hi_t[upd] = np.where(same[good], hi_t[upd], mid[upd])
             alive[sel[~good]] = False  # a hole inside the bracket: keep the last bracket
-            if time.perf_counter() - t0 > budget:
+            if budget is not None and time.perf_counter() - t0 > budget:
                 break  # out of time: every vertex keeps its current (narrowed) bracket
         pos[todo] = 0.5 * (lo_t + hi_t)
         refined[todo] = np.abs(hi_t - lo_t) < np.abs(b[todo] - a[todo])

@@ -53,8 +53,9 @@ MAX_POINTS = 10**9
 MAX_MAP_BYTES = 4 * 2**30
 #: Largest map [points] whose stability boundary is located and stored.
 BOUNDARY_MAX_POINTS = 16 * 10**6
-#: Wall-time budget [s] of the boundary's bisection (vertices keep their bracket when it runs out).
-BOUNDARY_BUDGET = 1.0
+#: Bisection steps of a map's boundary vertices: brackets of 2^-12 ~ 2e-4 of a grid step (the exact
+#: arithmetic that decides points closer to the boundary is not needed for a figure, and costs seconds).
+BOUNDARY_ITERATIONS = 12
 #: Maps with more points than this store ``max_real`` and ``frequency`` as float32.
 _FLOAT32_ABOVE = 2 * 10**7
 
@@ -329,7 +330,7 @@ def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen
         Also locate the stability boundary as curves refined onto it by
         bisection (:func:`~.boundary.stability_boundary`; stored as
         ``boundary_<name>`` variables; only for maps of at most
-        :data:`BOUNDARY_MAX_POINTS` points, within :data:`BOUNDARY_BUDGET` seconds).
+        :data:`BOUNDARY_MAX_POINTS` points, to :data:`BOUNDARY_ITERATIONS` bisection steps).
 
     Returns
     -------
@@ -373,7 +374,7 @@ def _boundary(space: object, plan: _Plan, stable: np.ndarray, status: np.ndarray
 
     if plan.outer.num * plan.inner.num > BOUNDARY_MAX_POINTS:
         return None
-    return stability_boundary(space, plan.outer, plan.inner, stable, status, budget=BOUNDARY_BUDGET)
+    return stability_boundary(space, plan.outer, plan.inner, stable, status, iterations=BOUNDARY_ITERATIONS)
 
 
 @dataclass(frozen=True)
