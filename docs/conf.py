@@ -33,6 +33,7 @@ extensions = [
     "sphinx.ext.autosummary",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",  # MathJax 3 bundled into _static/mathjax: no CDN (sets mathjax_path)
     "bsdocs",
 ]
 
@@ -57,9 +58,37 @@ napoleon_numpy_docstring = True
 napoleon_use_rtype = False
 napoleon_use_ivar = True
 
-html_theme = "alabaster"
+# pydata-sphinx-theme (NumPy, SciPy, pandas, xarray): light/dark switch, search as you type. Its CSS,
+# JavaScript and icon font ship with the package; nothing here may point off the machine (no icon links,
+# analytics, version switcher or announcement URL), and ``make docs`` checks it after the build
+# (``_ext/check_offline.py``).
+html_theme = "pydata_sphinx_theme"
 html_title = f"brakesqueal {release}"
-html_static_path: list[str] = []
+html_static_path: list[str] = ["_static"]
+html_css_files = ["brakesqueal.css"]
+html_show_sourcelink = False
+html_theme_options = {
+    "search_as_you_type": True,
+    "navbar_align": "left",
+    "header_links_before_dropdown": 6,
+    "show_toc_level": 2,
+    "navigation_with_keys": False,
+    "icon_links": [],
+    "external_links": [],
+    "analytics": {},
+    "footer_start": ["copyright"],
+    "footer_center": [],
+    "footer_end": [],
+    "secondary_sidebar_items": ["page-toc"],
+    "pygments_light_style": "tango",
+    "pygments_dark_style": "monokai",
+}
+html_context = {"default_mode": "auto"}  # follow the reader's system setting until the switch is used
+
+# Mathematics: $...$ / $$...$$ (MyST dollarmath) rendered by the bundled MathJax 3 (see the extension above).
+# Equation numbers are the paper's: display equations carry ``\tag{N}`` and a target ``(eq-N)=``, so that any
+# page or docstring can link to them (``{ref}`eq. (44) <eq-44>```, ``:ref:`eq. (44) <eq-44>```).
+mathjax3_config = {"chtml": {"displayAlign": "center"}}
 
 # The README's ``console`` blocks hold comments with apostrophes, which Pygments' console lexer
 # cannot tokenize; Sphinx then falls back to plain text.  Only the colouring is affected.
