@@ -13,6 +13,9 @@
 * ``.. brakesqueal-gallery::`` shows every ``figures/*.png`` (sorted by name).
 * ``.. brakesqueal-guides::`` is a toctree of the top-level pages that are not
   in ``bsdocs_fixed_pages`` (the guides colleagues add to ``docs/``).
+* ``.. brakesqueal-equations::`` is the table "equation of the theory page →
+  function" of ``_ext/equations.py``; each module's API page lists its own rows
+  under "Theory", linking back to the equations.
 """
 
 from __future__ import annotations
@@ -34,6 +37,11 @@ from sphinx.util.docutils import SphinxDirective
 from sphinx.util.nodes import nested_parse_with_titles
 
 logger = logging.getLogger(__name__)
+
+try:  # the docs' own table; bsdocs also works without it
+    from equations import EQUATIONS
+except ImportError:  # pragma: no cover
+    EQUATIONS = []
 
 PACKAGE = "brakesqueal"
 API_DIR = "api"
@@ -157,11 +165,37 @@ def _directive(obj: Any) -> str:
     return "autodata"
 
 
+def _equation_ref(label: str, eqs: str) -> str:
+    return f":ref:`eq. {eqs} <{label}>`" if eqs[:1] == "(" else f":ref:`{eqs} <{label}>`"
+
+
+def equation_rows(modname: str | None = None) -> list[tuple[str, str, str, str]]:
+    """Rows of :data:`equations.EQUATIONS` (those of functions defined in ``modname`` if given)."""
+    return [row for row in EQUATIONS if modname is None or row[2].rsplit(".", 1)[0] == modname]
+
+
+def check_equation_rows() -> None:
+    """Warn (an error under ``-W``) about rows whose function cannot be found."""
+    for _, _, name, _ in EQUATIONS:
+        modname, attr = name.rsplit(".", 1)
+        try:
+            ok = hasattr(importlib.import_module(modname), attr)
+        except ImportError:
+            ok = False
+        if not ok:
+            logger.warning("bsdocs: _ext/equations.py names %s, which does not exist", name)
+
+
 def module_page(modname: str, table: dict[tuple[str, str], str], modules: list[str]) -> str:
     """reST source of one module's API page."""
     mod = importlib.import_module(modname)
     title = f"``{modname}``"
     lines = [title, "=" * len(title), "", f".. automodule:: {modname}", "   :no-members:", ""]
+    rows = equation_rows(modname)
+    if rows:
+        lines += [".. rubric:: Theory", "", "Equations of the :doc:`theory page </theory>` implemented here:", ""]
+        lines += [f"* {_equation_ref(label, eqs)}: :func:`~{name}` — {what}" for label, eqs, name, what in rows]
+        lines += [""]
     own, reexported = [], []
     for name in public_names(mod):
         if inspect.ismodule(getattr(mod, name, None)):
@@ -207,6 +241,7 @@ def write_api_pages(app: Sphinx) -> None:
     for name, err in sorted(errors.items()):
         logger.warning("bsdocs: module %s cannot be imported: %s", name, err)
     table = canonical_locations(modules)
+    check_equation_rows()
     for m in modules:
         (out / f"{m}.rst").write_text(module_page(m, table, modules))
 
@@ -288,6 +323,21 @@ class GuidesDirective(SphinxDirective):
         return node.children
 
 
+class EquationsDirective(SphinxDirective):
+    """The table "equation of the theory page → function that implements it" (``_ext/equations.py``)."""
+
+    has_content = False
+
+    def run(self) -> list[nodes.Node]:
+        lines = [".. list-table::", "   :header-rows: 1", "   :widths: 18 32 50", "   :class: eq-map", "",
+                 "   * - Equations", "     - Function", "     - What it computes"]  # fmt: skip
+        for label, eqs, name, what in equation_rows():
+            lines += [f"   * - {_equation_ref(label, eqs)}", f"     - :func:`{name}`", f"     - {what}"]
+        node = nodes.container()
+        self.state.nested_parse(StringList(lines, source="_ext/equations.py"), self.content_offset, node)
+        return node.children
+
+
 def setup(app: Sphinx) -> dict[str, Any]:
     """Register the generator and the directives."""
     app.connect("builder-inited", write_api_pages)
@@ -295,5 +345,6 @@ def setup(app: Sphinx) -> dict[str, Any]:
     app.add_directive("brakesqueal-cli", CliDirective)
     app.add_directive("brakesqueal-gallery", GalleryDirective)
     app.add_directive("brakesqueal-guides", GuidesDirective)
+    app.add_directive("brakesqueal-equations", EquationsDirective)
     app.add_config_value("bsdocs_fixed_pages", [], "env")
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
