@@ -424,6 +424,8 @@ EXEMPT = {
     "plotting.py": "figures of results (nonlinear/continuation.py's branch plot): generates no cached code",
     "model/parameters.py": "parameter values and presets: never enter generated code",
     "model/roles.py": "ranges and units of parameters: validation only",
+    "nonlinear/models.py": "brake models as systems of the nonlinear machinery: runs the simulation's generated "
+                           "kernels and the crossings, generates no code",
 }  # fmt: skip
 
 
