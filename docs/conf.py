@@ -42,7 +42,7 @@ root_doc = "index"
 exclude_patterns = ["_build", "_ext", "figures/**", "**/.ipynb_checkpoints", "README.md"]
 templates_path: list[str] = []
 
-# MyST: the existing pages use plain Markdown; $...$ math and ::: fences are allowed in new ones.
+# MyST: Markdown pages with $...$ / $$...$$ mathematics (dollarmath) and ::: fences.
 myst_enable_extensions = ["colon_fence", "dollarmath"]
 myst_heading_anchors = 3
 
