@@ -24,6 +24,13 @@ def test_every_command_has_a_complete_summary(capsys):
         assert re.sub(r"\s+", " ", text) in flat, name
 
 
+def test_sub_command_summaries_are_whole_sentences(capsys):
+    for group in ("bench", "cache"):
+        assert main([group, "--help"]) == 0
+        listed = re.sub(r"\s+", " ", capsys.readouterr().out.split("Commands:", 1)[1])
+        assert "..." not in listed and not re.search(r"\bvs\.\s*(\w+\s{2,}|$)", listed), listed
+
+
 def test_no_arguments_prints_the_help(capsys):
     assert main([]) == 0
     assert "Commands:" in capsys.readouterr().out

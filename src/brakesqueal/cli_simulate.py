@@ -180,7 +180,8 @@ def _write(tr: Any, out: str | None, plot: str | None, wav: str | None) -> None:
 def _bench_cmd(
     fmt: Annotated[str, typer.Option("--format", help="Output format: text | json.")] = "text",
     baseline_t: Annotated[
-        float, typer.Option("--baseline-t", help="Simulated time of the (slow) lambdify baseline run [s].")
+        float, typer.Option("--baseline-t", min=1e-4, max=0.05,
+                            help="Simulated time of the (slow) lambdify baseline run [s].")
     ] = 0.002,
 ) -> None:
     """1 s of simulated squeal: paper-fig2 vs. lambdify + solve_ivp RK45; eight-dof vs. the former built-model path."""

@@ -243,12 +243,27 @@ SUMMARIES: dict[str, str] = {
 }
 
 
+def _first_sentence(doc: str | None) -> str:
+    import re
+
+    text = " ".join((doc or "").strip().split("\n\n")[0].split())
+    m = re.search(r"(?<!\bvs)(?<!\be\.g)(?<!\bi\.e)\.\s", text)  # not after an abbreviation
+    return text if m is None else text[:m.start() + 1]
+
+
 def _apply_summaries() -> None:
-    """Give every registered command and group its complete one-line summary."""
+    """Give every command and group a complete one-line summary (sub-commands: their docstring's first sentence)."""
     for info in [*app.registered_commands, *app.registered_groups]:
         name = info.name or (info.callback.__name__ if getattr(info, "callback", None) else None)
         if name in SUMMARIES:
             info.short_help = SUMMARIES[name]
+    for group in app.registered_groups:
+        sub = group.typer_instance
+        if sub is None:
+            continue
+        for cmd in sub.registered_commands:
+            if not cmd.short_help:
+                cmd.short_help = _first_sentence(cmd.help or (cmd.callback.__doc__ if cmd.callback else None))
 
 
 _apply_summaries()

@@ -73,7 +73,8 @@ def sweep(
 
 def bench_sweep(
     fmt: Annotated[_Fmt, typer.Option("--format", help="Output format.")] = _Fmt.text,
-    points: Annotated[int, typer.Option("--points", help="Points of the scaling study (3-D, verdict only).")]
+    points: Annotated[int, typer.Option("--points", min=1000, max=10**9,
+                                                   help="Points of the scaling study (3-D, verdict only).")]
     = 20_000_000,
     large: Annotated[bool, typer.Option("--large/--no-large", help="Also run the 1e8-point 3-D study in a "
                                                                     "subprocess and report its peak memory.")]

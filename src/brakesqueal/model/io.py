@@ -48,13 +48,62 @@ from .expressions import evaluate
 from .parameters import Preset, Value
 
 __all__ = ["spec_from_dict", "spec_to_dict", "load_model", "model_to_toml", "read_toml", "load_parameter_file",
-           "parameters_to_toml", "MAX_FILE_BYTES"]
+           "parameters_to_toml", "MAX_FILE_BYTES", "read_toml_text"]
 
 #: Largest model, parameter or study file read.
 MAX_FILE_BYTES = 1 << 20
 
 _TOP = ("name", "description", "reference", "parameters", "disk", "pads", "calipers", "presets")
 _PRESET_KEYS = ("description", "reference", "free", "fixed", "tied", "auxiliary")
+
+
+def _overflow(text: str) -> float:
+    """TOML float parser that refuses overflow (``1e400``): only a literal ``inf`` means infinity."""
+    v = float(text)
+    if math.isinf(v) and text.strip().lstrip("+-").lower() != "inf":
+        raise _Overflow(text)
+    return v
+
+
+class _Overflow(ValueError):
+    """A TOML number beyond the double range."""
+
+
+def read_toml_text(path: str, what: str) -> tuple[str, dict[str, Any]]:
+    """Read a TOML file (at most :data:`MAX_FILE_BYTES`): its text and document; every failure one ParameterError.
+
+    Parameters
+    ----------
+    path : str
+        The file.
+    what : str
+        What the file is, for messages (``"model file"``, ``"parameter file"``, ``"study file"``).
+
+    Returns
+    -------
+    text : str
+        The file's text.
+    data : dict
+        The parsed TOML document (numbers beyond the double range are refused, never read as infinity).
+    """
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise ParameterError(f"cannot read {what} '{path}': {exc.strerror or exc}") from None
+    if len(raw) > MAX_FILE_BYTES:
+        raise ParameterError(f"{what} '{path}' is larger than {MAX_FILE_BYTES // 1024} KiB; refusing to read it")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"{what} '{path}' is not UTF-8 text (byte {exc.start})") from None
+    try:
+        return text, tomllib.loads(text, parse_float=_overflow)
+    except _Overflow as exc:
+        raise ParameterError(f"{what} '{path}': the number {exc} overflows (at most 1.8e308; write inf for a "
+                             "rigid support)") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"{what} '{path}' is not valid TOML: {exc}") from None
 
 
 def read_toml(path: str, what: str) -> dict[str, Any]:
@@ -72,21 +121,7 @@ def read_toml(path: str, what: str) -> dict[str, Any]:
     dict
         The parsed TOML document.
     """
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read(MAX_FILE_BYTES + 1)
-    except OSError as exc:
-        raise ParameterError(f"cannot read {what} '{path}': {exc.strerror or exc}") from None
-    if len(raw) > MAX_FILE_BYTES:
-        raise ParameterError(f"{what} '{path}' is larger than {MAX_FILE_BYTES // 1024} KiB; refusing to read it")
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise ParameterError(f"{what} '{path}' is not UTF-8 text (byte {exc.start})") from None
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"{what} '{path}' is not valid TOML: {exc}") from None
+    return read_toml_text(path, what)[1]
 
 
 def _fields(cls: type, data: Mapping[str, Any], where: str) -> dict[str, Any]:

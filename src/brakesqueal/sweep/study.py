@@ -31,7 +31,6 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -394,16 +393,9 @@ def _default_chunks(shape: tuple[int, ...], points: int) -> tuple[int, ...]:
 
 
 def _read(path: str) -> tuple[str, dict[str, Any]]:
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ParameterError(f"cannot read study file '{path}': {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise ParameterError(f"study file '{path}' is not valid UTF-8 text") from None
-    try:
-        return text, tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"study file '{path}' is not valid TOML: {exc}") from None
+    from ..model.io import read_toml_text
+
+    return read_toml_text(path, "study file")
 
 
 def load_study(study: Any) -> Study:

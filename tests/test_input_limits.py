@@ -1,0 +1,52 @@
+"""Every input file channel refuses overflowing numbers and oversized files with one line (exit 2)."""
+
+from __future__ import annotations
+
+import pytest
+
+from brakesqueal.cli import main
+from brakesqueal.model import get_model, model_to_toml
+from brakesqueal.model.io import MAX_FILE_BYTES
+
+
+def _run(capsys, *args):
+    rc = main(list(args))
+    err = capsys.readouterr().err.strip().splitlines()
+    return rc, err
+
+
+@pytest.mark.parametrize("number", ["1e400", "-1e999", "2e308"])
+def test_overflowing_toml_numbers_are_refused_everywhere(tmp_path, capsys, number):
+    params = tmp_path / "p.toml"
+    params.write_text(f'preset = "paper-fig2"\n[parameters]\nk_ip = {number}\n')
+    rc, err = _run(capsys, "linearize", "--params", str(params))
+    assert rc == 2 and len(err) == 1 and "overflows" in err[0] and number in err[0]
+    model = tmp_path / "m.toml"
+    text = model_to_toml(get_model("paper"))
+    assert "k_ip1 = " in text
+    lines = [f"k_ip1 = {number}" if ln.startswith("k_ip1 = ") else ln for ln in text.splitlines()]
+    model.write_text("\n".join(lines) + "\n")
+    rc, err = _run(capsys, "linearize", "--model", str(model))
+    assert rc == 2 and len(err) == 1 and "overflows" in err[0]
+    study = tmp_path / "s.toml"
+    study.write_text(f'preset = "paper-fig2"\n[parameters]\nk_ip = {number}\n[axes]\nmu = "0.1:1:3"\n'
+                     'N0 = "1000:2000:2"\n')
+    rc, err = _run(capsys, "sweep", str(study), "--out", str(tmp_path / "s.zarr"))
+    assert rc == 2 and len(err) == 1 and "overflows" in err[0]
+
+
+def test_inf_is_still_a_rigid_support(tmp_path, capsys):
+    params = tmp_path / "p.toml"
+    params.write_text('preset = "paper-fig2"\n[parameters]\nk_ip = inf\n')
+    assert main(["linearize", "--params", str(params), "--format", "json"]) == 0
+    assert '"k_ip1": "inf"' in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("command", [["sweep"], ["sweep", "--status"], ["linearize", "--params"],
+                                     ["linearize", "--model"]])
+def test_oversized_and_endless_files_are_refused(tmp_path, capsys, command):
+    big = tmp_path / "big.toml"
+    big.write_text("# " + "x" * (MAX_FILE_BYTES + 10) + "\n")
+    for path in (str(big), "/dev/zero"):
+        rc, err = _run(capsys, *command, path)
+        assert rc == 2 and len(err) == 1 and "larger than" in err[0], err
