@@ -35,11 +35,12 @@ extensions = [
     "sphinx.ext.mathjax",
     "sphinx-mathjax-offline",  # MathJax 3 bundled into _static/mathjax: no CDN (sets mathjax_path)
     "bsdocs",
+    "gallery_run",  # runs the gallery's commands at build time (docs/_generated/gallery)
 ]
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 root_doc = "index"
-exclude_patterns = ["_build", "_ext", "figures/**", "**/.ipynb_checkpoints", "README.md"]
+exclude_patterns = ["_build", "_ext", "_generated", "figures/**", "**/.ipynb_checkpoints", "README.md"]
 templates_path: list[str] = []
 
 # MyST: Markdown pages with $...$ / $$...$$ mathematics (dollarmath) and ::: fences.
