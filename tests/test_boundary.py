@@ -164,3 +164,26 @@ def test_fig3_tips_close_the_squeal_region():
                 up = r[0][(dd[0] > 0) & (r[0] > down[0])]
                 assert up.size and down[0] < w_tip < up[0]
                 assert (up[0] - down[0]) / w_tip < 0.1  # the region closes at the tip
+
+
+@pytest.mark.parametrize("kip", [3e5, 1e6, 1e8])
+def test_points_on_the_boundary_get_one_verdict_everywhere(kip):
+    """At the float nearest an exact crossing (and its neighbours) linearize, eigen-analysis, the per-point
+    evaluator and a map report the same verdict."""
+    from brakesqueal.analysis.eigen import eigen_analysis
+    from brakesqueal.analysis.points import evaluate_point
+
+    space = ParameterSpace.from_preset("paper-fig2", {"k_ip": kip})
+    r = crossings(space, Axis("mu", 0.05, 1.0))
+    assert r.crossings
+    for v, _ in r.crossings:
+        for mu in (np.nextafter(v, 0), v, np.nextafter(v, 2)):
+            lin = eigen_analysis(linearize(space.resolve({"mu": float(mu)}))).verdict().status
+            pv = evaluate_point(space, {"mu": float(mu)})
+            pt = "stable" if pv.stable else ("unstable" if pv.decided else "undecided")
+            d_t = space.value("d_t")
+            m = stability_map(space, Axis("mu", float(mu), 1.5, 2), Axis("d_t", d_t, 2 * d_t + 1, 2), boundary=False)
+            row = m.data.sel(mu=float(mu), d_t=d_t)
+            mp = "stable" if bool(row.stable.values) else ("unstable" if int(row.status.values) == 0
+                                                             else "undecided")
+            assert lin == pt == mp, (kip, mu, lin, pt, mp)

@@ -55,7 +55,7 @@ import numpy as np
 from ..errors import ParameterError, SilentMotionError
 from ..status import PointStatus, status_of_error
 from .robust import (
-    STABLE, UNDECIDED, descriptor_verdicts, eigen_verdicts, matrix_verdicts, trivial_verdicts,
+    STABLE, UNDECIDED, UNSTABLE, descriptor_verdicts, eigen_verdicts, matrix_verdicts, trivial_verdicts,
 )
 
 __all__ = ["PointVerdict", "Points", "evaluate", "evaluate_arrays", "evaluate_point", "linear_verdict",
@@ -263,7 +263,26 @@ def linear_verdict(lm: Any) -> tuple[int, float, float]:
         c, mr, fr = matrix_verdicts(lm.M, lm.D, lm.K)
     else:
         c, mr, fr = eigen_verdicts(lm.M[None], lm.D[None], lm.K[None])
+    if int(c[0]) == UNDECIDED and getattr(getattr(lm, "silent", None), "trivial", False):
+        # the float matrices cannot decide (a point on the boundary to rounding): the parameter point's own
+        # route can (closed forms in exact arithmetic), and maps and sweeps report that verdict
+        pv = _point_of(lm)
+        if pv is not None and pv.decided:
+            return (STABLE if pv.stable else UNSTABLE), pv.max_real, pv.frequency
     return int(c[0]), float(mr[0]), float(fr[0])
+
+
+def _point_of(lm: Any) -> PointVerdict | None:
+    """The per-point verdict of a linear model's parameters (``None`` if they cannot be evaluated so)."""
+    from ..model.parameters import ParameterSpace
+
+    params = getattr(lm, "params", None)
+    if params is None:
+        return None
+    try:
+        return evaluate_point(ParameterSpace.from_parameters(params))
+    except (ParameterError, SilentMotionError):
+        return None
 
 
 def eliminate_algebraic(E: np.ndarray, A: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
