@@ -267,7 +267,9 @@ def linear_verdict(lm: Any) -> tuple[int, float, float]:
         # the float matrices cannot decide (a point on the boundary to rounding): the parameter point's own
         # route can (closed forms in exact arithmetic), and maps and sweeps report that verdict
         pv = _point_of(lm)
-        if pv is not None and pv.decided:
+        size = max(abs(2 * math.pi * float(fr[0])), abs(float(mr[0])), 1.0)
+        # only when the matrices are those of the parameters (a LinearModel built by hand may differ)
+        if pv is not None and pv.decided and abs(pv.max_real - float(mr[0])) <= 1e-9 * size:
             return (STABLE if pv.stable else UNSTABLE), pv.max_real, pv.frequency
     return int(c[0]), float(mr[0]), float(fr[0])
 
