@@ -73,6 +73,7 @@ def pencil_eigenvalues(E: np.ndarray, A: np.ndarray, sweeps: int = 20) -> np.nda
     import scipy.linalg
 
     E, A = np.array(E, dtype=float), np.array(A, dtype=float)
+    E0, A0 = E.copy(), A.copy()
     for _ in range(sweeps):
         for axis in (1, 0):
             mag = np.maximum(np.abs(E).max(axis=axis), np.abs(A).max(axis=axis))
@@ -83,7 +84,21 @@ def pencil_eigenvalues(E: np.ndarray, A: np.ndarray, sweeps: int = 20) -> np.nda
             else:
                 E, A = E * scale[None, :], A * scale[None, :]
     lam = scipy.linalg.eigvals(A, E)
-    return lam[np.isfinite(lam)]
+    lam = lam[np.isfinite(lam)]
+    # a regular index-1 pencil has one finite eigenvalue per nonzero row of E; the scaling can push a huge but
+    # finite pad mode (rate coefficient 1e-16 of its stiffness) to beta = 0: take it from the unscaled pencil
+    expected = int(np.count_nonzero(np.any(E0 != 0, axis=1)))
+    if lam.size < expected:
+        try:  # a nonsingular E: balanced QR of E^-1 A (what 60-digit arithmetic confirms for these modes)
+            raw = np.linalg.eigvals(np.linalg.solve(E0, A0)) if expected == E0.shape[0] else None
+        except np.linalg.LinAlgError:
+            raw = None
+        if raw is None:
+            raw = scipy.linalg.eigvals(A0, E0)
+        raw = raw[np.isfinite(raw)]
+        extra = raw[np.argsort(-np.abs(raw))][: expected - lam.size]
+        lam = np.concatenate([lam, extra])
+    return lam
 
 
 def _sort(lam: np.ndarray) -> np.ndarray:
