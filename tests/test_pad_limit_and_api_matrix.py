@@ -375,8 +375,7 @@ MODES_SPLIT = ("modes_along/track_modes fix the number of columns at the first p
                "real eigenvalues -5.82e4 and -6.06e4 are missing from ModeTracks.eigenvalues (6 columns, 8 needed)")
 
 
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=MODES_SPLIT))
-                                  if n == "six-dof" else n for n in NAMES])
+@pytest.mark.parametrize("name", NAMES)  # six-dof: a pair splits into two real eigenvalues (was MODES_SPLIT)
 def test_modes_along_the_path(name):
     space = space_of(name)
     pname, start, stop, log = PATHS[name][0]
@@ -466,11 +465,8 @@ MODES_MERGE = ("modes_along raises ValueError('the number of modes changes along
 
 
 @pytest.mark.parametrize("path", [
-    pytest.param(("d_ip", 1.0, 1e4, True), marks=pytest.mark.xfail(strict=True, reason=MODES_SPLIT.replace(
-        "six-dof, d_t = 0.1..1e4 log, num=7: at d_t = 1e4 the real eigenvalues -5.82e4 and -6.06e4 are missing "
-        "from ModeTracks.eigenvalues (6 columns, 8 needed)", "belt, d_ip = 1..1e4 log, num=5: at d_ip = 1e3 "
-        "only -114.18 of the eigenvalues -114.18, -875.82 is tracked"))),
-    pytest.param(("slope", -10.0, 0.2, False), marks=pytest.mark.xfail(strict=True, reason=MODES_MERGE)),
+    ("d_ip", 1.0, 1e4, True),  # was MODES_SPLIT: belt, at d_ip = 1e3 only -114.18 of -114.18, -875.82 was tracked
+    ("slope", -10.0, 0.2, False),  # was MODES_MERGE: ValueError when two real eigenvalues merge into a pair
 ], ids=["split", "merge"])
 def test_modes_along_a_path_where_a_pair_splits_or_merges(path):
     """m u'' + (d_ip - N0 slope) u' + k_ip u = 0: a complex pair for |d_ip - N0 slope| < 2 sqrt(k_ip m), else real."""

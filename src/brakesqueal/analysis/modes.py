@@ -8,7 +8,10 @@ value to the next: modes are matched by solving an assignment problem
 (:func:`scipy.optimize.linear_sum_assignment`) whose cost combines the loss of
 eigenvector correlation (``1 - MAC``, the modal assurance criterion) and the
 eigenvalue jump relative to the spectrum's scale.  One mode of each complex
-conjugate pair is kept (``Im lambda >= 0``).
+conjugate pair is kept (``Im lambda >= 0``), every real eigenvalue is its own
+track: where a pair splits into two real eigenvalues a track opens, where two
+merge into a pair one closes (``NaN`` where a track does not exist), so no
+eigenvalue is ever dropped.
 
 Marked on the result:
 
@@ -155,25 +158,35 @@ def track_modes(values: Sequence[float], linear: Callable[[float], Any], *, para
 
     vals = np.asarray(values, dtype=float)
     w0, v0 = _first_order(linear(float(vals[0])))
-    n_modes = w0.size
-    lam = np.zeros((vals.size, n_modes), dtype=complex)
-    cont = np.ones((vals.size, n_modes))
-    lam[0] = w0
+    # at most every eigenvalue real: 2n columns; a complex pair that splits into two real eigenvalues opens a
+    # track, two real eigenvalues that merge into a pair close one (NaN where a track does not exist)
+    width = 2 * w0.size
+    lam = np.full((vals.size, width), complex(np.nan, np.nan), dtype=complex)
+    cont = np.full((vals.size, width), np.nan)
+    lam[0, :w0.size] = w0
+    cont[0, :w0.size] = 1.0
+    active = list(range(w0.size))  # column of each eigenvalue of the previous point
     prev_w, prev_v = w0, v0
     for i in range(1, vals.size):
         w, v = _first_order(linear(float(vals[i])))
-        m = min(w.size, n_modes)
-        scale = max(float(np.abs(prev_w).max()), 1e-300)
+        scale = max(float(np.abs(prev_w).max()), float(np.abs(w).max()), 1e-300)
         cost = (1.0 - _mac(prev_v, v)) + np.abs(prev_w[:, None] - w[None, :]) / scale
         rows, cols = linear_sum_assignment(cost)
-        order = np.full(n_modes, -1)
-        order[rows] = cols
-        if np.any(order < 0) or m < n_modes:
-            raise ValueError("the number of modes changes along the path")
-        w, v = w[order], v[:, order]
-        lam[i] = w
-        cont[i] = np.diag(_mac(prev_v, v))
+        col_of = np.full(w.size, -1)
+        col_of[cols] = np.asarray(active)[rows]
+        free = [c for c in range(width) if c not in set(col_of[col_of >= 0].tolist())
+                and np.all(np.isnan(lam[:i, c]))]
+        for j in np.flatnonzero(col_of < 0):  # new tracks (a pair split) in unused columns
+            col_of[j] = free.pop(0)
+        lam[i, col_of] = w
+        mac = _mac(prev_v, v)
+        for r, c in zip(rows, cols):
+            cont[i, col_of[c]] = mac[r, c]
+        active = col_of.tolist()
         prev_w, prev_v = w, v
+    used = ~np.all(np.isnan(lam), axis=0)
+    lam, cont = lam[:, used], cont[:, used]
+    n_modes = lam.shape[1]
 
     def mid(a: float, b: float) -> float:
         return math.sqrt(a * b) if log and a > 0 and b > 0 else 0.5 * (a + b)
@@ -186,7 +199,8 @@ def track_modes(values: Sequence[float], linear: Callable[[float], Any], *, para
 
     for k in range(n_modes):
         flag = np.array([unstable(z) for z in lam[:, k]])
-        for i in np.flatnonzero(flag[1:] != flag[:-1]):
+        exists = ~np.isnan(lam[:, k])
+        for i in np.flatnonzero((flag[1:] != flag[:-1]) & exists[1:] & exists[:-1]):
             a, b = float(vals[i]), float(vals[i + 1])
             for _ in range(40):
                 c = mid(a, b)
@@ -212,7 +226,8 @@ def track_modes(values: Sequence[float], linear: Callable[[float], Any], *, para
     for a_ in range(n_modes):
         for b_ in range(a_ + 1, n_modes):
             gap = np.abs(f[:, a_] - f[:, b_]) / np.maximum(np.maximum(f[:, a_], f[:, b_]), 1e-300)
-            close = (gap <= rtol) & (f[:, a_] > 0)
+            with np.errstate(invalid="ignore"):
+                close = (gap <= rtol) & (f[:, a_] > 0)
             for i in np.flatnonzero(close[1:] != close[:-1]):
                 lo, hi = float(vals[i]), float(vals[i + 1])
                 entering = bool(close[i + 1])
