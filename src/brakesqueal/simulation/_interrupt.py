@@ -18,9 +18,11 @@ interpreter runs.  Two places where that bytecode is not ours made
 :func:`interrupt_guard` installs (in the main thread, when the default
 handler is active) a handler that records the interrupt *and* raises it, and
 an unraisable hook that keeps such swallowed interrupts quiet and delivers
-them again (so they are raised as soon as the interpreter runs its own code,
-e.g. numba's compiler); the simulation also calls :func:`check_interrupt` at
-safe points.
+them again (so they are raised as soon as the interpreter runs its own code);
+the simulation also calls :func:`check_interrupt` at safe points.  While
+numba compiles (this thread holds its compiler lock) the interrupt is only
+recorded: unwinding through llvmlite could abort the process on an LLVM
+assertion, so it is raised at the next safe point after the compilation.
 """
 
 from __future__ import annotations
@@ -37,8 +39,22 @@ __all__ = ["interrupt_guard", "check_interrupt"]
 _state = {"depth": 0, "flag": False, "redeliver": 0}
 
 
+def _compiling() -> bool:
+    """Whether this thread holds numba's compiler lock (an LLVM compilation must not be unwound)."""
+    mod = sys.modules.get("numba.core.compiler_lock")
+    lock = getattr(getattr(mod, "global_compiler_lock", None), "_lock", None)
+    try:
+        return bool(lock._is_owned())  # type: ignore[union-attr]
+    except AttributeError:
+        return False
+
+
 def _handler(signum: int, frame: Any) -> None:
     _state["flag"] = True
+    if _compiling():
+        # raised at the next safe point (check_interrupt) once the compilation has finished: unwinding
+        # through llvmlite's callbacks could abort the process (an LLVM assertion)
+        return
     raise KeyboardInterrupt
 
 
@@ -49,7 +65,7 @@ def _unraisable(hook: Any) -> Any:
             # interpreter runs code of its own (a bounded number of times; check_interrupt catches the rest)
             _state["flag"] = True
             _state["redeliver"] += 1
-            if _state["redeliver"] <= 100:
+            if _state["redeliver"] <= 100 and not _compiling():
                 import _thread
 
                 _thread.interrupt_main()
