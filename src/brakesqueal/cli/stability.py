@@ -160,7 +160,7 @@ def _hopf_text(points: list) -> str:  # type: ignore[type-arg]
             lines.append(f"{head}: {hp.message}")
             continue
         amp = ", ".join(f"{n}: {a:.4g}" for n, a in list(zip(h.state_names, h.amplitude_coefficients))[:4])
-        lines.append(f"{head}: Hopf at {h.omega0 / (2 * 3.141592653589793):.6g} Hz, {h.criticality}, "
+        lines.append(f"{head}: Hopf at {h.frequency0_hz:.6g} Hz, {h.criticality}, "
                      f"l1 = {h.l1:.6g} ± {h.l1_error:.2g}")
         if h.side:
             lines.append(f"      cycles for {hp.parameter} {'>' if h.side > 0 else '<'} {h.p0:.12g}; first-harmonic "
@@ -231,7 +231,7 @@ def cycles(
         return
     h = b.hopf.hopf
     lines = [f"Hopf point {axis.name} = {h.p0:.12g}: {h.criticality} (l1 = {h.l1:.6g} ± {h.l1_error:.2g}), "
-             f"{h.omega0 / (2 * 3.141592653589793):.6g} Hz",
+             f"{h.frequency0_hz:.6g} Hz",
              f"{d['points']} branch points ({d['status']}: {d['message']})"]
     if b.contact_loss is not None:
         amp = ", ".join(f"{k}: {v:.4g}" for k, v in list(d["amplitude_at_last_contact_point"].items())[:2])

@@ -132,7 +132,7 @@ class HopfPoint:
             return d
         names = tuple(h.state_names or ())
         d["hopf"] = {
-            "p0": h.p0, "omega0": h.omega0, "frequency_hz": h.omega0 / (2 * math.pi), "l1": h.l1,
+            "p0": h.p0, "omega0": h.omega0, "frequency_hz": h.frequency0_hz, "l1": h.l1,
             "l1_error": h.l1_error, "criticality": h.criticality, "c1": [h.c1.real, h.c1.imag],
             "dRe_lambda_dp": h.dRe_lambda_dp, "side": h.side,
             "cycles_exist_for": ("p > p0" if h.side > 0 else "p < p0") if h.side else None,
