@@ -3,7 +3,7 @@
 Parameter names follow the paper (``mu1``, ``k_ip``, ``h10``, ``Omega``); their
 symbols are derived by one rule (Greek names become Greek letters, trailing
 digits and underscore parts become subscripts), units come from the model's
-roles (:mod:`brakesqueal.model.roles`) through the caller.
+roles (:mod:`brakesqueal.model.roles`) through :func:`unit`.
 
 >>> symbol("k_ip1")
 'k_{\\\\mathrm{ip}1}'
@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import re
 
-__all__ = ["symbol", "axis_label", "QUANTITIES", "STYLE"]
+from typing import Any
+
+__all__ = ["symbol", "axis_label", "unit", "QUANTITIES", "STYLE"]
 
 _GREEK = {"alpha", "beta", "gamma", "delta", "epsilon", "zeta", "eta", "theta", "iota", "kappa", "lambda", "mu",
           "nu", "xi", "pi", "rho", "sigma", "tau", "phi", "chi", "psi", "omega", "Gamma", "Delta", "Theta",
@@ -29,6 +31,9 @@ QUANTITIES: dict[str, tuple[str, str]] = {
     "damping_ratio": (r"\zeta", ""),
     "Omega_crit": (r"\Omega_\mathrm{crit}", "rad/s"),
 }
+
+#: Units of the auxiliary names of the paper's presets (not parameters of the paper's model).
+AUX_UNITS: dict[str, str] = {"mu": "", "k_ip": "N/m", "h": "m", "R_disk": "m"}
 
 #: Matplotlib style of every figure: sizes for a single journal column (3.5 in), vector-friendly.
 STYLE: dict[str, object] = {
@@ -102,3 +107,30 @@ def axis_label(name: str, unit: str | None = None) -> str:
         unit = QUANTITIES.get(name, ("", ""))[1]
     text = f"${symbol(name)}$"
     return f"{text} [{_unit_text(unit)}]" if unit else text
+
+
+def unit(name: str, space: Any = None) -> str:
+    """SI unit of a settable name.
+
+    Parameters
+    ----------
+    name : str
+        A parameter or auxiliary name (``"mu"``, ``"k_ip1"``, ``"Omega"``).
+    space : ParameterSpace, optional
+        The space the name belongs to: its preset's model roles and
+        auxiliary names decide; without it, the paper's model.
+
+    Returns
+    -------
+    str
+        The unit (``""`` for dimensionless or unknown names).
+    """
+    if space is not None:
+        try:
+            return str(space.preset.unit(name))
+        except Exception:  # an auxiliary name without a unit
+            return ""
+    from .model.library import get_model
+
+    spec = get_model("paper")
+    return spec.unit(name) if name in spec.parameters else AUX_UNITS.get(name, "")

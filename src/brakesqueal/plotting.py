@@ -227,11 +227,9 @@ def plot_path(r: Any, ax: Any = None) -> Any:
     if r.log:
         ax.set_xscale("log")
     ax.set_yscale("symlog", linthresh=1e-2)
-    from .labels import axis_label
+    from .labels import axis_label, unit
 
-    from .results import _units
-
-    ax.set_xlabel(axis_label(r.parameter, _units(r.parameter, getattr(r, "space", None))))
+    ax.set_xlabel(axis_label(r.parameter, unit(r.parameter, getattr(r, "space", None))))
     ax.set_ylabel(axis_label("max_real"))
     from matplotlib.lines import Line2D
 

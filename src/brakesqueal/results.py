@@ -15,23 +15,9 @@ from typing import Any
 
 import numpy as np
 
+from .labels import unit
+
 __all__ = ["StabilityMap", "CrossingResult", "CriticalSpeedResult", "open_map", "MapFile", "plot_map_file"]
-
-_AUX_UNITS = {"mu": "", "k_ip": "N/m", "h": "m", "R_disk": "m"}
-
-
-def _units(name: str, space: Any = None) -> str:
-    """SI unit of a settable name: from the space's preset (model roles, auxiliary names), else the paper's model."""
-    if space is not None:
-        try:
-            return str(space.preset.unit(name))
-        except Exception:  # an auxiliary name without a unit
-            return ""
-    from .model.library import get_model
-
-    spec = get_model("paper")
-    return spec.unit(name) if name in spec.parameters else _AUX_UNITS.get(name, "")
-
 
 def _status_attrs() -> dict[str, Any]:
     from .status import STATUS_MEANINGS, PointStatus
@@ -57,7 +43,7 @@ _STABLE_FLAGS = {"flag_values": np.array([0, 1], dtype=np.int8), "flag_meanings"
 
 
 def _coord_attrs(ax: Any, space: Any) -> dict[str, Any]:
-    return {"units": _units(ax.name, space), "scale": "log" if ax.log else "linear"}
+    return {"units": unit(ax.name, space), "scale": "log" if ax.log else "linear"}
 
 
 #: Dimension of the stored boundary vertices (curves separated by NaN).
@@ -65,7 +51,7 @@ BOUNDARY_DIM = "boundary_vertex"
 
 
 def _boundary_attrs(name: str, space: Any) -> dict[str, Any]:
-    return {"units": _units(name, space),
+    return {"units": unit(name, space),
             "long_name": f"{name} along the stability boundary (curves separated by NaN; vertices refined "
                          "onto the boundary by bisection, brakesqueal.analysis.boundary)"}
 
@@ -422,7 +408,7 @@ class CrossingResult:
         import xarray as xr
 
         return xr.Dataset({"value": ("crossing", [v for v, _ in self.crossings],
-                                     {"units": _units(self.parameter, self.space)}),
+                                     {"units": unit(self.parameter, self.space)}),
                            "direction": ("crossing", np.array([1 if d == "stabilizing" else -1
                                                                for _, d in self.crossings], dtype=np.int8))},
                           attrs={"parameter": self.parameter, "stable_at_start": int(self.stable_at_start)})

@@ -333,9 +333,9 @@ def compile_model(spec: Any, *, use_cache: bool = True) -> CompiledModel:
     CompiledModel
         Memoized per process by the model's equations.
     """
-    from ..model.parameters import _model
+    from ..model.parameters import as_model_spec
 
-    spec = _model(spec)
+    spec = as_model_spec(spec)
     cm = _compiled(model_key(spec), spec, use_cache)
     if cm.spec is not spec:
         cm = CompiledModel(spec=spec, coords=cm.coords, algebraic=cm.algebraic, param_names=cm.param_names,

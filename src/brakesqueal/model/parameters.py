@@ -32,7 +32,7 @@ import numpy as np
 from ..errors import ParameterError
 from .expressions import RESERVED_NAMES, dependency_order, evaluate, evaluate_array, names_in, to_sympy
 
-__all__ = ["Value", "Parameters", "Preset", "ParameterSpace", "compliance"]
+__all__ = ["Value", "Parameters", "Preset", "ParameterSpace", "as_model_spec", "compliance"]
 
 Value = Union[float, str]  # a number or an expression string such as "16*pi"
 
@@ -64,7 +64,24 @@ def compliance(value: Any) -> Any:
     return float(out) if np.ndim(out) == 0 else out
 
 
-def _model(model: Any) -> Any:
+def as_model_spec(model: Any) -> Any:
+    """The :class:`~brakesqueal.model.components.ModelSpec` named by ``model``.
+
+    Parameters
+    ----------
+    model : ModelSpec or str
+        A model, a built-in model name or the path of a model TOML file.
+
+    Returns
+    -------
+    ModelSpec
+        ``model`` itself, or :func:`~brakesqueal.model.library.resolve_model` of the name.
+
+    Raises
+    ------
+    ParameterError
+        For anything else, or a name that is neither a built-in model nor a model file.
+    """
     from .components import ModelSpec
     from .library import resolve_model
 
@@ -105,7 +122,7 @@ class Parameters(Mapping[str, float]):
     def __init__(self, model: Any, values: Mapping[str, Value], *, source: str | None = None) -> None:
         from .roles import problems
 
-        spec = _model(model)
+        spec = as_model_spec(model)
         where = f"{source}: " if source else ""
         names = list(spec.parameters)
         unknown = [n for n in values if n not in spec.parameters]
@@ -395,7 +412,7 @@ class ParameterSpace:
         """A preset (of ``model``, or any built-in preset) with validated overrides."""
         from .library import get_preset
 
-        pr = _model(model).get_preset(name) if model is not None else get_preset(name)
+        pr = as_model_spec(model).get_preset(name) if model is not None else get_preset(name)
         space = cls(pr, dict(overrides or {}))
         space.resolve({})
         return space

@@ -393,7 +393,7 @@ def simulation_model(model: Any = "paper", *, use_cache: bool = True) -> Simulat
     """
     from ..codegen import compile_model
     from ..codegen.compiled import model_key
-    from ..model.parameters import _model
+    from ..model.parameters import as_model_spec as _model
     from ._kernels import load_kernels
 
     spec = _model(model)

@@ -24,6 +24,7 @@ from typing import Any, TextIO
 import numpy as np
 
 from ..errors import ParameterError
+from ..labels import unit
 from ..status import PointStatus
 from .compute import FLOAT_QUANTITIES, ChunkSpec, compute_chunk
 from .lock import StoreLock, lock_holder
@@ -464,20 +465,14 @@ def _in_memory(st: Study, spec: ChunkSpec, workers: Any, scheduler: Any, client:
     va = variable_attrs(st)
     dims = st.dims
     if st.kind == "grid":
-        coords: dict[str, Any] = {a.name: xr.Variable((a.name,), a.values, {"units": _units(a.name, st),
+        coords: dict[str, Any] = {a.name: xr.Variable((a.name,), a.values, {"units": unit(a.name, st.space()),
                                                                              "scale": a.scale}) for a in st.axes}
     else:
         coords = {"sample": np.arange(st.n_samples)}
-        coords.update({n: ("sample", v, {"units": _units(n, st)}) for n, v in st.samples().items()})
+        coords.update({n: ("sample", v, {"units": unit(n, st.space())}) for n, v in st.samples().items()})
     ds = xr.Dataset({k: (dims, v, {a: b for a, b in va[k].items() if a != "coordinates"})
                      for k, v in data.items()}, coords=coords, attrs=study_attrs(st))
     return ds
-
-
-def _units(name: str, study: Any = None) -> str:
-    from ..results import _units as u
-
-    return u(name, study.space() if study is not None else None)
 
 
 def open_sweep(store: str | Path, *, verify: bool = True) -> Any:

@@ -52,6 +52,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import BrakesquealError, ParameterError
+from ..labels import unit
 from ..status import STATUS_MEANINGS, PointStatus
 from .compute import FLOAT_QUANTITIES
 
@@ -73,12 +74,6 @@ class StoreError(BrakesquealError):
 
 class _NotWritable(StoreError):
     """The store's location cannot be written (a complete store may still be read)."""
-
-
-def _units(name: str, study: Any = None) -> str:
-    from ..results import _units as u
-
-    return u(name, study.space() if study is not None else None)
 
 
 def checksum(a: np.ndarray) -> str:
@@ -244,7 +239,7 @@ def _build_skeleton(root: Path, study: Any, attrs: dict[str, Any], *, write_coor
     if study.kind == "grid":
         for ax in study.axes:
             a = g.create_array(ax.name, shape=(ax.size,), dtype="f8", chunks=(ax.size,), dimension_names=(ax.name,),
-                               attributes={"units": _units(ax.name, study), "scale": ax.scale})
+                               attributes={"units": unit(ax.name, study.space()), "scale": ax.scale})
             if write_coordinates:
                 a[:] = coords[ax.name]
     else:
@@ -255,7 +250,7 @@ def _build_skeleton(root: Path, study: Any, attrs: dict[str, Any], *, write_coor
             a[:] = coords["sample"]
         for r in study.ranges:
             a = g.create_array(r.name, shape=(n,), dtype="f8", chunks=(chunks[0],), dimension_names=("sample",),
-                               attributes={"units": _units(r.name, study), "scale": "log" if r.log else "linear",
+                               attributes={"units": unit(r.name, study.space()), "scale": "log" if r.log else "linear",
                                            "sampling": f"{study.method} seed={study.seed}"})
             if write_coordinates:
                 a[:] = coords[r.name]

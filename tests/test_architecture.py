@@ -1,0 +1,177 @@
+"""Structure of the package, read from the source with :mod:`ast` (nothing is imported).
+
+* No private name crosses a subpackage boundary: no ``from ..x._private import``,
+  no ``from ..x import _private`` between different subpackages (top-level modules
+  such as ``results.py`` count as their own unit).
+* No import cycle between subpackages at module import time: the imports executed
+  when a module is imported (module level, class bodies, ``try``/``if`` blocks, not
+  function bodies nor ``if TYPE_CHECKING:``) form an acyclic graph between units.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+SRC = Path(__file__).resolve().parents[1] / "src"
+ROOT = "brakesqueal"
+
+#: Private cross-package imports tolerated for now (importer unit, imported module), each with its reason.
+ALLOWED_PRIVATE: dict[tuple[str, str], str] = {
+    ("cli_simulate", "brakesqueal.simulation._interrupt"): "being made public by another change",
+    ("cli_simulate", "brakesqueal.cli._progress"): "cli_simulate.py is a command module of cli/ living beside it",
+}
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for path in sorted((SRC / ROOT).rglob("*.py")):
+        parts = list(path.relative_to(SRC).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts.pop()
+        out[".".join(parts)] = path
+    return out
+
+
+MODULES = _modules()
+
+
+def _is_package(name: str) -> bool:
+    return MODULES[name].name == "__init__.py"
+
+
+def unit(module: str) -> str:
+    """The subpackage (or top-level module) a module belongs to: ``brakesqueal.analysis.linear`` -> ``analysis``."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else ROOT
+
+
+def _private(word: str) -> bool:
+    return word.startswith("_") and not (word.startswith("__") and word.endswith("__"))
+
+
+def _base(module: str, node: ast.ImportFrom) -> str | None:
+    """The absolute module of ``from <node.module> import ...`` written in ``module`` (None: outside the package)."""
+    if node.level == 0:
+        return node.module if node.module and (node.module == ROOT or node.module.startswith(ROOT + ".")) else None
+    pkg = module.split(".") if _is_package(module) else module.split(".")[:-1]
+    pkg = pkg[: len(pkg) - (node.level - 1)]
+    return ".".join(pkg + ([node.module] if node.module else []))
+
+
+def _imports(module: str, tree: ast.Module, *, import_time: bool) -> list[tuple[str, list[str], int]]:
+    """``(imported module, imported names, line)`` of every import (only those run at import time if asked)."""
+    found: list[tuple[str, list[str], int]] = []
+
+    def visit(nodes: list[ast.stmt]) -> None:
+        for node in nodes:
+            if isinstance(node, ast.Import):
+                found.extend((a.name, [], node.lineno) for a in node.names
+                             if a.name == ROOT or a.name.startswith(ROOT + "."))
+            elif isinstance(node, ast.ImportFrom):
+                base = _base(module, node)
+                if base is not None:
+                    found.append((base, [a.name for a in node.names], node.lineno))
+            elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                if not import_time:
+                    visit(node.body)
+            elif isinstance(node, ast.If) and import_time and "TYPE_CHECKING" in ast.unparse(node.test):
+                visit(node.orelse)
+            else:
+                for field in ("body", "orelse", "finalbody", "handlers"):
+                    visit([n for n in getattr(node, field, []) if isinstance(n, ast.stmt)]
+                          if field != "handlers" else [s for h in getattr(node, field, []) for s in h.body])
+                for case in getattr(node, "cases", []):
+                    visit(case.body)
+    visit(tree.body)
+    return found
+
+
+def _targets(base: str, names: list[str]) -> list[str]:
+    """Modules an import executes: ``from pkg import sub`` imports the submodule ``pkg.sub``."""
+    subs = [f"{base}.{n}" for n in names if f"{base}.{n}" in MODULES]
+    return subs if subs and len(subs) == len(names) else [base, *subs]
+
+
+TREES = {m: ast.parse(p.read_text(encoding="utf-8"), str(p)) for m, p in MODULES.items()}
+
+
+def test_modules_found() -> None:
+    assert {"brakesqueal.analysis.linear", "brakesqueal.model.parameters", "brakesqueal.results"} <= set(MODULES)
+    assert unit("brakesqueal.analysis.linear") == "analysis" and unit("brakesqueal.results") == "results"
+
+
+def test_no_private_name_across_subpackages() -> None:
+    bad = []
+    for module, tree in TREES.items():
+        for base, names, line in _imports(module, tree, import_time=False):
+            if unit(base) == unit(module):
+                continue
+            words = base.split(".")[1:] + names
+            if any(_private(w) for w in words) and (unit(module), base) not in ALLOWED_PRIVATE:
+                bad.append(f"{MODULES[module].relative_to(SRC)}:{line}: from {base} import {', '.join(names)}")
+    assert not bad, "private names imported across subpackages:\n" + "\n".join(bad)
+
+
+def _unit_graph() -> dict[str, dict[str, str]]:
+    """unit -> {imported unit: one example 'file:line'} of the imports run at import time."""
+    graph: dict[str, dict[str, str]] = {}
+    for module, tree in TREES.items():
+        for base, names, line in _imports(module, tree, import_time=True):
+            for target in _targets(base, names):
+                # importing a.b.c runs the packages a.b and a too: their units are reached as well
+                parts = target.split(".")
+                for k in range(1, len(parts) + 1):
+                    t = ".".join(parts[:k])
+                    if t in MODULES and unit(t) != unit(module):
+                        graph.setdefault(unit(module), {}).setdefault(
+                            unit(t), f"{MODULES[module].relative_to(SRC)}:{line}")
+    return graph
+
+
+def _cycle(graph: dict[str, dict[str, str]]) -> list[str] | None:
+    state: dict[str, int] = {}
+    stack: list[str] = []
+
+    def dfs(u: str) -> list[str] | None:
+        state[u] = 1
+        stack.append(u)
+        for v in graph.get(u, {}):
+            if state.get(v) == 1:
+                return stack[stack.index(v):] + [v]
+            if v not in state and (c := dfs(v)):
+                return c
+        stack.pop()
+        state[u] = 2
+        return None
+
+    for u in sorted(graph):
+        if u not in state and (c := dfs(u)):
+            return c
+    return None
+
+
+def test_cycle_detection_works() -> None:
+    assert _cycle({"a": {"b": ""}, "b": {"c": ""}, "c": {"a": ""}}) == ["a", "b", "c", "a"]
+    assert _cycle({"a": {"b": ""}, "b": {"c": ""}}) is None
+
+
+def test_no_import_cycle_between_subpackages() -> None:
+    graph = _unit_graph()
+    cycle = _cycle(graph)
+    if cycle:
+        where = [f"{a} -> {b} ({graph[a][b]})" for a, b in zip(cycle, cycle[1:])]
+        pytest.fail("import cycle between subpackages at import time:\n" + "\n".join(where))
+
+
+def test_private_import_detector_sees_relative_forms() -> None:
+    tree = ast.parse("from ..simulation._interrupt import check_interrupt\nfrom ..results import _units\n"
+                     "def f():\n    from ..model.parameters import _model\n")
+    found = _imports("brakesqueal.sweep.runner", tree, import_time=False)
+    assert [(b, n) for b, n, _ in found] == [("brakesqueal.simulation._interrupt", ["check_interrupt"]),
+                                            ("brakesqueal.results", ["_units"]),
+                                            ("brakesqueal.model.parameters", ["_model"])]
+    assert [b for b, _, _ in _imports("brakesqueal.sweep.runner", tree, import_time=True)] == [
+        "brakesqueal.simulation._interrupt", "brakesqueal.results"]
