@@ -34,7 +34,10 @@ class BenchResult:
 
 
 def best_time(fn: Callable[[], Any], *, repeat: int = 5, min_time: float = 0.0) -> float:
-    """Best wall time of ``repeat`` calls [s] (each call repeated until ``min_time`` has passed)."""
+    """Best wall time of ``repeat`` calls [s] (each call repeated until ``min_time`` has passed).
+
+    A call slower than ``5 * max(min_time, 1 s)`` is not repeated: its time is already well above the noise.
+    """
     best = math.inf
     for _ in range(repeat):
         n, t0 = 0, time.perf_counter()
@@ -45,6 +48,8 @@ def best_time(fn: Callable[[], Any], *, repeat: int = 5, min_time: float = 0.0) 
             if dt >= min_time:
                 break
         best = min(best, dt / n)
+        if best > 5 * max(min_time, 1.0):
+            break
     return best
 
 

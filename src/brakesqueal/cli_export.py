@@ -99,14 +99,12 @@ def _export_cmd(
     print(f"wrote {path} ({to.value}, {what.value}, model {space.model.name})", file=sys.stderr)
 
 
-def register(app: typer.Typer, bench_app: typer.Typer) -> None:
+def register(app: typer.Typer) -> None:
     """Add the ``export`` command to the application.
 
     Parameters
     ----------
     app : typer.Typer
         The main application (:data:`brakesqueal.cli.app`).
-    bench_app : typer.Typer
-        The ``bench`` sub-application (unused: export has no benchmark).
     """
     app.command("export")(_export_cmd)

@@ -1,4 +1,4 @@
-"""``brakesqueal simulate`` and ``brakesqueal bench simulate`` (registered by :mod:`brakesqueal.cli`).
+"""``brakesqueal simulate`` (registered by :mod:`brakesqueal.cli`).
 
 Heavy modules (numba, SciPy, the kernels) are imported inside the commands.
 """
@@ -177,21 +177,6 @@ def _write(tr: Any, out: str | None, plot: str | None, wav: str | None) -> None:
         tr.to_wav(wav, what="--wav")
 
 
-def _bench_cmd(
-    fmt: Annotated[str, typer.Option("--format", help="Output format: text | json.")] = "text",
-    baseline_t: Annotated[
-        float, typer.Option("--baseline-t", min=1e-4, max=0.05,
-                            help="Simulated time of the (slow) lambdify baseline run [s].")
-    ] = 0.002,
-) -> None:
-    """1 s of simulated squeal: paper-fig2 vs. lambdify + solve_ivp RK45; eight-dof vs. the former built-model path."""
-    from .bench import report
-    from .simulation.bench import bench_simulate
-
-    sys.stdout.write(report(bench_simulate(baseline_t=baseline_t), fmt))
-
-
-def register(app: typer.Typer, bench_app: typer.Typer) -> None:
-    """Add ``simulate`` to ``app`` and ``simulate`` to ``bench_app``."""
+def register(app: typer.Typer) -> None:
+    """Add ``simulate`` to ``app``."""
     app.command("simulate")(_simulate_cmd)
-    bench_app.command("simulate")(_bench_cmd)

@@ -100,3 +100,18 @@ def neimark_sacker(a: float = 0.3, k: float = 4.0, **kw) -> SmoothSystem:
     s = -1 + sp.nsimplify(k) * r2
     aa = sp.nsimplify(a)
     return sympy_system([g * x - y, g * y + x, s * u - aa * v, aa * u + s * v], [x, y, u, v], p, **kw)
+
+
+def friction_oscillator(exact: bool = True, **kw) -> SmoothSystem:
+    """The 4-state 2-DOF friction-type (mode-coupling) oscillator of ``benchmarks/bench_nonlinear.py``.
+
+    q'' + C q' + K(p) q + k_n q^3 + d_n q^2 q' = 0 (cubic terms componentwise), K(p) = [[k1, p], [-p, k2]],
+    C = diag(c1, c2); state (q1, q2, dq1, dq2), parameter p; exact B, C unless ``exact=False``.
+    """
+    q1, q2, v1, v2, p = sp.symbols("q1 q2 dq1 dq2 p", real=True)
+    k1, k2, c1, c2, kn, dn = 1, sp.Rational(3, 2), sp.Rational(1, 50), sp.Rational(1, 50), sp.Rational(1, 2), \
+        sp.Rational(3, 10)  # fmt: skip
+    exprs = [v1, v2, -(k1 * q1 + p * q2) - c1 * v1 - kn * q1**3 - dn * q1**2 * v1,
+             -(-p * q1 + k2 * q2) - c2 * v2 - kn * q2**3 - dn * q2**2 * v2]
+    return sympy_system(exprs, [q1, q2, v1, v2], p, exact_multilinear=exact, parameter_name="p",
+                        state_names=("q1", "q2", "dq1", "dq2"), **kw)

@@ -156,11 +156,10 @@ def test_bad_options(bautin_branch):
 def test_branch_in_si_units_matches_the_dimensionless_system():
     """Brake-like scaling (omega ~ 1e4 rad/s, angles ~ 1e-5 rad): every branch point is an orbit of the
     dimensionless system (independent shooting there) with period x 1e-4 and amplitudes x diag(S)."""
+    from _nl_systems import friction_oscillator
     from test_nl_hopf import _si_scaled
 
-    from brakesqueal.nonlinear.bench import benchmark_system
-
-    base = benchmark_system()
+    base = friction_oscillator()
     S, s = _si_scaled(base)
     h = first_lyapunov(s, np.zeros(4), 0.2509980079602)
     br = continue_cycles(s, h, (h.p0, h.p0 + 0.002), max_points=8)

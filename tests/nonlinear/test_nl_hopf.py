@@ -156,9 +156,10 @@ def test_mode_coupling_hopf_tracks_the_critical_pair():
     """2-DOF friction-type oscillator with equal damping: at the Hopf point both pairs have the same
     frequency (mode coupling).  Refinement from either side must follow the pair that crosses, and
     dRe_lambda_dp must match a finite difference of that eigenvalue (tracked by its eigenvector)."""
-    from brakesqueal.nonlinear.bench import _jac, benchmark_system
+    from _nl_systems import friction_oscillator
 
-    s, sfd = benchmark_system(), benchmark_system(exact=False)
+    s, sfd = friction_oscillator(), friction_oscillator(exact=False)
+    _jac = s.jac
     ref = first_lyapunov(s, np.zeros(4), 0.2509980079602)
     assert abs(ref.eigenvalue.real) < 1e-12
     for p0 in (0.2509, 0.2511):
@@ -194,9 +195,9 @@ def test_badly_scaled_si_states_keep_a_sharp_error_estimate():
     """Stiffness entries ~1e8 next to ones (SI states) must not inflate the error estimate into a false
     'degenerate' verdict: l1 from exact and from finite-difference forms agree to 1e-10 and the
     estimate stays small; a_j carry the units (angles x L, rates x L W), omega0 x W."""
-    from brakesqueal.nonlinear.bench import benchmark_system
+    from _nl_systems import friction_oscillator
 
-    base = benchmark_system()
+    base = friction_oscillator()
     h0 = first_lyapunov(base, np.zeros(4), 0.2509980079602)
     for exact in (True, False):
         S, s = _si_scaled(base, exact=exact)

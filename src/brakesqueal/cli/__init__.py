@@ -29,8 +29,6 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
 )
-bench_app = typer.Typer(help="Measure speed on this machine against a baseline run in the same process.")
-app.add_typer(bench_app, name="bench")
 
 
 def _version(value: bool) -> None:
@@ -215,7 +213,7 @@ def _register_plugins() -> None:
 
     for name in (".stability", ".modes", ".sweep", ".cache", "..cli_simulate", "..cli_export"):
         mod = importlib.import_module(name, __package__)
-        mod.register(app, bench_app)
+        mod.register(app)
 
 
 _register_plugins()
@@ -238,7 +236,6 @@ SUMMARIES: dict[str, str] = {
     "sweep": "Resumable N-D parameter study into a Zarr store.",
     "simulate": "Integrate the nonlinear equations; summary, NetCDF, WAV.",
     "export": "Write equations as LaTeX, Octave, C, Julia or Python.",
-    "bench": "Measure speed against a baseline run in the same process.",
     "cache": "Inspect or clear the code cache.",
 }
 

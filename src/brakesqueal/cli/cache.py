@@ -38,14 +38,12 @@ def _clear_cmd(
         sys.stdout.write(f"removed {d}\n")
 
 
-def register(app: typer.Typer, bench_app: typer.Typer) -> None:
+def register(app: typer.Typer) -> None:
     """Add the ``cache`` command group to the application.
 
     Parameters
     ----------
     app : typer.Typer
         The main application (:data:`brakesqueal.cli.app`).
-    bench_app : typer.Typer
-        The ``bench`` sub-application (unused).
     """
     app.add_typer(cache_app, name="cache")

@@ -55,6 +55,6 @@ def modes(
     sys.stdout.write("\n".join(lines) + "\n")
 
 
-def register(app: typer.Typer, bench_app: typer.Typer) -> None:
+def register(app: typer.Typer) -> None:
     """Add ``modes`` to the application."""
     app.command("modes")(modes)

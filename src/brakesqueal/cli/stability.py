@@ -246,15 +246,13 @@ def cycles(
     sys.stdout.write("\n".join(lines) + "\n")
 
 
-def register(app: typer.Typer, bench_app: typer.Typer) -> None:
-    """Add the stability commands to ``app`` (their benchmarks are scripts in ``benchmarks/``).
+def register(app: typer.Typer) -> None:
+    """Add the stability commands to ``app``.
 
     Parameters
     ----------
     app : typer.Typer
         The main application.
-    bench_app : typer.Typer
-        The ``bench`` sub-application (unused).
     """
     app.command("crossings")(crossings)
     app.command("critical-speed")(critical_speed)

@@ -1,4 +1,4 @@
-"""``brakesqueal sweep`` (parameter studies on Dask) and ``brakesqueal bench sweep``.
+"""``brakesqueal sweep`` (parameter studies on Dask).
 
 Registered by :mod:`brakesqueal.cli` through :func:`register`; dask, zarr and
 xarray are imported inside the commands.
@@ -71,23 +71,6 @@ def sweep(
                          f"{run.computed} computed, {run.reused} reused{fixed}); {100 * stable:.1f}% stable\n")
 
 
-def bench_sweep(
-    fmt: Annotated[_Fmt, typer.Option("--format", help="Output format.")] = _Fmt.text,
-    points: Annotated[int, typer.Option("--points", min=1000, max=10**9,
-                                                   help="Points of the scaling study (3-D, verdict only).")]
-    = 20_000_000,
-    large: Annotated[bool, typer.Option("--large/--no-large", help="Also run the 1e8-point 3-D study in a "
-                                                                    "subprocess and report its peak memory.")]
-    = True,
-) -> None:
-    """Sweep throughput in-process vs. LocalCluster with 1 and 2 workers; peak memory of a 1e8-point study."""
-    from ..bench import report
-    from ..sweep.bench import bench_sweep as _b
-
-    sys.stdout.write(report(_b(points=points, large=large), fmt.value))
-
-
-def register(app: typer.Typer, bench_app: typer.Typer) -> None:
-    """Add ``sweep`` to ``app`` and ``sweep`` to ``bench_app``."""
+def register(app: typer.Typer) -> None:
+    """Add ``sweep`` to ``app``."""
     app.command("sweep")(sweep)
-    bench_app.command("sweep")(bench_sweep)
