@@ -30,7 +30,38 @@ class BrakesquealError(Exception):
 
 
 class ParameterError(BrakesquealError, ValueError):
-    """A model parameter, preset or option has a missing, unknown or invalid value."""
+    """A model parameter, preset or option has a missing, unknown or invalid value.
+
+    Parameters
+    ----------
+    message : str
+        One line naming the offending parameter, its value and what is allowed.
+    parameter : str, optional
+        The name the error is about (a parameter, a tied or auxiliary name),
+        when there is one; callers map errors to their own keys with it,
+        never by the message text.
+    names : tuple of str, optional
+        Every name involved, ``parameter`` first: the other violated
+        parameters, the inputs of a tie that cannot be evaluated, or the
+        names of a cycle of ties in their order.
+
+    Attributes
+    ----------
+    parameter : str or None
+    names : tuple of str
+    """
+
+    def __init__(self, message: str = "", *, parameter: str | None = None, names: tuple[str, ...] = ()) -> None:
+        super().__init__(message)
+        self.parameter = parameter
+        self.names = tuple(dict.fromkeys(((parameter,) if parameter else ()) + tuple(names)))
+
+    def about(self, parameter: str, names: tuple[str, ...] = ()) -> ParameterError:
+        """Name the parameter of an error raised without one (e.g. by the expression evaluator); returns self."""
+        if self.parameter is None:
+            self.parameter = parameter
+        self.names = tuple(dict.fromkeys((self.parameter, *self.names, parameter, *names)))
+        return self
 
 
 class SilentMotionError(BrakesquealError):

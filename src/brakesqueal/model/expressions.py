@@ -334,7 +334,12 @@ def dependency_order(exprs: Mapping[str, str], *, what: str = "expressions") -> 
         If the definitions form a cycle (the message shows it, e.g.
         ``a -> b -> a``) or an expression is malformed.
     """
-    uses = {name: names_in(expr, what=f"{what}: '{name}'") for name, expr in exprs.items()}
+    uses: dict[str, set[str]] = {}
+    for name, expr in exprs.items():
+        try:
+            uses[name] = names_in(expr, what=f"{what}: '{name}'")
+        except ParameterError as exc:
+            raise exc.about(name) from None
     order: list[str] = []
     path: list[str] = []
 
@@ -343,7 +348,8 @@ def dependency_order(exprs: Mapping[str, str], *, what: str = "expressions") -> 
             return
         if name in path:
             cycle = " -> ".join([*path[path.index(name):], name])
-            raise ParameterError(f"{what}: the definitions form a cycle: {cycle}")
+            raise ParameterError(f"{what}: the definitions form a cycle: {cycle}", parameter=name,
+                                 names=tuple(path[path.index(name):]))
         path.append(name)
         for ref in sorted(uses[name] & set(exprs)):
             visit(ref)

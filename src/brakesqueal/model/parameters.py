@@ -44,16 +44,19 @@ def _fmt(value: float) -> str:
     return repr(value)
 
 
-def _number(value: Any, what: str) -> float:
-    """A float from a number or a constant expression (``"16*pi"``, ``"inf"``)."""
+def _number(value: Any, what: str, name: str | None = None) -> float:
+    """A float from a number or a constant expression (``"16*pi"``, ``"inf"``); errors name ``name``."""
     if isinstance(value, str):
-        return evaluate(value, {}, what=what)
+        try:
+            return evaluate(value, {}, what=what)
+        except ParameterError as exc:
+            raise (exc.about(name) if name else exc) from None
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ParameterError(f"{what} must be a number or an expression string; got {value!r} "
-                             f"({type(value).__name__})")
+                             f"({type(value).__name__})", parameter=name)
     v = float(value)
     if math.isnan(v):
-        raise ParameterError(f"{what} must be a number; got nan")
+        raise ParameterError(f"{what} must be a number; got nan", parameter=name)
     return v
 
 
@@ -130,15 +133,18 @@ class Parameters(Mapping[str, float]):
             from ..suggest import did_you_mean
 
             raise ParameterError(f"{where}unknown parameter '{unknown[0]}' of model '{spec.name}'"
-                                 f"{did_you_mean(unknown[0], names)}; valid names: {', '.join(names)}")
+                                 f"{did_you_mean(unknown[0], names)}; valid names: {', '.join(names)}",
+                                 parameter=unknown[0], names=tuple(unknown))
         missing = [n for n in names if n not in values]
         if missing:
             raise ParameterError(f"{where}missing parameter(s) {', '.join(missing)} of model '{spec.name}' "
-                                 "(give all of them or start from a preset)")
-        vals = {n: _number(values[n], f"{where}value of '{n}'") for n in names}
+                                 "(give all of them or start from a preset)", parameter=missing[0],
+                                 names=tuple(missing))
+        vals = {n: _number(values[n], f"{where}value of '{n}'", n) for n in names}
         probs = problems(spec.roles(), vals)
         if probs:
-            raise ParameterError(where + "; ".join(m for _, m in probs))
+            raise ParameterError(where + "; ".join(m for _, m in probs), parameter=probs[0][0],
+                                 names=tuple(n for n, _ in probs))
         object.__setattr__(self, "_model", spec)
         object.__setattr__(self, "_values", MappingProxyType(vals))
 
@@ -257,25 +263,31 @@ class Preset:
         every = [*self.fixed, *self.free, *self.tied]
         duplicates = sorted({n for n in every if every.count(n) > 1})
         if duplicates:
-            raise ParameterError(f"{where}: names in more than one of fixed/free/tied: {', '.join(duplicates)}")
+            raise ParameterError(f"{where}: names in more than one of fixed/free/tied: {', '.join(duplicates)}",
+                                 parameter=duplicates[0], names=tuple(duplicates))
         bad = [n for n in every if not n.isidentifier() or n in RESERVED_NAMES]
         if bad:
-            raise ParameterError(f"{where}: invalid or reserved name '{bad[0]}'")
+            raise ParameterError(f"{where}: invalid or reserved name '{bad[0]}'", parameter=bad[0])
         missing = [n for n in spec.parameters if n not in every]
         if missing:
-            raise ParameterError(f"{where}: parameter(s) of model '{spec.name}' not defined: {', '.join(missing)}")
+            raise ParameterError(f"{where}: parameter(s) of model '{spec.name}' not defined: {', '.join(missing)}",
+                                 parameter=missing[0], names=tuple(missing))
         for name, value in {**self.fixed, **self.free}.items():
-            _number(value, f"{where}: value of '{name}'")
+            _number(value, f"{where}: value of '{name}'", name)
         used: set[str] = set()
         for name, expr in self.tied.items():
-            refs = names_in(expr, what=f"{where}: tied parameter '{name}'")
+            try:
+                refs = names_in(expr, what=f"{where}: tied parameter '{name}'")
+            except ParameterError as exc:
+                raise exc.about(name) from None
             unknown = sorted(refs - set(every))
             if unknown:
-                raise ParameterError(f"{where}: tied parameter '{name}' = {expr} uses unknown name '{unknown[0]}'")
+                raise ParameterError(f"{where}: tied parameter '{name}' = {expr} uses unknown name '{unknown[0]}'",
+                                     parameter=name, names=(unknown[0],))
             used |= refs
         unused = [n for n in every if n not in spec.parameters and n not in used]
         if unused:
-            raise ParameterError(f"{where}: auxiliary name '{unused[0]}' is not used")
+            raise ParameterError(f"{where}: auxiliary name '{unused[0]}' is not used", parameter=unused[0])
         dependency_order(self.tied, what=where)
 
     def bind(self, spec: Any) -> Preset:
@@ -335,18 +347,23 @@ class Preset:
             self.check_name(name)
         defs = {**self.fixed, **self.free}
         tied = {k: v for k, v in self.tied.items() if k not in overrides}
-        values = {n: _number(overrides.get(n, d), f"value of '{n}'") for n, d in defs.items()}
+        values = {n: _number(overrides.get(n, d), f"value of '{n}'", n) for n, d in defs.items()}
         for n in overrides:
             if n not in defs:
-                values[n] = _number(overrides[n], f"value of '{n}'")
+                values[n] = _number(overrides[n], f"value of '{n}'", n)
         for name in dependency_order(tied, what=f"preset '{self.name}'"):
-            values[name] = evaluate(tied[name], values, what=f"tied parameter '{name}'")
+            try:
+                values[name] = evaluate(tied[name], values, what=f"tied parameter '{name}'")
+            except ParameterError as exc:
+                raise exc.about(name, tuple(sorted(names_in(tied[name])))) from None
         model_values = {n: values[n] for n in spec.parameters}
         from .roles import problems
 
         probs = problems(spec.roles(), model_values)
         if probs:
-            raise ParameterError("; ".join(self._explain(n, m, values, tied) for n, m in probs))
+            inputs = tuple(sorted({r for n, _ in probs if n in tied for r in names_in(tied[n])}))
+            raise ParameterError("; ".join(self._explain(n, m, values, tied) for n, m in probs),
+                                 parameter=probs[0][0], names=(*(n for n, _ in probs), *inputs))
         return Parameters(spec, model_values)
 
     def check_name(self, name: str) -> None:
@@ -360,7 +377,7 @@ class Preset:
         hint = f"; it is a free parameter of preset {', '.join(elsewhere)}" if elsewhere else ""
         raise ParameterError(f"The parameter '{name}' is not defined in preset '{self.name}'"
                              f"{did_you_mean(name, self.all_names())}{hint}; settable names: "
-                             + ", ".join(self.settable_names()))
+                             + ", ".join(self.settable_names()), parameter=name)
 
     def _explain(self, name: str, message: str, values: Mapping[str, float], tied: Mapping[str, str]) -> str:
         if name not in tied:
@@ -457,20 +474,21 @@ class ParameterSpace:
     def value(self, name: str) -> float:
         """Current value of a settable name."""
         self.check_axis(name)
-        return _number(self.definitions()[name], f"value of '{name}'")
+        return _number(self.definitions()[name], f"value of '{name}'", name)
 
     def check_axis(self, name: str) -> None:
         """Raise ParameterError (one line) unless ``name`` can be varied in this space."""
         if name in self.tied:
             raise ParameterError(
                 f"cannot vary '{name}': it is tied in preset '{self.label}' ({name} = {self.tied[name]}); "
-                f"vary one of {', '.join(self.settable())}, or give '{name}' a value to replace its tie")
+                f"vary one of {', '.join(self.settable())}, or give '{name}' a value to replace its tie",
+                parameter=name)
         if name not in self.settable():
             from ..suggest import did_you_mean
 
             raise ParameterError(f"unknown parameter '{name}' for preset '{self.label}'"
                                  f"{did_you_mean(name, self.settable())}; settable names: "
-                                 + ", ".join(self.settable()))
+                                 + ", ".join(self.settable()), parameter=name)
 
     def with_values(self, changes: Mapping[str, Value]) -> ParameterSpace:
         """A new space with more overrides."""

@@ -153,7 +153,7 @@ def build_space(preset: str | None, values: tuple[tuple[str, Value], ...],
     for name, expr in tied:
         if name not in defs and name not in ties:
             where = f"preset '{base.name}'" if base else "the model parameters"
-            raise ParameterError(f"cannot tie '{name}': it is not a name of {where}")
+            raise ParameterError(f"cannot tie '{name}': it is not a name of {where}", parameter=name)
         defs.pop(name, None)
         ties[name] = expr
     from ..model.expressions import names_in

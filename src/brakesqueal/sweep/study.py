@@ -486,27 +486,23 @@ def _preset_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str | No
     try:
         space = build_space(preset_name, tuple(values.items()), tuple(tied_tab.items()), model_json)
     except ParameterError as exc:
-        bad = _offending_key(str(exc), values, tied_tab)
-        raise ctx.err(bad, str(exc)) from None
+        raise ctx.err(_offending_key(exc, values, tied_tab), str(exc)) from None
 
     return preset_name, values, tied_tab, space, model_json
 
 
-def _offending_key(msg: str, values: dict[str, Value], tied: dict[str, Any]) -> str:
-    """The study-file key an error message of the parameter layer is about (a tie cycle: the first tie in it)."""
-    import re
+def _offending_key(exc: ParameterError, values: Mapping[str, Any], tied: Mapping[str, Any]) -> str:
+    """The study-file key a parameter error is about, from the names it carries (never from its text).
 
-    def named(k: str) -> bool:
-        return re.search(rf"(?<![\w.]){re.escape(k)}(?![\w])", msg) is not None
-
-    if "cycle" in msg:
-        cyc = next((f"tied.{k}" for k in tied if named(k)), None)
-        if cyc:
-            return cyc
-    return (next((f"parameters.{k}" for k in values if f"'{k}'" in msg), None)
-            or next((f"tied.{k}" for k in tied if f"'{k}'" in msg), None)
-            or next((f"tied.{k}" for k in tied if named(k)), None)
-            or "parameters")
+    The first of the error's names (the offending one first, then the others involved: the inputs of a
+    tie, the members of a cycle) that the study gives in ``[parameters]`` or ``[tied]``; else ``parameters``.
+    """
+    for name in exc.names:
+        if name in values:
+            return f"parameters.{name}"
+        if name in tied:
+            return f"tied.{name}"
+    return "parameters"
 
 
 def _model_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str, dict[str, Value], Any]:
@@ -536,8 +532,7 @@ def _model_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str, dict
     try:
         space = build_space(None, tuple(values.items()), (), model_json)
     except ParameterError as exc:
-        bad = next((f"parameters.{k}" for k in values if f"'{k}'" in str(exc)), "parameters")
-        raise ctx.err(bad, str(exc)) from None
+        raise ctx.err(_offending_key(exc, values, {}), str(exc)) from None
     return model_json, values, space
 
 
