@@ -52,7 +52,8 @@ def model_key(spec: Any) -> str:
     from ..model.io import spec_to_dict
 
     d = spec_to_dict(spec, presets=False)
-    d = {k: v for k, v in d.items() if k in ("disk", "pads", "calipers")}
+    # every component table (a new kind of component is hashed without a change here); not the texts or values
+    d = {k: v for k, v in d.items() if k not in ("name", "description", "reference", "parameters", "presets")}
     d["parameters"] = list(spec.parameters)  # the packing order, not the values
     text = json.dumps(d, sort_keys=True)
     return "model-" + hashlib.sha256(text.encode()).hexdigest()[:20]
