@@ -12,7 +12,7 @@ import time
 
 import pytest
 
-from brakesqueal.simulation._interrupt import check_interrupt, interrupt_guard
+from brakesqueal.interrupts import check_interrupt, interrupt_guard
 
 
 @pytest.mark.skipif(signal.getsignal(signal.SIGINT) is not signal.default_int_handler,

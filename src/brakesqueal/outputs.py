@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import OutputError
+from .interrupts import critical, remove_on_exit
 
 __all__ = ["check_output", "check_output_dir", "atomic_write", "write_with", "describe_oserror"]
 
@@ -125,11 +126,13 @@ def atomic_write(path: str | os.PathLike[str], *, what: str = "output file") -> 
     os.close(fd)
     tmp = Path(tmp_name)
     try:
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; the result gets the permissions of a plain open()
-        yield tmp
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, final)
+        with remove_on_exit(tmp):  # removed too if a CLI ends the process after an unanswered Ctrl-C
+            os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; the result gets the permissions of open()
+            yield tmp
+            with open(tmp, "rb+") as fh:
+                os.fsync(fh.fileno())
+            with critical():
+                os.replace(tmp, final)
     except OSError as exc:
         _remove(tmp)
         raise OutputError(f"{what}: cannot write '{path}': {describe_oserror(exc)}") from None

@@ -282,8 +282,13 @@ def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else list(argv)
     if not args:
         args = ["--help"]
+    from ..interrupts import EXIT_AFTER_S, EXIT_STATUS, exit_now, interrupt_guard
+
     try:
-        rv = app(args=args, prog_name="brakesqueal", standalone_mode=False)
+        # Ctrl-C within a second: a command that does not unwind in EXIT_AFTER_S is ended (not a sweep: its
+        # Dask workers must be shut down); the program itself then skips the interpreter's slow teardown
+        with interrupt_guard(exit_after=None if args[:1] == ["sweep"] else EXIT_AFTER_S):
+            rv = app(args=args, prog_name="brakesqueal", standalone_mode=False)
     except BrakesquealError as exc:
         print(f"brakesqueal: error: {exc}", file=sys.stderr)
         return 2
@@ -292,10 +297,16 @@ def main(argv: list[str] | None = None) -> int:
         print(f"brakesqueal: error: {msg}", file=sys.stderr)
         return 2
     except Exit as exc:
-        return exc.exit_code
+        if exc.exit_code != EXIT_STATUS:
+            return exc.exit_code
+        rv = EXIT_STATUS  # typer's answer to a KeyboardInterrupt
     except (Abort, KeyboardInterrupt):
+        rv = EXIT_STATUS
+    if rv == EXIT_STATUS:
         print("brakesqueal: interrupted", file=sys.stderr)
-        return 130
+        if argv is None:
+            exit_now(EXIT_STATUS)  # the program: outputs are complete or removed; no slow teardown
+        return EXIT_STATUS
     return rv if isinstance(rv, int) else 0
 
 
