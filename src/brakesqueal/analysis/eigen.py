@@ -251,12 +251,32 @@ def _null_vectors(Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return Vh[-1].conj(), U[:, -1]
 
 
+def _eig_left_right(A: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Eigenvalues, left and right eigenvectors (columns) of ``A``: NumPy's ``eig``, the left ones from ``V^-1``.
+
+    The rows of ``V^-1`` are left eigenvectors paired with the columns of ``V`` (``y_i^H x_i = 1``); this keeps
+    SciPy (about 0.15 s of imports) off the command line's ``linearize``.  A singular ``V`` (a defective
+    matrix) falls back to LAPACK's left eigenvectors through :func:`scipy.linalg.eig`.
+    """
+    w, vr = np.linalg.eig(A)
+    try:
+        vl = np.linalg.inv(vr).conj().T
+    except np.linalg.LinAlgError:
+        vl = None
+    if vl is None or not np.all(np.isfinite(vl)):
+        import scipy.linalg
+
+        w, vl, vr = scipy.linalg.eig(A, left=True, right=True)
+    return w, vl, vr
+
+
 def eigen_analysis(model: Any) -> EigenAnalysis:
     """Eigen-analysis of a linear model (or of ``linearize(params)``), for any model.
 
     The eigenvalues are those of the first-order state matrix of eq. (47)
     (including the pads kept as first-order states), computed with
-    :func:`scipy.linalg.eig` together with left and right eigenvectors.
+    :func:`numpy.linalg.eig`; the left eigenvectors are the rows of the inverse
+    of the right ones (LAPACK's own for a defective matrix).
 
     Parameters
     ----------
@@ -278,11 +298,9 @@ def eigen_analysis(model: Any) -> EigenAnalysis:
     SilentMotionError
         If ``model`` is a parameter set without a usable silent motion.
     """
-    import scipy.linalg
-
     lm = model if isinstance(model, LinearModel) else linearize(model)
     A = lm.A
-    w, vl, vr = scipy.linalg.eig(A, left=True, right=True)
+    w, vl, vr = _eig_left_right(A)
     order = np.lexsort((-w.imag, -w.real))
     w, vl, vr = w[order], vl[:, order], vr[:, order]
     cond = np.array([np.linalg.norm(vl[:, i]) * np.linalg.norm(vr[:, i]) / abs(np.vdot(vl[:, i], vr[:, i]))
