@@ -211,7 +211,7 @@ def _register_plugins() -> None:
     """Add the command groups that live in their own modules."""
     import importlib
 
-    for name in (".stability", ".modes", ".sweep", ".cache", "..cli_simulate", "..cli_export"):
+    for name in (".stability", ".modes", ".sweep", ".cache", "..cli_simulate", "..cli_export", ".explore"):
         mod = importlib.import_module(name, __package__)
         mod.register(app)
 
@@ -237,6 +237,7 @@ SUMMARIES: dict[str, str] = {
     "simulate": "Integrate the nonlinear equations; summary, NetCDF, WAV.",
     "export": "Write equations as LaTeX, Octave, C, Julia or Python.",
     "cache": "Inspect or clear the code cache.",
+    "explore": "The squeal explorer in the browser (live, offline).",
 }
 
 

@@ -1,0 +1,645 @@
+"""The explorer's page: Panel widgets and Bokeh figures, linked to the library through :mod:`.state`.
+
+One :class:`Explorer` per browser session.  Widgets change the
+:class:`~.state.ViewState`; every change is validated (the command line's
+resolution), written to the URL and handed to three lanes of work
+(:class:`~.worker.LatestWorker`): the eigenvalues and root locus (fast, on
+every slider move), the map with critical speeds and Hopf criticality
+(recomputed only when their inputs change), and the simulation (on request,
+cancellable).  A hidden element ``#bs-render`` counts the updates applied to
+the page and carries the state they show, for tests and benchmarks.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import logging
+import math
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from ..errors import BrakesquealError, ParameterError
+from .state import (
+    AUDIO_RATE,
+    MAX_MAP_POINTS,
+    MAX_T_END,
+    LocusView,
+    MapView,
+    Origin,
+    SimulationView,
+    SliderRange,
+    ViewState,
+    critical_speed_text,
+    format_eigenvalue,
+    hopf_scan,
+    hopf_text,
+    locus_view,
+    map_view,
+    simulation_view,
+    slider_range,
+)
+from .worker import Cancelled, LatestWorker
+
+__all__ = ["Explorer", "build_page"]
+
+log = logging.getLogger(__name__)
+
+_LOG_FORMAT = "return Number((10 ** tick).toPrecision(3)).toExponential();"
+_MAP_PALETTE = ["#f3a5a5", "#a9cdf5", "#c8c8c8"]  # unstable, stable, no verdict
+
+
+def _fmt_value(v: float) -> str:
+    return "inf" if math.isinf(v) else f"{v:.6g}"
+
+
+def _label(space: Any, name: str) -> str:
+    unit = space.preset.unit(name)
+    return f"{name} [{unit}]" if unit else name
+
+
+class Explorer:
+    """One session of the explorer.
+
+    Parameters
+    ----------
+    origin : Origin
+        The command line's parameter space.
+    query : Mapping[str, str]
+        The page's URL query (a link's state).
+    """
+
+    def __init__(self, origin: Origin, query: dict[str, str]) -> None:
+        import panel as pn
+
+        self.pn = pn
+        self.origin = origin
+        self.count = 0
+        self.doc = pn.state.curdoc
+        self.errors: dict[str, str] = {}
+        state = origin.initial_state()
+        try:
+            state = origin.complete(ViewState.from_query(query, state)) if query else state
+            origin.space_of(state)
+        except BrakesquealError as exc:
+            self.errors["link"] = f"link: {exc}; showing the command line's view"
+            state = origin.initial_state()
+        self.state = state
+        self.space = origin.space_of(state)
+        self.shown: dict[str, Any] = {}
+        self._map_key: Any = None
+        self._cs_key: Any = None
+        self._hopf_key: Any = None
+        self._building = False
+        self.ranges: dict[str, SliderRange] = {n: slider_range(self.space, n) for n in self.space.settable()}
+        self._map_logs = (self.ranges[state.x].log, self.ranges[state.y].log)
+        self._map_axes = (state.x, state.y)
+        self._make_widgets()
+        self._make_figures()
+        self._rebuild_parameters()
+        schedule = self._schedule
+        self.locus_lane = LatestWorker(self._compute_locus, self._show_locus, schedule, name="explorer-locus")
+        self.map_lane = LatestWorker(self._compute_map, self._show_map, schedule,
+                                     progress=self._map_progress, name="explorer-map")
+        self.sim_lane = LatestWorker(self._compute_sim, self._show_sim, schedule,
+                                     progress=self._sim_progress, name="explorer-sim")
+        self.page = self._layout()
+        self._refresh_alert()
+        self._submit()
+        if pn.state.curdoc is not None:
+            pn.state.onload(self._write_url)
+
+    # ------------------------------------------------------------------------------------------ plumbing
+    def _schedule(self, fn: Any) -> None:
+        doc = self.doc
+        if doc is None:  # no server (tests of the object): run now
+            fn()
+            return
+        try:
+            doc.add_next_tick_callback(fn)
+        except Exception:  # the session is gone
+            self.stop()
+
+    def stop(self) -> None:
+        """End the session's worker threads."""
+        for lane in (getattr(self, n, None) for n in ("locus_lane", "map_lane", "sim_lane")):
+            if lane is not None:
+                lane.stop()
+
+    # ------------------------------------------------------------------------------------------ widgets
+    def _make_widgets(self) -> None:
+        pn = self.pn
+        self.model_select = pn.widgets.Select(name="model", options=self.origin.models(), value=self.state.model,
+                                              width=160)
+        self.preset_select = pn.widgets.Select(name="preset", options=self.origin.presets(self.state.model),
+                                               value=self.state.preset, width=160)
+        self.model_select.param.watch(self._on_model, "value")
+        self.preset_select.param.watch(self._on_preset, "value")
+        self.alert = pn.pane.Alert("", alert_type="danger", visible=False, sizing_mode="stretch_width",
+                                   css_classes=["bs-alert"])
+        self.params_box = pn.Column(sizing_mode="stretch_width")
+        self.fixed_box = pn.Card(title="fixed parameters", collapsed=True, sizing_mode="stretch_width")
+        self.along_select = pn.widgets.Select(name="root locus along", width=150)
+        self.x_select = pn.widgets.Select(name="map x", width=110)
+        self.y_select = pn.widgets.Select(name="map y", width=110)
+        self.nx_input = pn.widgets.IntInput(name="x points", value=self.state.nx, start=2, width=90)
+        self.ny_input = pn.widgets.IntInput(name="y points", value=self.state.ny, start=2, width=90)
+        for w in (self.along_select, self.x_select, self.y_select, self.nx_input, self.ny_input):
+            w.param.watch(self._on_view, "value")
+        self.t_end_input = pn.widgets.FloatInput(name="simulated time [s]", value=self.state.t_end, start=0.001,
+                                                 end=MAX_T_END, width=130)
+        self.t_end_input.param.watch(self._on_view, "value")
+        self.sim_button = pn.widgets.Button(name="Simulate", button_type="primary", width=100)
+        self.sim_button.on_click(self._on_simulate)
+        self.cancel_button = pn.widgets.Button(name="Cancel", width=80)
+        self.cancel_button.on_click(self._on_cancel)
+        self.map_progress = pn.indicators.Progress(value=0, max=100, width=150, visible=False)
+        self.sim_progress = pn.indicators.Progress(value=0, max=100, width=150, visible=False)
+        self.leading_text = pn.pane.HTML("", sizing_mode="stretch_width")
+        self.cs_text = pn.pane.HTML("critical speed: …", sizing_mode="stretch_width")
+        self.hopf_text = pn.pane.HTML("Hopf: …", sizing_mode="stretch_width")
+        self.map_text = pn.pane.HTML("", sizing_mode="stretch_width")
+        self.sim_text = pn.pane.HTML("Press Simulate to integrate the nonlinear equations and hear the squeal.",
+                                     sizing_mode="stretch_width")
+        self.audio = pn.pane.Audio(None, name="squeal", sample_rate=AUDIO_RATE, width=320, css_classes=["bs-audio"])
+        self.render = pn.pane.HTML(self._render_html(), width=0, height=0, margin=0)
+
+    def _axis_options(self) -> None:
+        names = list(self.space.settable())
+        self._building = True
+        try:
+            for w, value in ((self.along_select, self.state.along), (self.x_select, self.state.x),
+                             (self.y_select, self.state.y)):
+                w.options = names
+                w.value = value
+        finally:
+            self._building = False
+
+    def _rebuild_parameters(self) -> None:
+        """One slider and one typed input per free name; typed inputs for the fixed names."""
+        pn = self.pn
+        from bokeh.models import CustomJSTickFormatter
+
+        self.sliders: dict[str, Any] = {}
+        self.inputs: dict[str, Any] = {}
+        self.ranges: dict[str, SliderRange] = {}
+        rows = []
+        space = self.space
+        for name in space.settable():
+            self.ranges[name] = slider_range(space, name)
+        for name in space.preset.free:
+            rng = self.ranges[name]
+            value = space.value(name)
+            kw: dict[str, Any] = {"format": CustomJSTickFormatter(code=_LOG_FORMAT)} if rng.log else {}
+            lo, hi = rng.to_slider(rng.low), rng.to_slider(rng.high)
+            slider = pn.widgets.FloatSlider(name=_label(space, name), start=lo, end=hi, step=(hi - lo) / 500,
+                                            value=rng.to_slider(value), width=230, css_classes=[f"bs-slider-{name}"],
+                                            **kw)
+            box = pn.widgets.TextInput(value=_fmt_value(value), width=110, name=" ",
+                                       css_classes=[f"bs-input-{name}"])
+            slider.param.watch(lambda e, n=name: self._on_slider(n, e.new), "value")
+            box.param.watch(lambda e, n=name: self._on_text(n, e.new), "value")
+            self.sliders[name], self.inputs[name] = slider, box
+            rows.append(pn.Row(slider, box, sizing_mode="stretch_width"))
+        fixed = []
+        for name in space.settable():
+            if name in space.preset.free:
+                continue
+            box = pn.widgets.TextInput(name=_label(space, name), value=_fmt_value(space.value(name)), width=150,
+                                       css_classes=[f"bs-input-{name}"])
+            box.param.watch(lambda e, n=name: self._on_text(n, e.new), "value")
+            self.inputs[name] = box
+            fixed.append(box)
+        self.params_box.objects = rows
+        self.fixed_box.objects = [pn.FlexBox(*fixed)]
+        self._axis_options()
+
+    # ------------------------------------------------------------------------------------------ figures
+    def _make_figures(self) -> None:
+        from bokeh.models import ColumnDataSource, LinearColorMapper, Span
+        from bokeh.plotting import figure
+
+        pn = self.pn
+        self.src_locus = ColumnDataSource({"xs": [], "ys": [], "mode": []})
+        self.src_now = ColumnDataSource({"re": [], "im": []})
+        f = figure(height=330, width=420, title="eigenvalues along the path (root locus)",
+                   x_axis_label="Re λ [1/s]", y_axis_label="Im λ [1/s]", tools="pan,wheel_zoom,box_zoom,reset")
+        f.multi_line("xs", "ys", source=self.src_locus, line_width=1.5, color="#4c72b0", alpha=0.8)
+        f.scatter("re", "im", source=self.src_now, size=9, color="#d62728", legend_label="current point")
+        f.add_layout(Span(location=0, dimension="height", line_color="black", line_dash="dashed", line_width=1))
+        f.legend.location = "top_left"
+        f.css_classes = ["bs-locus"]
+        self.fig_locus = f
+        self.src_modes = ColumnDataSource({"xs": [], "freq": [], "real": []})
+        self.span_f = Span(location=0, dimension="height", line_color="#d62728", line_width=1)
+        self.span_r = Span(location=0, dimension="height", line_color="#d62728", line_width=1)
+        self.pane_locus = pn.pane.Bokeh(f, css_classes=['bs-locus'])
+        self.pane_modes = pn.pane.Bokeh(self._modes_figure(False))
+        self.src_map = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
+        self.src_boundary = ColumnDataSource({"x": [], "y": []}, name="bs-boundary")
+        self.src_point = ColumnDataSource({"x": [], "y": []})
+        self.map_mapper = LinearColorMapper(palette=_MAP_PALETTE, low=-0.5, high=2.5)
+        self.pane_map = pn.pane.Bokeh(self._map_figure(*self._map_logs), css_classes=['bs-map'])
+        self.src_hist = ColumnDataSource({"t": [], "x": []})
+        self.src_spec = ColumnDataSource({"f": [], "a": []})
+        h = figure(height=220, width=520, title="time history", x_axis_label="t [s]", y_axis_label="deviation",
+                   tools="pan,wheel_zoom,box_zoom,reset")
+        h.line("t", "x", source=self.src_hist, line_width=0.8)
+        self.fig_hist = h
+        s = figure(height=220, width=360, title="spectrum", x_axis_label="frequency [Hz]", y_axis_label="amplitude",
+                   y_axis_type="log", tools="pan,wheel_zoom,box_zoom,reset")
+        s.line("f", "a", source=self.src_spec, line_width=0.8)
+        self.fig_spec = s
+
+    def _modes_figure(self, log: bool) -> Any:
+        from bokeh.layouts import column
+        from bokeh.plotting import figure
+
+        xt = "log" if log else "linear"
+        name = self.state.along
+        lab = _label(self.space, name)
+        a = figure(height=165, width=420, title="mode coupling", x_axis_type=xt, y_axis_label="f [Hz]",
+                   tools="pan,wheel_zoom,box_zoom,reset")
+        a.multi_line("xs", "freq", source=self.src_modes, line_width=1.5, color="#4c72b0")
+        a.add_layout(self.span_f)
+        b = figure(height=165, width=420, x_axis_type=xt, x_axis_label=lab, y_axis_label="Re λ [1/s]",
+                   x_range=a.x_range, tools="pan,wheel_zoom,box_zoom,reset")
+        b.multi_line("xs", "real", source=self.src_modes, line_width=1.5, color="#4c72b0")
+        b.add_layout(self.span_r)
+        return column(a, b)
+
+    def _map_figure(self, x_log: bool, y_log: bool) -> Any:
+        from bokeh.events import Tap
+        from bokeh.models import CustomJSTickFormatter
+        from bokeh.plotting import figure
+
+        st = self.state
+        f = figure(height=380, width=470, title="stability map (click to move there)",
+                   x_axis_label=_label(self.space, st.x) + (" (log)" if x_log else ""),
+                   y_axis_label=_label(self.space, st.y) + (" (log)" if y_log else ""),
+                   tools="tap,pan,wheel_zoom,box_zoom,reset")
+        f.image("image", x="x", y="y", dw="dw", dh="dh", source=self.src_map, color_mapper=self.map_mapper)
+        f.line("x", "y", source=self.src_boundary, line_color="black", line_width=2, legend_label="boundary")
+        f.scatter("x", "y", source=self.src_point, marker="cross", size=16, line_width=3, color="#2ca02c",
+                  legend_label="current point")
+        f.legend.location = "bottom_right"
+        f.title.text_font_size = "9pt"
+        if x_log:
+            f.xaxis.formatter = CustomJSTickFormatter(code=_LOG_FORMAT)
+        if y_log:
+            f.yaxis.formatter = CustomJSTickFormatter(code=_LOG_FORMAT)
+        f.css_classes = ["bs-map"]
+        f.on_event(Tap, self._on_tap)
+        self.fig_map = f
+        self._map_logs = (x_log, y_log)
+        return f
+
+    def _layout(self) -> Any:
+        pn = self.pn
+        head = pn.Row(pn.pane.HTML("<h2 style='margin:4px 0'>brakesqueal explorer</h2>"), self.model_select,
+                      self.preset_select, sizing_mode="stretch_width")
+        left = pn.Column(self.params_box, self.fixed_box,
+                         pn.Row(self.along_select, self.x_select, self.y_select),
+                         pn.Row(self.nx_input, self.ny_input, self.map_progress),
+                         pn.Row(self.t_end_input, self.sim_button, self.cancel_button), self.sim_progress,
+                         width=400)
+        legend = pn.pane.HTML("<small>map: <span style='background:#a9cdf5'>&nbsp;stable&nbsp;</span> "
+                              "<span style='background:#f3a5a5'>&nbsp;unstable&nbsp;</span> "
+                              "<span style='background:#c8c8c8'>&nbsp;no verdict&nbsp;</span>; black: the exact "
+                              "boundary (refined by bisection); green cross: the current point</small>")
+        texts = pn.Column(self.leading_text, self.cs_text, self.hopf_text, self.map_text, legend, self.sim_text,
+                          width=460)
+        views = pn.Column(pn.Row(self.pane_locus, self.pane_modes), pn.Row(self.pane_map, texts),
+                          pn.Row(self.fig_hist, self.fig_spec), self.audio)
+        return pn.Column(head, self.alert, pn.Row(left, views), self.render, sizing_mode="stretch_width")
+
+    # ------------------------------------------------------------------------------------------ state changes
+    def _refresh_alert(self) -> None:
+        text = "; ".join(self.errors.values())
+        self.alert.object = html.escape(text)
+        self.alert.visible = bool(text)
+
+    def _set_state(self, state: ViewState, *, source: str) -> bool:
+        """Validate and adopt a new state (False, with the message shown, if it is refused)."""
+        try:
+            space = self.origin.space_of(state)
+        except BrakesquealError as exc:
+            self.errors[source] = str(exc)
+            self._refresh_alert()
+            return False
+        self.errors.pop(source, None)
+        self.errors.pop("link", None)
+        self._refresh_alert()
+        self.state, self.space = state, space
+        self._write_url()
+        self._submit()
+        return True
+
+    def _write_url(self) -> None:
+        loc = self.pn.state.location
+        if loc is not None:
+            try:
+                loc.update_query(**self.state.to_query())
+            except Exception:  # no browser location (tests of the object)
+                log.debug("no location", exc_info=True)
+
+    def _on_slider(self, name: str, position: float) -> None:
+        if self._building:
+            return
+        value = self.ranges[name].from_slider(position)
+        text = _fmt_value(value)
+        self._building = True
+        try:
+            self.inputs[name].value = text
+        finally:
+            self._building = False
+        self._set_state(self.state.with_values({name: text}), source=name)
+
+    def _on_text(self, name: str, text: str) -> None:
+        if self._building:
+            return
+        if self._set_state(self.state.with_values({name: text.strip()}), source=name) and name in self.sliders:
+            rng = self.ranges[name]
+            self._building = True
+            try:
+                self.sliders[name].value = rng.to_slider(self.space.value(name))
+            finally:
+                self._building = False
+
+    def _move_to(self, changes: dict[str, float]) -> None:
+        """Set several values (a click on the map), updating their widgets."""
+        texts = {n: _fmt_value(v) for n, v in changes.items()}
+        if not self._set_state(self.state.with_values(texts), source="map click"):
+            return
+        self._building = True
+        try:
+            for n, t in texts.items():
+                if n in self.inputs:
+                    self.inputs[n].value = t
+                if n in self.sliders:
+                    self.sliders[n].value = self.ranges[n].to_slider(float(t) if t != "inf" else math.inf)
+        finally:
+            self._building = False
+
+    def _on_tap(self, event: Any) -> None:
+        if event.x is None or event.y is None:
+            return
+        x_log, y_log = self._map_logs
+        x = 10.0 ** event.x if x_log else float(event.x)
+        y = 10.0 ** event.y if y_log else float(event.y)
+        self._move_to({self.state.x: x, self.state.y: y})
+
+    def _on_view(self, event: Any) -> None:
+        if self._building:
+            return
+        st = self.state
+        new = replace(st, along=self.along_select.value, x=self.x_select.value, y=self.y_select.value,
+                      nx=int(self.nx_input.value or 0), ny=int(self.ny_input.value or 0),
+                      t_end=float(self.t_end_input.value or 0))
+        self._set_state(new, source="view")
+
+    def _reset_to(self, state: ViewState, source: str) -> None:
+        try:
+            state = self.origin.complete(state)
+        except BrakesquealError as exc:
+            self.errors[source] = str(exc)
+            self._refresh_alert()
+            return
+        if self._set_state(state, source=source):
+            self._building = True
+            try:
+                self.preset_select.options = self.origin.presets(state.model)
+                self.preset_select.value = state.preset
+            finally:
+                self._building = False
+            self._rebuild_parameters()
+
+    def _on_model(self, event: Any) -> None:
+        if self._building:
+            return
+        self._reset_to(ViewState(model=event.new, preset="", nx=self.state.nx, ny=self.state.ny,
+                                 t_end=self.state.t_end), "model")
+
+    def _on_preset(self, event: Any) -> None:
+        if self._building or not event.new:
+            return
+        self._reset_to(ViewState(model=self.state.model, preset=event.new, nx=self.state.nx, ny=self.state.ny,
+                                 t_end=self.state.t_end), "preset")
+
+    def _on_simulate(self, event: Any) -> None:
+        self.sim_text.object = "simulating …"
+        self.sim_progress.value, self.sim_progress.visible = 0, True
+        self.sim_lane.submit(self.state)
+
+    def _on_cancel(self, event: Any) -> None:
+        self.sim_lane.cancel()
+        self.map_lane.cancel()
+
+    def _submit(self) -> None:
+        """The eigenvalues first; the map lane follows each delivered locus (so it never delays the first view)."""
+        self.locus_lane.submit(self.state)
+
+    # ------------------------------------------------------------------------------------------ lanes
+    def _compute_locus(self, state: ViewState, check: Any) -> tuple[Any, LocusView]:
+        space = self.origin.space_of(state)
+        rng = slider_range(space, state.along) if state.along not in self.ranges else self.ranges[state.along]
+        return space, locus_view(space, state.along, rng)
+
+    def _mark(self) -> None:
+        self.count += 1
+        self.render.object = self._render_html()
+
+    def _render_html(self) -> str:
+        data = json.dumps(self.shown, default=str)
+        return (f"<div id='bs-render' data-count='{self.count}' data-shown='{html.escape(data, quote=True)}' "
+                "style='display:none'></div>")
+
+    def _show_locus(self, state: ViewState, result: Any, error: BaseException | None) -> None:
+        self.map_lane.submit(self.state)
+        if error is not None:
+            self.leading_text.object = f"<b>leading eigenvalue:</b> {html.escape(str(error))}"
+            self.shown["locus"] = {"state": state.to_query(), "error": str(error)}
+            self._mark()
+            return
+        space, lv = result
+        lead = format_eigenvalue(lv.leading)
+        verdict = "unstable (squeal)" if lv.leading.real > 0 else "stable"
+        self.leading_text.object = (f"<b>leading eigenvalue</b> λ = <span id='bs-leading'>{lead}</span> 1/s "
+                                    f"({abs(lv.leading.imag) / (2 * math.pi):.6g} Hz) — {verdict}")
+        upper = lv.eigenvalues[lv.eigenvalues.imag >= 0]
+        self.src_now.data = {"re": upper.real.tolist(), "im": upper.imag.tolist()}
+        current = space.value(state.along)
+        self.span_f.location = self.span_r.location = current if math.isfinite(current) else None
+        tr = lv.tracks
+        if tr is not None:
+            lam = tr.eigenvalues
+            xs, ys, mode, vx, fr, re_ = [], [], [], [], [], []
+            for k in range(lam.shape[1]):
+                col = lam[:, k]
+                xs.append(col.real.tolist())
+                ys.append(col.imag.tolist())
+                mode.append(k)
+                vx.append(tr.values.tolist())
+                fr.append((np.abs(col.imag) / (2 * math.pi)).tolist())
+                re_.append(col.real.tolist())
+            self.src_locus.data = {"xs": xs, "ys": ys, "mode": mode}
+            log_now = bool(tr.log)
+            if getattr(self, "_modes_key", None) != (state.along, log_now, state.model, state.preset):
+                self._modes_key = (state.along, log_now, state.model, state.preset)
+                self.pane_modes.object = self._modes_figure(log_now)
+            self.src_modes.data = {"xs": vx, "freq": fr, "real": re_}
+        if lv.message:
+            self.leading_text.object += f"<br><i>{html.escape(lv.message)}</i>"
+        x, y = self._map_point(space, state)
+        self.src_point.data = {"x": [x], "y": [y]}
+        self.shown["locus"] = {"state": state.to_query(), "leading": lead, "re": lv.leading.real,
+                               "im": lv.leading.imag, "point": [x, y]}
+        self._mark()
+
+    def _map_point(self, space: Any, state: ViewState) -> tuple[float, float]:
+        x_log, y_log = self._map_logs
+        vx, vy = space.value(state.x), space.value(state.y)
+        rx, ry = self.ranges.get(state.x), self.ranges.get(state.y)
+        if rx is not None and math.isinf(vx):
+            vx = rx.high
+        if ry is not None and math.isinf(vy):
+            vy = ry.high
+        return (math.log10(vx) if x_log and vx > 0 else vx), (math.log10(vy) if y_log and vy > 0 else vy)
+
+    def _compute_map(self, state: ViewState, check: Any) -> dict[str, Any]:
+        space = self.origin.space_of(state)
+        ranges = {n: (self.ranges.get(n) or slider_range(space, n)) for n in (state.x, state.y, state.along)}
+        out: dict[str, Any] = {}
+        defs = {k: str(v) for k, v in space.definitions().items()}
+        map_key = (state.model, state.preset, state.x, state.y, state.nx, state.ny,
+                   tuple(sorted((k, v) for k, v in defs.items() if k not in (state.x, state.y))))
+        if map_key != self._map_key:
+            try:
+                out["map"] = map_view(space, state.x, state.y, ranges[state.x], ranges[state.y], state.nx, state.ny,
+                                      progress=check)
+                self._map_key = map_key
+            except BrakesquealError as exc:
+                out["map_error"] = str(exc)
+                self._map_key = None
+        cs_key = (state.model, state.preset, tuple(sorted(defs.items())))
+        if cs_key != self._cs_key:
+            check(1.0)
+            out["cs"] = critical_speed_text(space)
+            self._cs_key = cs_key
+        hopf_key = (state.model, state.preset, state.along,
+                    tuple(sorted((k, v) for k, v in defs.items() if k != state.along)))
+        if hopf_key != self._hopf_key:
+            check(1.0)
+            self._hopf_points = hopf_scan(space, state.along, ranges[state.along])
+            self._hopf_key = hopf_key
+        out["hopf"] = hopf_text(self._hopf_points, state.along, space.value(state.along), ranges[state.along])
+        return out
+
+    def _map_progress(self, fraction: float) -> None:
+        self.map_progress.visible = fraction < 1.0
+        self.map_progress.value = int(100 * fraction)
+
+    def _show_map(self, state: ViewState, out: Any, error: BaseException | None) -> None:
+        self.map_progress.visible = False
+        if error is not None:
+            self._map_key = self._cs_key = self._hopf_key = None
+            if not isinstance(error, Cancelled):
+                self.map_text.object = f"<b>map:</b> {html.escape(str(error))}"
+            else:
+                self.map_text.object = "<b>map:</b> cancelled"
+            self._mark()
+            return
+        if "map_error" in out:
+            self.map_text.object = f"<b>map:</b> {html.escape(out['map_error'])}"
+            self.shown["map"] = {"state": state.to_query(), "error": out["map_error"]}
+        if "map" in out:
+            mv: MapView = out["map"]
+            self._draw_map(state, mv)
+        if "cs" in out:
+            self.cs_text.object = html.escape(out["cs"])
+            self.shown["cs"] = out["cs"]
+        if "hopf" in out:
+            self.hopf_text.object = html.escape(out["hopf"])
+            self.shown["hopf"] = out["hopf"]
+        self.shown["lane_state"] = state.to_query()
+        self._mark()
+
+    def _draw_map(self, state: ViewState, mv: MapView) -> None:
+        tx = np.log10(mv.x) if mv.x_log else mv.x
+        ty = np.log10(mv.y) if mv.y_log else mv.y
+        code = np.where(mv.status <= 1, mv.stable.astype(np.int8), 2).astype(np.float32)
+        dx = (tx[-1] - tx[0]) / max(tx.size - 1, 1)
+        dy = (ty[-1] - ty[0]) / max(ty.size - 1, 1)
+        if self._map_logs != (mv.x_log, mv.y_log) or getattr(self, "_map_axes", None) != (state.x, state.y):
+            self._map_axes = (state.x, state.y)
+            self.pane_map.object = self._map_figure(mv.x_log, mv.y_log)
+        self.src_map.data = {"image": [code], "x": [tx[0] - dx / 2], "y": [ty[0] - dy / 2],
+                             "dw": [tx[-1] - tx[0] + dx], "dh": [ty[-1] - ty[0] + dy]}
+        bx = np.log10(mv.boundary_x) if mv.x_log else mv.boundary_x
+        by = np.log10(mv.boundary_y) if mv.y_log else mv.boundary_y
+        self.src_boundary.data = {"x": bx, "y": by}
+        space = self.origin.space_of(state)
+        px, py = self._map_point(space, state)
+        self.src_point.data = {"x": [px], "y": [py]}
+        n = mv.x.size * mv.y.size
+        frac = float(np.mean(mv.stable))
+        self.map_text.object = (f"<b>map:</b> {mv.x.size} × {mv.y.size} = {n:,} points (at most {MAX_MAP_POINTS:,}), "
+                                f"{100 * frac:.1f} % stable, boundary with {int(np.isfinite(mv.boundary_x).sum())} "
+                                f"refined vertices; {html.escape(mv.method)}")
+        self.shown["map"] = {"state": state.to_query(), "points": n, "stable_fraction": frac,
+                             "boundary_vertices": int(np.isfinite(mv.boundary_x).sum())}
+
+    def _compute_sim(self, state: ViewState, check: Any) -> SimulationView:
+        return simulation_view(self.origin.space_of(state), state.t_end, progress=check)
+
+    def _sim_progress(self, fraction: float) -> None:
+        self.sim_progress.value = int(100 * min(max(fraction, 0.0), 1.0))
+
+    def _show_sim(self, state: ViewState, sv: Any, error: BaseException | None) -> None:
+        self.sim_progress.visible = False
+        if error is not None:
+            msg = "cancelled" if isinstance(error, Cancelled) else str(error)
+            self.sim_text.object = f"<b>simulation:</b> {html.escape(msg)}"
+            self.shown["sim"] = {"state": state.to_query(), "error": msg}
+            self._mark()
+            return
+        self.src_hist.data = {"t": sv.t, "x": sv.x}
+        self.fig_hist.yaxis.axis_label = sv.coordinate
+        keep = sv.f > 0
+        self.src_spec.data = {"f": sv.f[keep], "a": np.maximum(sv.spectrum[keep], 1e-300)}
+        self.audio.object = sv.audio
+        self.sim_text.object = html.escape(sv.summary) + f" — audio {sv.duration:.3f} s"
+        self.shown["sim"] = {"state": state.to_query(), "duration": sv.duration, "samples": int(sv.audio.size),
+                             "summary": sv.summary}
+        self._mark()
+
+
+def build_page(origin: Origin) -> Any:
+    """The page of one session (Panel calls this once per browser tab).
+
+    Parameters
+    ----------
+    origin : Origin
+        The command line's parameter space.
+
+    Returns
+    -------
+    panel.viewable.Viewable
+    """
+    import panel as pn
+
+    args = pn.state.session_args or {}
+    query = {k: (v[0].decode() if isinstance(v[0], bytes) else str(v[0])) for k, v in args.items() if v}
+    ex = Explorer(origin, query)
+    pn.state.on_session_destroyed(lambda ctx: ex.stop())
+    return ex.page
+
+
+def check(state: ViewState, origin: Origin) -> None:
+    """Raise ParameterError unless ``state`` resolves (used by the command before serving)."""
+    try:
+        origin.space_of(state)
+    except BrakesquealError as exc:
+        raise ParameterError(str(exc)) from None

@@ -1,0 +1,593 @@
+"""The explorer's state and computations, without any user-interface code.
+
+The state of a view (:class:`ViewState`: model, preset, parameter values, the
+path of the root locus, the map's axes and size, the simulated time) is a
+small immutable value that round-trips through the page's URL query
+(:meth:`ViewState.to_query`, :meth:`ViewState.from_query`), so a link
+reproduces a view.  Parameter values are kept as the texts a user typed (as
+for ``--set``) and resolved by :func:`brakesqueal.model.options.resolve_space`,
+the function every command uses, so the explorer accepts and refuses exactly
+what the command line does.
+
+The computations call the library's public routes only:
+:func:`~brakesqueal.analysis.linear.linearize`,
+:func:`~brakesqueal.analysis.modes.modes_along`,
+:func:`~brakesqueal.analysis.maps.stability_map`,
+:func:`~brakesqueal.analysis.crossings.critical_speeds`,
+:func:`~brakesqueal.nonlinear.models.hopf_points` and
+:func:`~brakesqueal.simulation.simulate`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError
+
+__all__ = ["MAX_MAP_POINTS", "MAX_T_END", "LOCUS_POINTS", "AUDIO_RATE", "SliderRange", "ViewState",
+           "slider_range", "format_eigenvalue", "leading_eigenvalue", "MapView", "map_view", "LocusView",
+           "locus_view", "critical_speed_text", "hopf_scan", "hopf_text", "SimulationView",
+           "simulation_view", "check_map_size", "check_t_end", "Origin", "audio_samples", "default_axes"]
+
+#: Largest number of map points the explorer computes (``brakesqueal map`` has no such cap).
+MAX_MAP_POINTS = 1_000_000
+#: Largest simulated time [s] the explorer runs (``brakesqueal simulate`` has no such cap).
+MAX_T_END = 5.0
+#: Points of the root locus along the path.
+LOCUS_POINTS = 60
+#: Sample rate [Hz] of the simulation output and its audio.
+AUDIO_RATE = 44100
+#: Largest number of points of a drawn time history (min/max per bucket beyond).
+HISTORY_POINTS = 4000
+
+
+@dataclass(frozen=True)
+class SliderRange:
+    """The range of a parameter's slider.
+
+    Attributes
+    ----------
+    low, high : float
+        Ends of the range (SI unit of the parameter).
+    log : bool
+        Whether the slider moves in ``log10`` of the value.
+    """
+
+    low: float
+    high: float
+    log: bool
+
+    def to_slider(self, value: float) -> float:
+        """Slider position of a value (``log10`` for log ranges), clipped to the range."""
+        v = min(max(value, self.low), self.high) if math.isfinite(value) else self.high
+        return math.log10(v) if self.log else v
+
+    def from_slider(self, position: float) -> float:
+        """Value of a slider position."""
+        return 10.0 ** position if self.log else position
+
+
+def slider_range(space: Any, name: str) -> SliderRange:
+    """A slider range around the current value of a settable name.
+
+    Positive dimensional values get a log range of two decades each way;
+    dimensionless values (friction coefficients, slopes) a linear range from
+    0 to at least 1; zero and negative values a linear range.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The space (its preset gives units and defaults).
+    name : str
+        A settable name.
+
+    Returns
+    -------
+    SliderRange
+    """
+    try:
+        v = space.value(name)
+    except ParameterError:
+        v = math.nan
+    unit = space.preset.unit(name)
+    if math.isinf(v):  # a rigid support: a log range of stiffnesses, typed input gives inf
+        return SliderRange(1e5, 1e10, True)
+    if not math.isfinite(v):
+        return SliderRange(0.0, 1.0, False)
+    if not unit and v >= 0:
+        high = max(1.0, 2.0 * v)
+        try:  # a friction coefficient may sit in a denominator (paper-fig2: N0 = 1800/mu)
+            space.resolve({name: 0.0})
+            low = 0.0
+        except ParameterError:
+            low = high / 100.0
+        return SliderRange(low, high, False)
+    if v > 0:
+        return SliderRange(v / 100.0, v * 100.0, True)
+    if v == 0:
+        return SliderRange(0.0, 1.0, False)
+    return SliderRange(3.0 * v, -3.0 * v, False)
+
+
+def format_eigenvalue(lam: complex, digits: int = 6) -> str:
+    """An eigenvalue as shown by the explorer: ``"0.183869 + 10927.2i"`` (``digits`` significant digits)."""
+    re_, im = float(lam.real), float(lam.imag)
+    sign = "+" if im >= 0 else "−"
+    return f"{re_:.{digits}g} {sign} {abs(im):.{digits}g}i"
+
+
+def leading_eigenvalue(eigenvalues: Sequence[complex] | np.ndarray) -> complex:
+    """The eigenvalue with the largest real part (of a conjugate pair, the one with ``Im >= 0``)."""
+    lam = np.asarray(eigenvalues, dtype=complex)
+    if lam.size == 0:
+        raise ParameterError("the model has no eigenvalues")
+    order = np.lexsort((lam.imag, lam.real))  # by real part, then imaginary part
+    return complex(lam[order[-1]])
+
+
+def check_map_size(nx: int, ny: int) -> None:
+    """Raise ParameterError (one line) unless an ``nx × ny`` map is within :data:`MAX_MAP_POINTS`."""
+    for what, n in (("x", nx), ("y", ny)):
+        if not (isinstance(n, (int, np.integer)) and n >= 2):
+            raise ParameterError(f"map points along {what} must be an integer of at least 2; got {n!r}")
+    if nx * ny > MAX_MAP_POINTS:
+        raise ParameterError(f"map of {nx} × {ny} = {nx * ny:,} points: the explorer computes at most "
+                             f"{MAX_MAP_POINTS:,} points; use 'brakesqueal map' for larger maps")
+
+
+def check_t_end(t_end: float) -> None:
+    """Raise ParameterError (one line) unless ``0 < t_end <= MAX_T_END``."""
+    if not (isinstance(t_end, (int, float)) and math.isfinite(t_end) and 0 < t_end <= MAX_T_END):
+        raise ParameterError(f"simulated time t_end = {t_end!r} s: must be in (0, {MAX_T_END:g}] s in the explorer; "
+                             "use 'brakesqueal simulate' for longer runs")
+
+
+@dataclass(frozen=True)
+class ViewState:
+    """Everything a link to the explorer reproduces.
+
+    Attributes
+    ----------
+    model : str
+        A built-in model name, or the name of the model given on the command line.
+    preset : str
+        A preset of the model.
+    values : Mapping[str, str]
+        Overrides of settable names, as texts (``"0.4"``, ``"inf"``, ``"16*pi"``).
+    along : str
+        The path parameter of the root locus, Hopf analysis and mode-coupling diagram.
+    x, y : str
+        The map's axes.
+    nx, ny : int
+        The map's points along ``x`` and ``y``.
+    t_end : float
+        Simulated time [s].
+    """
+
+    model: str
+    preset: str
+    values: Mapping[str, str] = field(default_factory=dict)
+    along: str = ""
+    x: str = ""
+    y: str = ""
+    nx: int = 400
+    ny: int = 250
+    t_end: float = 0.5
+
+    def sets(self) -> list[str]:
+        """The values as ``--set`` texts."""
+        return [f"{k}={v}" for k, v in self.values.items()]
+
+    def with_values(self, changes: Mapping[str, str]) -> ViewState:
+        """A copy with more overrides."""
+        return replace(self, values={**self.values, **changes})
+
+    def to_query(self) -> dict[str, str]:
+        """URL query parameters (``set`` holds ``NAME=VALUE`` pairs separated by commas, as ``--set``)."""
+        return {"model": self.model, "preset": self.preset, "set": ",".join(self.sets()), "along": self.along,
+                "x": self.x, "y": self.y, "nx": str(self.nx), "ny": str(self.ny), "t_end": f"{self.t_end:g}"}
+
+    @classmethod
+    def from_query(cls, query: Mapping[str, str], default: ViewState) -> ViewState:
+        """The state of a URL query; missing keys keep ``default``'s (a new model or preset drops its values).
+
+        Raises
+        ------
+        ParameterError
+            A malformed number or ``set`` entry (names and values are
+            checked when the state is resolved, :meth:`space`).
+        """
+        model = query.get("model") or default.model
+        preset = query.get("preset") or (default.preset if model == default.model else "")
+        same = model == default.model and preset == default.preset
+        values: dict[str, str] = dict(default.values) if same else {}
+        text = query.get("set")
+        if text is not None:
+            values = {}
+            for item in filter(None, (t.strip() for t in text.split(","))):
+                name, sep, value = item.partition("=")
+                if not sep or not name.strip() or not value.strip():
+                    raise ParameterError(f"malformed set entry {item!r} in the link: expected NAME=VALUE")
+                values[name.strip()] = value.strip()
+
+        def integer(key: str, fallback: int) -> int:
+            if not query.get(key):
+                return fallback
+            try:
+                return int(query[key])
+            except ValueError:
+                raise ParameterError(f"'{key}' in the link must be an integer; got {query[key]!r}") from None
+
+        t_end = default.t_end
+        if query.get("t_end"):
+            try:
+                t_end = float(query["t_end"])
+            except ValueError:
+                raise ParameterError(f"'t_end' in the link must be a number of seconds; got {query['t_end']!r}") \
+                    from None
+        keep = same or not (query.get("model") or query.get("preset"))
+        return cls(model=model, preset=preset, values=values,
+                   along=query.get("along") or (default.along if keep else ""),
+                   x=query.get("x") or (default.x if keep else ""), y=query.get("y") or (default.y if keep else ""),
+                   nx=integer("nx", default.nx), ny=integer("ny", default.ny), t_end=t_end)
+
+
+def default_axes(space: Any) -> tuple[str, str, str]:
+    """Default ``(along, x, y)`` of a space: the first free name, and the first two settable names."""
+    names = list(space.settable())
+    free = list(space.preset.free) or names
+    along = free[0]
+    if len(free) >= 2:
+        x, y = free[1], free[0]
+    else:
+        others = [n for n in names if n != along]
+        x, y = (others[0] if others else along), along
+    return along, x, y
+
+
+# ---------------------------------------------------------------------------------------------- root locus
+@dataclass(frozen=True)
+class LocusView:
+    """The eigenvalues at the current point and along the path.
+
+    Attributes
+    ----------
+    eigenvalues : ndarray of complex
+        At the current point [1/s].
+    leading : complex
+        :func:`leading_eigenvalue` of ``eigenvalues``.
+    tracks : ModeTracks or None
+        The modes along the path (``None`` when the path could not be computed; see ``message``).
+    message : str
+        Why the path is missing, else ``""``.
+    """
+
+    eigenvalues: np.ndarray
+    leading: complex
+    tracks: Any
+    message: str = ""
+
+
+def locus_view(space: Any, along: str, rng: SliderRange, num: int = LOCUS_POINTS) -> LocusView:
+    """Linearize at the current point and track every mode along ``along`` over ``rng``.
+
+    Raises
+    ------
+    ParameterError, SilentMotionError
+        At the current point (errors along the path are reported in ``message``).
+    """
+    from ..analysis.linear import linearize
+    from ..analysis.modes import modes_along
+    from ..errors import BrakesquealError
+
+    lm = linearize(space.resolve({}))
+    lam = np.asarray(lm.eigenvalues, dtype=complex)
+    try:
+        tracks = modes_along(space, along, rng.low, rng.high, num=num, log=rng.log)
+        message = ""
+    except BrakesquealError as exc:
+        tracks, message = None, f"root locus along {along}: {exc}"
+    return LocusView(lam, leading_eigenvalue(lam), tracks, message)
+
+
+# ---------------------------------------------------------------------------------------------- map
+@dataclass(frozen=True)
+class MapView:
+    """A stability map prepared for drawing (arrays indexed ``[y, x]``).
+
+    Attributes
+    ----------
+    x, y : ndarray
+        Grid values of the axes (SI units).
+    x_log, y_log : bool
+        Whether the axes are logarithmic.
+    max_real : ndarray
+        Largest real part [1/s] (NaN where the status is not decided).
+    stable : ndarray of bool
+        Certified verdicts.
+    status : ndarray of int8
+        :class:`~brakesqueal.status.PointStatus` codes.
+    boundary_x, boundary_y : ndarray
+        The stored refined boundary (curves separated by NaN; empty if none).
+    method : str
+        The map's route.
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    x_log: bool
+    y_log: bool
+    max_real: np.ndarray
+    stable: np.ndarray
+    status: np.ndarray
+    boundary_x: np.ndarray
+    boundary_y: np.ndarray
+    method: str
+
+
+def map_view(space: Any, x: str, y: str, rx: SliderRange, ry: SliderRange, nx: int, ny: int, *,
+             progress: Callable[[float], None] | None = None) -> MapView:
+    """The stability map over ``x`` and ``y`` (the library's :func:`~brakesqueal.analysis.maps.stability_map`).
+
+    Raises
+    ------
+    ParameterError
+        Equal or tied axes, too many points (:data:`MAX_MAP_POINTS`).
+    """
+    from ..analysis.maps import Axis, stability_map
+
+    check_map_size(nx, ny)
+    if x == y:
+        raise ParameterError(f"the map's axes must differ; both are '{x}'")
+    ax = Axis(x, rx.low, rx.high, nx, rx.log)
+    ay = Axis(y, ry.low, ry.high, ny, ry.log)
+    m: Any = stability_map(space, ax, ay, progress=progress)
+    ds = m.data
+    stable = ds["stable"].transpose(y, x).values
+    status = ds["status"].transpose(y, x).values
+    mr = ds["max_real"].transpose(y, x).values.astype(float)
+    mr = np.where(status <= 1, mr, np.nan)
+    bx = ds[f"boundary_{x}"].values if f"boundary_{x}" in ds else np.empty(0)
+    by = ds[f"boundary_{y}"].values if f"boundary_{y}" in ds else np.empty(0)
+    return MapView(ds[x].values, ds[y].values, rx.log, ry.log, mr, stable, status, np.asarray(bx, dtype=float),
+                   np.asarray(by, dtype=float), str(ds.attrs.get("method", "")))
+
+
+# ---------------------------------------------------------------------------------------------- speeds, Hopf
+def critical_speed_text(space: Any) -> str:
+    """One line: the critical speeds of the current point (:func:`~brakesqueal.analysis.crossings.critical_speeds`)."""
+    from ..analysis.crossings import critical_speeds, omega_name
+    from ..errors import BrakesquealError
+
+    try:
+        name = omega_name(space)
+        r: Any = critical_speeds(space)
+    except BrakesquealError as exc:
+        return f"critical speed: {exc}"
+    if not r.crossings:
+        state = "stable" if r.stable_at_start else "unstable"
+        return f"critical speed: none in [{r.start:g}, {r.stop:g}] rad/s ({state} throughout)"
+    parts = [f"{v:.6g} rad/s ({d})" for v, d in r.crossings]
+    crit = "" if r.Omega_crit is None else f"{name}_crit = {r.Omega_crit:.6g} rad/s; "
+    certain = "" if r.Omega_crit_certain else " (not certain: undecided ranges)"
+    return f"critical speed: {crit}changes at " + ", ".join(parts) + certain
+
+
+def hopf_scan(space: Any, along: str, rng: SliderRange) -> list[Any] | str:
+    """Every Hopf point along the path (:func:`~brakesqueal.nonlinear.models.hopf_points`), or why not (a line)."""
+    from ..analysis.maps import Axis
+    from ..errors import BrakesquealError
+    from ..nonlinear.models import hopf_points
+
+    try:
+        return list(hopf_points(space, Axis(along, rng.low, rng.high, 2, rng.log)))
+    except BrakesquealError as exc:
+        return f"Hopf: {exc}"
+
+
+def hopf_text(points: list[Any] | str, along: str, current: float, rng: SliderRange) -> str:
+    """One line: the Hopf point nearest ``current`` among :func:`hopf_scan`'s, its criticality and amplitude."""
+    if isinstance(points, str):
+        return points
+    if not points:
+        return f"Hopf: no stability change along {along} in [{rng.low:.4g}, {rng.high:.4g}]"
+    if rng.log and current > 0:
+        hp = min(points, key=lambda h: abs(math.log(h.value / current)))
+    else:
+        hp = min(points, key=lambda h: abs(h.value - current))
+    if hp.hopf is None:
+        return f"Hopf: {hp.direction} crossing at {along} = {hp.value:.6g}; {hp.message}"
+    h = hp.hopf
+    side = (f"{along} > {h.p0:.6g}" if h.side > 0 else f"{along} < {h.p0:.6g}") if h.side else "?"
+    names = tuple(h.state_names or ())
+    amp = ""
+    if names:
+        a = float(h.amplitude_coefficients[0])
+        dp = abs(current - h.p0)
+        here = dp > 0 and h.side != 0 and (h.side > 0) == (current > h.p0) and h.criticality == "supercritical"
+        amp = (f"; predicted amplitude of {names[0]} ≈ {a:.3g}·sqrt(|{along} − {h.p0:.4g}|)"
+               + (f" = {a * math.sqrt(dp):.3g} here" if here else ""))
+    return (f"Hopf at {along} = {h.p0:.6g} ({hp.direction}, {h.frequency0_hz:.6g} Hz): {h.criticality}, "
+            f"l1 = {h.l1:.3g}; cycles for {side}{amp}")
+
+
+# ---------------------------------------------------------------------------------------------- simulation
+@dataclass(frozen=True)
+class SimulationView:
+    """A simulation prepared for drawing and listening.
+
+    Attributes
+    ----------
+    t, x : ndarray
+        Time history of the first coordinate's deviation (at most :data:`HISTORY_POINTS` points).
+    coordinate : str
+        Its name.
+    f, spectrum : ndarray
+        Amplitude spectrum (Hz, amplitude).
+    audio : ndarray of int16
+        The squeal at :data:`AUDIO_RATE` (normalized to 90 % full scale).
+    duration : float
+        Simulated duration [s] (``audio.size / AUDIO_RATE``).
+    summary : str
+        One line: status, frequency, growth rate, final amplitude.
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    coordinate: str
+    f: np.ndarray
+    spectrum: np.ndarray
+    audio: np.ndarray
+    duration: float
+    summary: str
+
+
+def _decimate(t: np.ndarray, x: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """At most ``2 n`` points keeping each bucket's minimum and maximum (the envelope stays visible)."""
+    if t.size <= 2 * n:
+        return t, x
+    k = t.size // n
+    m = (t.size // k) * k
+    tb, xb = t[:m].reshape(-1, k), x[:m].reshape(-1, k)
+    i_min, i_max = xb.argmin(axis=1), xb.argmax(axis=1)
+    first = np.minimum(i_min, i_max)
+    second = np.maximum(i_min, i_max)
+    rows = np.arange(tb.shape[0])
+    tt = np.column_stack([tb[rows, first], tb[rows, second]]).ravel()
+    xx = np.column_stack([xb[rows, first], xb[rows, second]]).ravel()
+    return tt, xx
+
+
+def audio_samples(velocity: np.ndarray) -> np.ndarray:
+    """16-bit PCM of a velocity signal: mean removed, normalized to 90 % full scale (as :meth:`Trajectory.to_wav`)."""
+    v = np.asarray(velocity, dtype=float)
+    v = np.where(np.isfinite(v), v, 0.0)
+    v = v - v.mean() if v.size else v
+    peak = float(np.abs(v).max()) if v.size else 0.0
+    if peak == 0:
+        return np.zeros(v.size, dtype=np.int16)
+    return np.round(v / peak * 0.9 * 32767).astype(np.int16)
+
+
+def simulation_view(space: Any, t_end: float, *, progress: Callable[[float], None] | None = None) -> SimulationView:
+    """Integrate the nonlinear equations for ``t_end`` seconds (:func:`brakesqueal.simulation.simulate`).
+
+    Raises
+    ------
+    ParameterError
+        ``t_end`` outside ``(0, MAX_T_END]``, or bad parameters.
+    SilentMotionError
+        If the silent motion does not exist.
+    """
+    from ..simulation import simulate
+
+    check_t_end(t_end)
+    tr: Any = simulate(None, space.resolve({}), float(t_end), sample_rate=float(AUDIO_RATE), progress=progress)
+    dq = tr.dq[:, 0]
+    t, x = _decimate(np.asarray(tr.t, dtype=float), np.asarray(dq, dtype=float), HISTORY_POINTS)
+    if tr.t.size >= 16:
+        f, X = tr.spectrum()
+    else:
+        f, X = np.empty(0), np.empty(0)
+    audio = audio_samples(tr.audio_velocity()[0]) if tr.t.size >= 2 else np.zeros(0, dtype=np.int16)
+    s = tr.summary
+    unit = "rad" if tr.tilting else "m"
+    amp = f"{s.amplitude_final:.3g} {unit}" if math.isfinite(s.amplitude_final) else "n/a"
+    summary = (f"simulation {tr.status}: f = {s.frequency_hz:.6g} Hz, growth rate = {s.growth_rate:.4g} 1/s, "
+               f"final amplitude = {amp}" + (f"; {tr.message}" if getattr(tr, "message", "") else ""))
+    return SimulationView(t, x, f"{tr.coords[0]} − {tr.coords[0]}₀ [{unit}]", np.asarray(f), np.asarray(X), audio,
+                          audio.size / AUDIO_RATE, summary)
+
+
+# ---------------------------------------------------------------------------------------------- resolution
+@dataclass(frozen=True)
+class Origin:
+    """What the explorer was started with: the command line's parameter space.
+
+    Attributes
+    ----------
+    space : ParameterSpace
+        From :func:`brakesqueal.model.options.resolve_space` (``--model/--preset/--params/--set``).
+    """
+
+    space: Any
+
+    def initial_state(self) -> ViewState:
+        """The view of the command line's space (its overrides as texts, default axes)."""
+        along, x, y = default_axes(self.space)
+        values = {k: (v if isinstance(v, str) else repr(float(v))) for k, v in self.space.values.items()}
+        return ViewState(model=self.space.model.name, preset=self.space.label, values=values, along=along, x=x, y=y)
+
+    def models(self) -> list[str]:
+        """Model names a view may name: the built-in models and the command line's model."""
+        from ..model.library import MODELS
+
+        names = list(MODELS)
+        if self.space.model.name not in names:
+            names.insert(0, self.space.model.name)
+        return names
+
+    def spec(self, name: str) -> Any:
+        """The model of a view.  Only built-in models and the command line's model are allowed (a link
+        must not make the server read files).
+
+        Raises
+        ------
+        ParameterError
+            Any other name.
+        """
+        from ..model.library import get_model
+        from ..suggest import did_you_mean
+
+        if name == self.space.model.name:
+            return self.space.model
+        if name not in self.models():
+            raise ParameterError(f"unknown model '{name}'{did_you_mean(name, self.models())}; the explorer offers "
+                                 + ", ".join(self.models()))
+        return get_model(name)
+
+    def presets(self, model: str) -> list[str]:
+        """Preset names of a model (the command line's own preset first when it has no name in the model)."""
+        spec = self.spec(model)
+        names = list(spec.preset_names())
+        if model == self.space.model.name and self.space.label not in names:
+            names.insert(0, self.space.label)
+        return names
+
+    def space_of(self, state: ViewState) -> Any:
+        """The validated parameter space of a view: the same resolution as the command line's options.
+
+        Raises
+        ------
+        ParameterError
+            Unknown model, preset or names, invalid values (one line naming the parameter and the allowed range).
+        """
+        from ..model.options import resolve_space
+        from ..model.parameters import ParameterSpace, parse_sets
+
+        spec = self.spec(state.model)
+        if spec is self.space.model and state.preset == self.space.label \
+                and state.preset not in spec.preset_names():
+            space = ParameterSpace(self.space.preset, parse_sets(state.sets()))
+            space.resolve({})
+        else:
+            space = resolve_space(spec, state.preset or None, None, state.sets())
+        for name in (state.along, state.x, state.y):
+            if name:
+                space.check_axis(name)
+        return space
+
+    def complete(self, state: ViewState) -> ViewState:
+        """``state`` with a preset and axes filled in where the link left them out (raises like :meth:`space_of`)."""
+        if not state.preset:
+            state = replace(state, preset=self.spec(state.model).get_preset(None).name)
+        space = self.space_of(replace(state, along="", x="", y=""))
+        along, x, y = default_axes(space)
+        names = space.settable()
+        return replace(state, along=state.along if state.along in names else along,
+                       x=state.x if state.x in names else x, y=state.y if state.y in names else y)

@@ -1,0 +1,131 @@
+"""The explorer in a real browser: sliders, links, map clicks, the boundary overlay, audio, bad input, offline.
+
+Every expectation is computed independently with the library (``linearize``
+of the same parameters) and compared with what the page renders.
+"""
+
+from __future__ import annotations
+
+import math
+from urllib.parse import parse_qs, urlparse
+
+import numpy as np
+import pytest
+
+from brakesqueal import linearize, resolve_parameters
+from brakesqueal.explorer.state import AUDIO_RATE, format_eigenvalue
+
+pytestmark = pytest.mark.slow
+
+
+def library_leading(sets: list[str]) -> str:
+    """The leading eigenvalue of the paper-fig2 point ``sets``, computed directly and formatted as the page does."""
+    lam = np.asarray(linearize(resolve_parameters(None, "paper-fig2", None, sets)).eigenvalues)
+    top = lam[lam.real == lam.real.max()]
+    return format_eigenvalue(complex(top[np.argmax(top.imag)]))
+
+
+def sets_of(state: dict) -> list[str]:
+    return [s for s in state["set"].split(",") if s]
+
+
+def test_slider_moves_the_leading_eigenvalue(page):
+    page.open()
+    first = page.wait(lambda s: s["locus"]["state"]["set"] == "")
+    assert first["locus"]["leading"] == library_leading([])
+    assert page.page.locator("#bs-leading").text_content() == library_leading([])
+    handle = page.page.locator(".bs-slider-mu .noUi-handle")
+    handle.focus()
+    for _ in range(5):
+        page.page.keyboard.press("ArrowLeft")
+    typed = page.page.locator(".bs-input-mu input")
+    page.wait(lambda s: s["locus"]["state"]["set"] == f"mu={typed.input_value()}")
+    value = typed.input_value()
+    assert float(value) < 0.5
+    shown = page.page.locator("#bs-leading").text_content()
+    assert shown == library_leading([f"mu={value}"])
+    assert shown != library_leading([])
+    # the link holds the state
+    query = parse_qs(urlparse(page.page.url).query)
+    assert query["set"] == [f"mu={value}"] and query["preset"] == ["paper-fig2"]
+    page.screenshot("slider")
+
+
+def test_link_reproduces_the_view(page):
+    page.open("preset=paper-fig2&set=mu%3D0.3,k_ip%3D1e7&along=k_ip")
+    s = page.wait(lambda s: s["locus"]["state"]["set"] == "mu=0.3,k_ip=1e7")
+    assert s["locus"]["state"]["along"] == "k_ip"
+    assert page.page.locator(".bs-input-mu input").input_value() == "0.3"
+    assert float(page.page.locator(".bs-input-k_ip input").input_value()) == 1e7
+    assert page.page.locator("#bs-leading").text_content() == library_leading(["mu=0.3", "k_ip=1e7"])
+
+
+def test_map_click_moves_every_view(page):
+    page.open()
+    before = page.wait(lambda s: "map" in s and "cs" in s and "hopf" in s)
+    canvas = page.page.locator(".bs-map .bk-Canvas")
+    box = canvas.bounding_box()
+    page.page.mouse.click(box["x"] + 0.3 * box["width"], box["y"] + 0.75 * box["height"])
+    after = page.wait(lambda s: set(dict(v.split("=") for v in sets_of(s["locus"]["state"]))) == {"k_ip", "mu"}
+                      and s.get("lane_state", {}).get("set") == s["locus"]["state"]["set"])
+    values = dict(v.split("=") for v in sets_of(after["locus"]["state"]))
+    assert page.page.locator(".bs-input-mu input").input_value() == values["mu"]
+    assert page.page.locator(".bs-input-k_ip input").input_value() == values["k_ip"]
+    sets = [f"k_ip={values['k_ip']}", f"mu={values['mu']}"]
+    assert page.page.locator("#bs-leading").text_content() == library_leading(sets)
+    # the marker sits where the click was (map coordinates: log10 k_ip, mu)
+    px, py = after["locus"]["point"]
+    assert px == pytest.approx(math.log10(float(values["k_ip"])), abs=1e-5)
+    assert py == pytest.approx(float(values["mu"]), abs=1e-5)
+    # the Hopf line is the one of the new point (its distance to the crossing changed with mu)
+    assert after["hopf"] != before["hopf"] or float(values["mu"]) < 0.405
+    page.screenshot("map-click")
+
+
+def test_boundary_overlay_lies_on_the_stability_boundary(page):
+    page.open()
+    page.wait(lambda s: "map" in s)
+    data = page.page.evaluate(
+        "() => { const d = Bokeh.documents[0].get_model_by_name('bs-boundary').data;"
+        " return {x: Array.from(d.x), y: Array.from(d.y)} }")
+    bx, by = np.array(data["x"], dtype=float), np.array(data["y"], dtype=float)
+    ok = np.isfinite(bx) & np.isfinite(by)
+    assert ok.sum() > 50
+    # grid steps of the 400 x 250 map over log10 k_ip in [6, 10] and mu in [0.01, 1]
+    hx, hy = 4 / 399 / 2, 0.99 / 249 / 2
+    for i in np.flatnonzero(ok)[:: max(1, ok.sum() // 8)]:
+        signs = set()
+        for dx in (-hx, hx):
+            for dy in (-hy, hy):
+                sets = [f"k_ip={float(10 ** (bx[i] + dx))!r}", f"mu={float(by[i] + dy)!r}"]
+                lam = linearize(resolve_parameters(None, "paper-fig2", None, sets)).eigenvalues
+                signs.add(bool(np.max(np.real(lam)) > 0))
+        assert signs == {True, False}, f"vertex ({10 ** bx[i]:.6g}, {by[i]:.6g}) is not on the boundary"
+
+
+def test_audio_has_the_simulated_duration(page):
+    page.open("t_end=0.2")
+    page.page.get_by_role("button", name="Simulate").click()
+    s = page.wait(lambda s: "sim" in s, timeout=600)
+    assert "error" not in s["sim"], s["sim"]
+    samples = int(math.floor(0.2 * AUDIO_RATE + 1e-9)) + 1
+    assert s["sim"]["samples"] == samples
+    audio = page.page.locator(".bs-audio audio")
+    duration = audio.evaluate("a => new Promise(r => { if (a.readyState >= 1) r(a.duration); "
+                              "else a.addEventListener('loadedmetadata', () => r(a.duration)); })")
+    assert duration == pytest.approx(samples / AUDIO_RATE, abs=1e-3)
+    page.screenshot("simulation")
+
+
+def test_bad_input_shows_the_message_and_keeps_the_view(page):
+    page.open()
+    page.wait(lambda s: s["locus"]["state"]["set"] == "")
+    box = page.page.locator(".bs-input-mu input")
+    box.fill("-1")
+    box.press("Enter")
+    alert = page.page.locator(".bs-alert")
+    message = alert.get_by_text("must be in")
+    message.wait_for(timeout=30_000)
+    text = message.text_content()
+    assert "'mu1'" in text and "[0, inf)" in text
+    assert page.page.locator("#bs-leading").text_content() == library_leading([])

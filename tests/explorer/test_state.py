@@ -1,0 +1,105 @@
+"""The explorer's state and computations without a browser: links, validation, caps, eigenvalues, audio."""
+
+from __future__ import annotations
+
+import wave
+
+import numpy as np
+import pytest
+
+from brakesqueal import ParameterError, linearize, resolve_space
+from brakesqueal.analysis.linear import state_matrix
+from brakesqueal.cli import main
+from brakesqueal.explorer.state import (
+    MAX_MAP_POINTS,
+    Origin,
+    ViewState,
+    audio_samples,
+    check_map_size,
+    check_t_end,
+    format_eigenvalue,
+    leading_eigenvalue,
+    locus_view,
+    slider_range,
+)
+
+
+@pytest.fixture(scope="module")
+def origin():
+    return Origin(resolve_space(None, None, None, ["mu=0.4"]))
+
+
+def test_link_round_trip(origin):
+    st = origin.initial_state()
+    assert (st.model, st.preset, dict(st.values)) == ("paper", "paper-fig2", {"mu": "0.4"})
+    assert (st.along, st.x, st.y) == ("mu", "k_ip", "mu")
+    back = ViewState.from_query(st.to_query(), ViewState("belt", "belt"))
+    assert back == st
+    assert origin.space_of(back).resolve({})["mu1"] == 0.4
+
+
+def test_link_validates_like_the_command_line(origin):
+    st = origin.initial_state()
+    with pytest.raises(ParameterError, match="mu1"):
+        origin.space_of(st.with_values({"mu": "-1"}))
+    with pytest.raises(ParameterError, match="not defined in preset"):
+        origin.space_of(st.with_values({"nope": "1"}))
+    with pytest.raises(ParameterError, match="malformed set entry"):
+        ViewState.from_query({"set": "mu"}, st)
+
+
+def test_link_cannot_make_the_server_read_files(origin):
+    with pytest.raises(ParameterError, match="unknown model '/etc/passwd'"):
+        origin.space_of(ViewState("/etc/passwd", ""))
+
+
+def test_caps_have_clear_messages():
+    check_map_size(1000, 1000)
+    with pytest.raises(ParameterError, match=f"at most {MAX_MAP_POINTS:,} points"):
+        check_map_size(1001, 1000)
+    with pytest.raises(ParameterError, match=r"t_end = 10 s: must be in \(0, 5\] s"):
+        check_t_end(10)
+    with pytest.raises(ParameterError, match="t_end"):
+        check_t_end(float("nan"))
+
+
+def test_slider_range_avoids_invalid_ends(origin):
+    space = origin.space
+    rng = slider_range(space, "mu")  # N0 = 1800/mu: mu = 0 is invalid
+    assert rng.low > 0 and not rng.log
+    space.resolve({"mu": rng.low})
+    k = slider_range(space, "k_ip")
+    assert k.log and k.low == pytest.approx(1e6) and k.high == pytest.approx(1e10)
+    assert k.from_slider(k.to_slider(3e7)) == pytest.approx(3e7)
+
+
+def test_leading_eigenvalue_is_the_state_matrix_one(origin):
+    space = origin.space
+    lv = locus_view(space, "mu", slider_range(space, "mu"), num=10)
+    lm = linearize(space.resolve({}))
+    lam = np.linalg.eigvals(state_matrix(lm.M, lm.D, lm.K))  # an independent eigen-solve
+    ref = lam[np.argmax(lam.real + 1e-9 * np.sign(lam.imag))]
+    assert lv.leading.real == pytest.approx(ref.real, rel=1e-6, abs=1e-9)
+    assert lv.leading.imag == pytest.approx(abs(ref.imag), rel=1e-9)
+    assert lv.tracks.eigenvalues.shape == (10, 2)
+    assert leading_eigenvalue([1 - 2j, 1 + 2j, -3]) == 1 + 2j
+    assert format_eigenvalue(0.1838688 + 10927.157j) == "0.183869 + 10927.2i"
+
+
+def test_audio_equals_the_wav_file(tmp_path):
+    from brakesqueal.simulation import simulate
+
+    tr = simulate(None, resolve_space(None, None, None, ["mu=1"]).resolve({}), 0.02)
+    pcm = audio_samples(tr.audio_velocity()[0])
+    frames = tr.to_wav(str(tmp_path / "a.wav"))
+    with wave.open(str(tmp_path / "a.wav")) as w:
+        data = np.frombuffer(w.readframes(frames), dtype="<i2")
+    assert pcm.size == frames == tr.t.size
+    assert np.array_equal(pcm, data)
+
+
+def test_cli_refuses_bad_input_with_status_2(capsys):
+    assert main(["explore", "--set", "mu=-1", "--no-browser"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "mu1" in err
+    assert main(["explore", "--port", "70000", "--no-browser"]) == 2
