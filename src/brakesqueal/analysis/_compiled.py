@@ -25,7 +25,7 @@ import numpy as np
 
 __all__ = ["peval", "real_roots", "routh_interval", "routh_batch", "quartic_interval_batch", "horner_interval",
            "descartes", "isolate_roots", "critical_batch", "quartic_factor", "quartic_top_grid", "quartic_top_rows",
-           "UNSTABLE", "STABLE", "UNDECIDED"]
+           "charpoly_grid", "UNSTABLE", "STABLE", "UNDECIDED"]
 
 _JIT = dict(cache=True, error_model="numpy")
 
@@ -1009,6 +1009,380 @@ def quartic_top_rows(A, mr, fr, ok):  # type: ignore[no-untyped-def]
             fr[i] = np.nan
             ok[i] = 0
         warm = good
+
+
+# ---------------------------------------------------------------- n-DOF characteristic polynomial on a grid
+@numba.njit(**_JIT)
+def _cp_horner_rows(Q, RQ, x, T, RT):  # type: ignore[no-untyped-def]
+    """Row table ``T[k, b] = Σ_a Q[k, a, b] x^a`` with rigorous radii ``RT`` (``Q`` known to within ``RQ``)."""
+    m1, da1, db1 = Q.shape
+    ax = abs(x)
+    g = 2.0 * (2 * da1 + 2) * _U
+    for k in range(m1):
+        for b in range(db1):
+            v = Q[k, da1 - 1, b]
+            a = abs(v)
+            r = RQ[k, da1 - 1, b]
+            for i in range(da1 - 2, -1, -1):
+                v = v * x + Q[k, i, b]
+                a = a * ax + abs(Q[k, i, b])
+                r = r * ax + RQ[k, i, b]
+            T[k, b] = v
+            RT[k, b] = (r + g * a) * (1.0 + 4.0 * (da1 + 2) * _U) + _ETA
+
+
+@numba.njit(**_JIT)
+def _cp_coefficients(T, RT, y, c, rc):  # type: ignore[no-untyped-def]
+    """``c_k = Σ_b T[k, b] y^b`` with rigorous radii (Horner, running error bound)."""
+    m1, db1 = T.shape
+    ay = abs(y)
+    g = 2.0 * (2 * db1 + 2) * _U
+    for k in range(m1):
+        v = T[k, db1 - 1]
+        a = abs(v)
+        r = RT[k, db1 - 1]
+        for i in range(db1 - 2, -1, -1):
+            v = v * y + T[k, i]
+            a = a * ay + abs(T[k, i])
+            r = r * ay + RT[k, i]
+        c[k] = v
+        rc[k] = (r + g * a) * (1.0 + 4.0 * (db1 + 2) * _U) + _ETA
+
+
+@numba.njit(**_JIT)
+def _cp_scale(c, rc, m, b, rb):  # type: ignore[no-untyped-def]
+    """``b_k = c_k 2^(e k + f)`` (exact): ``λ = 2^e μ`` balances ``|c_0|`` and ``|c_m|``; returns ``e`` or -9999."""
+    if c[m] == 0.0 or not math.isfinite(c[m]):
+        return -9999
+    e = 0
+    if c[0] != 0.0 and math.isfinite(c[0]):
+        e = int(round((math.frexp(c[0])[1] - math.frexp(c[m])[1]) / m))
+    f = -(math.frexp(c[m])[1] + e * m)
+    for k in range(m + 1):
+        b[k] = math.ldexp(c[k], e * k + f)
+        rb[k] = math.ldexp(rc[k], e * k + f) * (1.0 + 4.0 * _U) + _ETA
+        if not (math.isfinite(b[k]) and math.isfinite(rb[k])):
+            return -9999
+        if b[k] != 0.0 and abs(b[k]) < 1e-280:  # subnormal range: the scaling would not be exact
+            return -9999
+    return e
+
+
+@numba.njit(inline="always", **_JIT)
+def _cabs(v):  # type: ignore[no-untyped-def]
+    """``|v|`` to within a relative ``2u`` (no ``hypot``: the operands here never overflow, else inf/NaN results)."""
+    return math.sqrt(v.real * v.real + v.imag * v.imag)
+
+
+@numba.njit(**_JIT)
+def _cp_cold(b, m, z, part):  # type: ignore[no-untyped-def]
+    """Starting roots: eigenvalues of the companion matrix of ``b`` (LAPACK), made exactly conjugate-symmetric.
+
+    ``part[i]`` is the index of the conjugate partner of ``z[i]`` (``i`` for a
+    real root).  Returns ``False`` when the roots cannot be paired.
+    """
+    C = np.zeros((m, m), dtype=np.complex128)
+    for k in range(m):
+        C[0, k] = -b[m - 1 - k] / b[m]
+        if not math.isfinite(C[0, k].real):
+            return False
+    for k in range(1, m):
+        C[k, k - 1] = 1.0
+    w = np.linalg.eigvals(C)
+    scale = 0.0
+    for i in range(m):
+        if not (math.isfinite(w[i].real) and math.isfinite(w[i].imag)):
+            return False
+        scale = max(scale, _cabs(w[i]))
+    tol = 1e-9 * scale
+    used = np.zeros(m, dtype=np.bool_)
+    n = 0
+    for i in range(m):  # pairs: a root above the axis with the nearest unused conjugate below it
+        if used[i] or not w[i].imag > tol:
+            continue
+        best = -1
+        dist = np.inf
+        for j in range(m):
+            if not used[j] and w[j].imag < -tol:
+                d = _cabs(w[j] - w[i].conjugate())
+                if d < dist:
+                    dist = d
+                    best = j
+        if best < 0:
+            return False
+        used[i] = True
+        used[best] = True
+        zi = 0.5 * (w[i] + w[best].conjugate())
+        z[n] = zi
+        z[n + 1] = zi.conjugate()
+        part[n] = n + 1
+        part[n + 1] = n
+        n += 2
+    for i in range(m):  # real roots
+        if not used[i]:
+            if abs(w[i].imag) > tol:
+                return False
+            z[n] = complex(w[i].real, 0.0)
+            part[n] = n
+            n += 1
+    return n == m
+
+
+@numba.njit(**_JIT)
+def _cp_sweep(b, rb, m, z, part, w, rad):  # type: ignore[no-untyped-def]
+    """One Weierstrass (Durand-Kerner) sweep at the current ``z`` (nothing updated).
+
+    ``w[i] = p(z_i) / (b_m Π_{j≠i} (z_i - z_j))`` and rigorous radii
+    ``rad[i] >= m |W_i|`` of the Gerschgorin disks of the generalized companion
+    matrix ``diag(z) - 1 Wᵀ`` (its eigenvalues are the roots of every
+    polynomial within the coefficient radii ``rb``): every root lies in the
+    union of the disks ``|λ - z_i| <= rad[i]``, and a connected component of
+    ``k`` disks holds exactly ``k`` roots.  ``z`` is conjugate-symmetric
+    (``part``), so only one root of each pair is computed (``W`` of the partner
+    is the conjugate, its disk the mirror image).  Returns the largest
+    ``|w_i| / |z_i|`` (inf if a product vanishes).
+    """
+    lead = abs(b[m]) - rb[m]
+    worst = 0.0
+    g = 2.0 * (4 * m + 8) * _U
+    for i in range(m):
+        if part[i] < i:
+            continue
+        zi = z[i]
+        az = _cabs(zi) * (1.0 + 2.0 * _U)
+        h = abs(b[m])
+        r = rb[m]
+        if part[i] == i:  # real root: real Horner
+            x = zi.real
+            vr = b[m]
+            for k in range(m - 1, -1, -1):
+                vr = vr * x + b[k]
+                h = h * az + abs(b[k])
+                r = r * az + rb[k]
+            v = complex(vr, 0.0)
+            av = abs(vr)
+        else:
+            v = complex(b[m], 0.0)
+            for k in range(m - 1, -1, -1):
+                v = v * zi + b[k]
+                h = h * az + abs(b[k])
+                r = r * az + rb[k]
+            av = _cabs(v)
+        pr = complex(b[m], 0.0)
+        for j in range(m):
+            if j != i:
+                pr = pr * (zi - z[j])
+        apr = _cabs(pr)
+        if not (apr > 0.0 and math.isfinite(apr) and lead > 0.0 and math.isfinite(av)):
+            w[i] = 0.0
+            rad[i] = np.inf
+            worst = np.inf
+            continue
+        wi = v / pr
+        if part[i] == i:
+            wi = complex(wi.real, 0.0)
+        w[i] = wi
+        num = (av + g * h + r) * (1.0 + 8.0 * (m + 2) * _U)
+        den = apr * (lead / abs(b[m])) * (1.0 - g * m)
+        rad[i] = m * (num / den) * (1.0 + 16.0 * _U) + _ETA
+        if part[i] != i:
+            w[part[i]] = wi.conjugate()
+            rad[part[i]] = rad[i]
+        rel = _cabs(wi) / az if az > 0.0 else np.inf
+        if rel > worst:
+            worst = rel
+    return worst
+
+
+@numba.njit(**_JIT)
+def _cp_verdict(z, rad, m):  # type: ignore[no-untyped-def]
+    """STABLE if every disk lies in the open left half-plane; UNSTABLE if an isolated disk lies in the open right
+    half-plane (it holds exactly one root); UNDECIDED otherwise."""
+    stable = True
+    for i in range(m):
+        if not (z[i].real + rad[i] * (1.0 + 4.0 * _U) < 0.0):
+            stable = False
+            break
+    if stable:
+        return STABLE
+    for i in range(m):
+        if not (z[i].real - rad[i] * (1.0 + 4.0 * _U) > 0.0):
+            continue
+        if _cp_isolated(z, rad, m, i):
+            return UNSTABLE
+    return UNDECIDED
+
+
+@numba.njit(**_JIT)
+def _cp_isolated(z, rad, m, i):  # type: ignore[no-untyped-def]
+    """Whether disk ``i`` is disjoint from every other disk (then it holds exactly one root)."""
+    for j in range(m):
+        if j != i and _cabs(z[i] - z[j]) * (1.0 - 4.0 * _U) <= (rad[i] + rad[j]) * (1.0 + 4.0 * _U):
+            return False
+    return True
+
+
+@numba.njit(**_JIT)
+def _cp_accurate(z, w, rad, part, m, acc):  # type: ignore[no-untyped-def]
+    """Whether ``max Re λ`` and its root are known to ``acc |z_top|``.
+
+    Gerschgorin row disks of ``T^-1 (diag(z) - 1 Wᵀ) T`` with ``T`` scaling
+    the top root and its conjugate partner by ``t = 2^10, 2^20`` or ``2^30`` (``|W_j| <= rad_j / m``):
+    the top root's disk has radius ``|W_top| + |W_partner| + Σ_other |W_k| / t``,
+    every other disk ``Σ_k |W_k| + t (|W_top| + |W_partner|)``.  Accepted when
+    the top disk is that small, disjoint from every other disk (so it holds
+    exactly one root) and no other disk reaches further right; the root then
+    lies within ``acc |z_top|`` of ``z_top - w_top``.
+    """
+    top = 0
+    for i in range(m):
+        if z[i].real > z[top].real:
+            top = i
+    p = part[top]
+    wt = rad[top] / m + (rad[p] / m if p != top else 0.0)
+    so = 0.0
+    for k in range(m):
+        if k != top and k != p:
+            so += rad[k] / m
+    f = 1.0 + 8.0 * (m + 2) * _U
+    for q in range(1, 4):
+        if _cp_scaled_ok(z, w, part, m, acc, top, wt, so, f, 2.0 ** (10 * q)):
+            return True
+    return False
+
+
+@numba.njit(**_JIT)
+def _cp_scaled_ok(z, w, part, m, acc, top, wt, so, f, t):  # type: ignore[no-untyped-def]
+    """The test of :func:`_cp_accurate` for one scaling ``t``."""
+    p = part[top]
+    rt = (wt + so / t) * f
+    if not rt + _cabs(w[top]) <= acc * _cabs(z[top]):  # the caller reports z_top - w_top
+        return False
+    ro = (wt + so + t * wt) * f
+    edge = z[top].real + rt
+    for j in range(m):
+        if j == top or j == p:
+            continue
+        if z[j].real + ro > edge:
+            return False
+        if _cabs(z[top] - z[j]) * (1.0 - 4.0 * _U) <= (rt + ro) * (1.0 + 4.0 * _U):
+            return False
+    if p != top and _cabs(z[top] - z[p]) * (1.0 - 4.0 * _U) <= 2.0 * rt * (1.0 + 4.0 * _U):
+        return False
+    return True
+
+
+@numba.njit(**_JIT)
+def _cp_point(b, rb, m, z, part, w, rad, eigen, acc, maxit):  # type: ignore[no-untyped-def]
+    """Iterate Weierstrass sweeps from ``z`` until the disks decide (and, with ``eigen``, ``max Re λ`` is accurate).
+
+    Returns the verdict (UNDECIDED if not reached within ``maxit`` sweeps);
+    ``z`` and ``rad`` hold the centres and radii that decided it.
+    """
+    for it in range(maxit):
+        worst = _cp_sweep(b, rb, m, z, part, w, rad)
+        if not math.isfinite(worst):
+            return UNDECIDED
+        if worst < 1e-4:
+            code = _cp_verdict(z, rad, m)
+            if code != UNDECIDED and (not eigen or _cp_accurate(z, w, rad, part, m, acc)):
+                return code
+        for i in range(m):
+            z[i] = z[i] - w[i]
+    return UNDECIDED
+
+
+@numba.njit(**_JIT)
+def charpoly_grid(Q, RQ, xo, yi, valid, eigen, acc, codes, mr, fr):  # type: ignore[no-untyped-def]
+    """Certified verdicts (and ``max Re λ``, frequency) from the exact characteristic polynomial on a grid.
+
+    ``Q[k, a, b]`` (radii ``RQ``) is the coefficient of ``λ^k x^a y^b`` of
+    ``det(λ²M + λD + K)`` (up to a factor that does not vanish where the
+    leading coefficient does not); ``x = xo[r]`` (outer), ``y = yi[j]``
+    (inner).  Per point: coefficients with rigorous radii (Horner with
+    running error bounds), ``λ = 2^e μ`` balancing, roots by Weierstrass
+    (Durand-Kerner) sweeps warm-started from the previous points of the row
+    (quadratic extrapolation; the first point of a row from the first point of
+    the previous row; cold start from companion eigenvalues), and the verdict
+    from Gerschgorin inclusion disks (:func:`_cp_sweep`, :func:`_cp_verdict`).
+    With ``eigen`` the root with the largest real part must also be known to
+    ``acc`` relative (:func:`_cp_accurate`), so that ``max_real`` and the
+    frequency are accurate to that.  Points not decided so get code
+    UNDECIDED (the caller recomputes them) and NaN.
+    """
+    m = Q.shape[0] - 1
+    db1 = Q.shape[2]
+    T = np.empty((m + 1, db1))
+    RT = np.empty((m + 1, db1))
+    c = np.empty(m + 1)
+    rc = np.empty(m + 1)
+    b = np.empty(m + 1)
+    rb = np.empty(m + 1)
+    z = np.empty(m, dtype=np.complex128)
+    w = np.empty(m, dtype=np.complex128)
+    rad = np.empty(m)
+    part = np.empty(m, dtype=np.int64)
+    hist = np.empty((3, m), dtype=np.complex128)  # roots (λ units) at the last decided points of the row
+    row0 = np.empty(m, dtype=np.complex128)  # roots at the first decided point of the previous row
+    part0 = np.empty(m, dtype=np.int64)
+    have0 = False
+    two_pi = 2.0 * math.pi
+    for r in range(xo.size):
+        _cp_horner_rows(Q, RQ, xo[r], T, RT)
+        have = 0
+        first = True
+        for j in range(yi.size):
+            codes[r, j] = UNDECIDED
+            mr[r, j] = np.nan
+            fr[r, j] = np.nan
+            if not valid[r, j]:
+                continue
+            _cp_coefficients(T, RT, yi[j], c, rc)
+            e = _cp_scale(c, rc, m, b, rb)
+            if e == -9999:
+                have = 0
+                continue
+            s = math.ldexp(1.0, -e)
+            code = UNDECIDED
+            if have > 0 or (first and have0):
+                for i in range(m):
+                    if have >= 3:
+                        z[i] = (3.0 * hist[0, i] - 3.0 * hist[1, i] + hist[2, i]) * s
+                    elif have == 2:
+                        z[i] = (2.0 * hist[0, i] - hist[1, i]) * s
+                    elif have == 1:
+                        z[i] = hist[0, i] * s
+                    else:
+                        z[i] = row0[i] * s
+                        part[i] = part0[i]
+                code = _cp_point(b, rb, m, z, part, w, rad, eigen, acc, 8)
+            if code == UNDECIDED:
+                have = 0
+                if _cp_cold(b, m, z, part):
+                    code = _cp_point(b, rb, m, z, part, w, rad, eigen, acc, 40)
+            if code == UNDECIDED:
+                have = 0
+                continue
+            codes[r, j] = code
+            si = math.ldexp(1.0, e)
+            top = 0
+            for i in range(m):
+                if z[i].real > z[top].real:
+                    top = i
+            zt = z[top] - w[top]  # the Weierstrass update: the centre of the top root's Gerschgorin disk
+            mr[r, j] = zt.real * si
+            fr[r, j] = abs(zt.imag) * si / two_pi
+            for i in range(m):
+                hist[2, i] = hist[1, i]
+                hist[1, i] = hist[0, i]
+                hist[0, i] = z[i] * si
+            if first:
+                for i in range(m):
+                    row0[i] = hist[0, i]
+                    part0[i] = part[i]
+                have0 = True
+                first = False
+            have = min(have + 1, 3)
 
 
 def _guard() -> None:

@@ -39,7 +39,10 @@ import numpy as np
 from ..errors import ParameterError
 from ..status import PointStatus
 from .robust import STABLE, UNDECIDED, UNSTABLE
-from .kernels import kernel_eigen, kernel_scaling, kernel_segments, map_kernel
+from .kernels import (
+    CHARPOLY_ROUTE, CharpolyTable, charpoly_table, charpoly_verdicts, kernel_eigen, kernel_scaling, kernel_segments,
+    map_kernel,
+)
 from .points import ROUTES, closed_form_route, evaluate_arrays, valid_points
 
 __all__ = ["Axis", "parse_axis", "stability_map", "write_map", "MapSummary", "classify_grid", "STATUS", "MAX_POINTS",
@@ -230,6 +233,7 @@ class _Plan:
     closed: bool
     method: str
     ftype: type
+    charpoly: CharpolyTable | None = None
 
 
 def _plan(space: object, x: Axis, y: Axis, force: bool, eigen: bool) -> _Plan:
@@ -241,13 +245,16 @@ def _plan(space: object, x: Axis, y: Axis, force: bool, eigen: bool) -> _Plan:
     outer, inner = (ax[kern.outer], ax[kern.inner]) if kern else (y, x)
     scaled = kernel_scaling(kern, inner.values())
     seg_T = kernel_segments(scaled[1]) if scaled is not None else None
+    cp = None
     if closed:
         method = ("closed form: certified compiled Hurwitz kernel of the exact quartic + robust per-point route"
                   if scaled is not None else ROUTES["closed"])
     else:
-        method = ROUTES["points"]
+        # n-DOF models with a trivial silent motion on the whole map: roots of the exact characteristic polynomial
+        cp = charpoly_table(space, outer.name, inner.name)  # type: ignore[arg-type]
+        method = CHARPOLY_ROUTE if cp is not None else ROUTES["points"]
     ftype = np.float32 if outer.num * inner.num > _FLOAT32_ABOVE else np.float64
-    return _Plan(kern, outer, inner, scaled, seg_T, closed, method, ftype)
+    return _Plan(kern, outer, inner, scaled, seg_T, closed, method, ftype, cp)
 
 
 _Rows = tuple[int, int, np.ndarray, np.ndarray, "np.ndarray | None", "np.ndarray | None"]
@@ -267,12 +274,16 @@ def _rows(space: object, plan: _Plan, eigen: bool, chunk_points: int) -> Iterato
     ov, iv = outer.values(), inner.values()
     n_o, n_i = ov.size, iv.size
     # without a compiled kernel points may go one by one: smaller blocks, so progress is reported often
-    rows = max(1, (chunk_points if kern is not None else min(chunk_points, 4096)) // n_i)
+    fast = kern is not None or plan.charpoly is not None
+    rows = max(1, (chunk_points if fast else min(chunk_points, 4096)) // n_i)
     buf = np.empty((min(rows, n_o), n_i), dtype=np.uint8)
     for r0 in range(0, n_o, rows):
         r1 = min(n_o, r0 + rows)
         arr = space.arrays({outer.name: ov[r0:r1, None], inner.name: iv[None, :]})  # type: ignore[attr-defined]
         valid = np.broadcast_to(valid_points(space, arr), (r1 - r0, n_i))
+        if plan.charpoly is not None:
+            yield (r0, r1, *_charpoly_rows(space, plan, ov[r0:r1], iv, valid, eigen))
+            continue
         if kern is None or plan.scaled is None or plan.seg_T is None:
             res = evaluate_arrays(space, arr, eigen=eigen, closed=plan.closed, valid=valid)
             yield r0, r1, res.stable, res.status, (res.max_real if eigen else None), (res.frequency if eigen else None)
@@ -301,6 +312,31 @@ def _rows(space: object, plan: _Plan, eigen: bool, chunk_points: int) -> Iterato
                 mr[redo] = res.max_real
                 fr[redo] = res.frequency
         yield r0, r1, stable, status, mr, fr
+
+
+def _charpoly_rows(space: object, plan: _Plan, ov: np.ndarray, iv: np.ndarray, valid: np.ndarray, eigen: bool
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """``(stable, status, max_real, frequency)`` of a block of rows by the characteristic-polynomial route.
+
+    Points whose inclusion disks do not decide (or, with ``eigen``, do not
+    give every root to :data:`~.kernels.CHARPOLY_ACCURACY`) go through
+    :func:`~.points.evaluate_arrays` (certified eigenvalue verdicts).
+    """
+    assert plan.charpoly is not None
+    codes, mr, fr = charpoly_verdicts(plan.charpoly, ov, iv, valid, eigen=eigen)
+    stable = valid & (codes == STABLE)
+    status = np.where(valid, np.int8(PointStatus.OK), np.int8(PointStatus.INVALID))
+    redo = np.nonzero(valid & (codes == UNDECIDED))
+    if redo[0].size:
+        sub = space.arrays({plan.outer.name: ov[redo[0]], plan.inner.name: iv[redo[1]]})  # type: ignore[attr-defined]
+        res = evaluate_arrays(space, sub, eigen=eigen, valid=np.ones(redo[0].size, dtype=bool))
+        stable[redo] = res.stable
+        status[redo] = res.status
+        mr[redo] = res.max_real
+        fr[redo] = res.frequency
+    if not eigen:
+        return stable, status, None, None
+    return stable, status, mr, fr
 
 
 def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen: bool = True,
