@@ -36,7 +36,8 @@ import numpy as np
 
 from ..errors import ContactLossError, NoSilentMotionError, NoSlidingError, SolverFailedError
 
-__all__ = ["SilentMotion", "silent_motion", "parameter_vector", "as_parameters", "is_trivial"]
+__all__ = ["SilentMotion", "SilentMotions", "silent_motion", "silent_motion_vector", "silent_motions",
+           "parameter_vector", "as_parameters", "is_trivial", "MAX_TILT"]
 
 _EPS = np.finfo(float).eps
 #: Largest tilt angle [rad] for which the kinematics (eq. 42: 1/(cos q1 cos q2)) is used.
@@ -186,7 +187,9 @@ def _newton(sysm: _System, y: np.ndarray, g: np.ndarray, max_iter: int = 30,
         if size > 0.9 * last and size <= 1e-9 * float(np.max(np.abs(y))):
             return y, it, True  # no longer contracting: at the noise floor of the residual
         if monotone and it > 1 and size > 0.5 * last:
-            return y, it, False
+            # no longer contracting: converged only if already at the noise floor of the residual (components
+            # resolved far below rounding relative to the largest, e.g. a tilt of 1e-13 rad beside 2e-7 m)
+            return y, it, bool(size <= 1e-9 * float(np.max(np.abs(y))))
         last = size
     return y, max_iter, bool(last <= 1e-9 * float(np.max(np.abs(y))))
 
@@ -309,7 +312,30 @@ def silent_motion(params: Any, *, model: Any = None, use_cache: bool = True) -> 
     params = as_parameters(params)
     model = getattr(model, "model", model)  # the transitional paper view wraps the compiled model
     cm = model if isinstance(model, CompiledModel) else compile_model(params.model, use_cache=use_cache)
-    p = list(map(float, params.vector()))
+    return silent_motion_vector(cm, list(map(float, params.vector())))
+
+
+def silent_motion_vector(model: Any, p: list[float]) -> SilentMotion:
+    """The per-point solver of :func:`silent_motion` on a packed parameter vector.
+
+    Parameters
+    ----------
+    model : CompiledModel
+        The compiled model.
+    p : list of float
+        Parameters in packing order (:meth:`Parameters.vector
+        <brakesqueal.model.parameters.Parameters.vector>`), assumed valid.
+
+    Returns
+    -------
+    SilentMotion
+
+    Raises
+    ------
+    NoSilentMotionError, SolverFailedError, ContactLossError, NoSlidingError
+        As :func:`silent_motion`.
+    """
+    cm = model
     n, m = cm.n, cm.m
     F0 = np.array([float(v) for v in np.broadcast_to(np.asarray(cm.zero_residuals(p), dtype=float), (n + m,))])
     S0 = np.array([float(v) for v in np.broadcast_to(np.asarray(cm.zero_residual_scale(p), dtype=float), (n + m,))])
@@ -331,7 +357,7 @@ def silent_motion(params: Any, *, model: Any = None, use_cache: bool = True) -> 
     for pad, f, v in zip(cm.spec.pads, fn, speed):
         if not (math.isfinite(f) and f > 0.0):
             raise ContactLossError(f"{pad.label} loses contact at the silent motion (normal force {f:.6g} N <= 0)"
-                                   + _where(params))
+                                   + _where(dict(zip(cm.param_names, p))))
         if not v > 0.0:
             raise NoSlidingError(f"{pad.label} does not slide at the silent motion (|v_r| = {v:g} m/s)")
     return SilentMotion(coords=cm.coords, q0=z[:n].copy(), l0=z[n:].copy(), normal_forces=fn.copy(),
@@ -341,3 +367,145 @@ def silent_motion(params: Any, *, model: Any = None, use_cache: bool = True) -> 
 def _where(params: Any) -> str:
     names = [k for k in ("mu1", "mu2", "h10", "h20", "N0", "k1", "k2") if k in params]
     return (" for " + ", ".join(f"{k}={params[k]:g}" for k in names)) if names else ""
+
+
+@dataclass(frozen=True)
+class SilentMotions:
+    """Silent motions of many parameter points (rows of the packed parameter matrix).
+
+    Attributes
+    ----------
+    status : ndarray of int8, shape (N,)
+        :class:`~brakesqueal.status.PointStatus`: ``OK`` (trivial silent
+        motion), ``OK_NONTRIVIAL``, or the status of the per-point solver's
+        failure (``NO_SILENT_MOTION``, ``CONTACT_LOSS``, ``NO_SLIDING``,
+        ``SOLVER_FAILED``).
+    q0 : ndarray, shape (N, n)
+        Coordinates at the silent motion (NaN where there is none).
+    l0 : ndarray, shape (N, m)
+        Pad deformations at the silent motion (NaN where there is none).
+    trivial : ndarray of bool, shape (N,)
+        Trivial silent motion (``q0 = 0`` exactly).
+    handover : ndarray of int8, shape (N,)
+        Why a point went to the per-point solver (:data:`~.silent_batch.HANDOVER`; 0: it did not).
+    iterations : ndarray of int, shape (N,)
+        Newton iterations of the compiled stage.
+    """
+
+    status: np.ndarray
+    q0: np.ndarray
+    l0: np.ndarray
+    trivial: np.ndarray
+    handover: np.ndarray
+    iterations: np.ndarray
+
+    @property
+    def z(self) -> np.ndarray:
+        """``(Q0, L0)`` per point, shape (N, n + m)."""
+        return np.concatenate([self.q0, self.l0], axis=1)
+
+
+def _trivial_rows(cm: Any, P: np.ndarray) -> np.ndarray:
+    """Rows whose zero-state residuals vanish to rounding (the criterion of ``silent_motion``)."""
+    N = P.shape[0]
+    cols = [np.ascontiguousarray(P[:, k]) for k in range(P.shape[1])]
+    with np.errstate(all="ignore"):
+        F = np.stack([np.broadcast_to(np.asarray(v, dtype=float), (N,)) for v in cm.zero_residuals(cols)])
+        S = np.stack([np.broadcast_to(np.asarray(v, dtype=float), (N,))
+                      for v in cm.zero_residual_scale(cols)])
+    return np.asarray(is_trivial(F, S), dtype=bool) & np.all(np.isfinite(F), axis=0)
+
+
+def silent_motions(model: Any, P: Any, *, use_cache: bool = True, compiled: bool = True) -> SilentMotions:
+    """Silent motions of many points: compiled Newton stage, the per-point solver wherever it is not clean.
+
+    Parameters
+    ----------
+    model : ModelSpec or CompiledModel
+        The model.
+    P : array_like, shape (N, n_params)
+        Packed parameter vectors (:meth:`Parameters.vector
+        <brakesqueal.model.parameters.Parameters.vector>`, one row per point;
+        e.g. :meth:`ParameterSpace.vectors
+        <brakesqueal.model.parameters.ParameterSpace.vectors>` stacked).
+        Assumed valid.
+    use_cache : bool, optional
+        Use the on-disk code cache (default ``True``).
+    compiled : bool, optional
+        ``False`` skips the compiled stage: every non-trivial point goes
+        through :func:`silent_motion_vector` (the reference the tests
+        compare with).
+
+    Returns
+    -------
+    SilentMotions
+        Equal in status to :func:`silent_motion` at every point and in value
+        to rounding (see :mod:`~.silent_batch`).
+    """
+    from ..codegen import CompiledModel, compile_model
+    from ..status import PointStatus, status_of_error
+    from .silent_batch import load_kernel
+
+    cm = model if isinstance(model, CompiledModel) else compile_model(model, use_cache=use_cache)
+    P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=float)))
+    N = P.shape[0]
+    n, m, npad = cm.n, cm.m, len(cm.spec.pads)
+    K = n + m
+    Z = np.full((N, K), np.nan)
+    code = np.ones(N, dtype=np.int8)
+    iters = np.zeros(N, dtype=np.int64)
+    status = np.full(N, int(PointStatus.OK_NONTRIVIAL), dtype=np.int8)
+    triv = _trivial_rows(cm, P) if N else np.zeros(0, dtype=bool)
+    code[triv] = 4
+    Z[triv] = 0.0
+    rest = np.flatnonzero(~triv)
+    if compiled and rest.size:
+        kern = load_kernel(cm.spec, use_cache=use_cache)
+        sub = np.ascontiguousarray(P[rest])
+        Zs = np.full((rest.size, K), np.nan)
+        cs = np.ones(rest.size, dtype=np.int8)
+        its = np.zeros(rest.size, dtype=np.int64)
+        fn = np.full((rest.size, max(npad, 1)), np.nan)
+        sp = np.full((rest.size, max(npad, 1)), np.nan)
+        with np.errstate(all="ignore"):
+            kern.newton_batch(sub, MAX_TILT, 12, Zs, cs, its, fn, sp)
+        Z[rest], code[rest], iters[rest] = Zs, cs, its
+    # the trivial points: contact and sliding at the zero state decide (vectorized, as silent_motion does)
+    t = np.flatnonzero(triv)
+    if t.size:
+        st = _zero_state_status(cm, P[t])
+        status[t] = st
+        Z[t[st != int(PointStatus.OK)]] = np.nan
+    for i in np.flatnonzero((code != 0) & (code != 4)):
+        try:
+            sm = silent_motion_vector(cm, [float(v) for v in P[i]])
+        except (NoSilentMotionError, SolverFailedError, ContactLossError, NoSlidingError) as exc:
+            status[i] = int(status_of_error(exc))
+            Z[i] = np.nan
+            continue
+        Z[i, :n], Z[i, n:] = sm.q0, sm.l0
+        status[i] = int(PointStatus.OK if sm.trivial else PointStatus.OK_NONTRIVIAL)
+    handover = np.where(code == 4, 0, code).astype(np.int8)
+    handover[triv] = 4
+    return SilentMotions(status=status, q0=Z[:, :n].copy(), l0=Z[:, n:].copy(), trivial=triv.copy(),
+                         handover=handover, iterations=iters)
+
+
+def _zero_state_status(cm: Any, P: np.ndarray) -> np.ndarray:
+    """``OK``, ``CONTACT_LOSS`` or ``NO_SLIDING`` of trivial silent motions (contact at the zero state)."""
+    from ..codegen.compiled import CONTACT_FIELDS
+    from ..status import PointStatus
+
+    N = P.shape[0]
+    cols = [np.ascontiguousarray(P[:, k]) for k in range(P.shape[1])]
+    with np.errstate(all="ignore"):
+        c = [np.broadcast_to(np.asarray(v, dtype=float), (N,)) for v in cm.vectorized.contact([0.0] * cm.nx, cols)]
+    nf = len(CONTACT_FIELDS)
+    st = np.full(N, int(PointStatus.OK), dtype=np.int8)
+    for j in range(len(cm.spec.pads)):
+        fn = c[nf * j]
+        v = np.sqrt(c[nf * j + 1] ** 2 + c[nf * j + 2] ** 2 + c[nf * j + 3] ** 2)
+        lost = ~(np.isfinite(fn) & (fn > 0))
+        st = np.where((st == int(PointStatus.OK)) & lost, np.int8(PointStatus.CONTACT_LOSS), st)
+        st = np.where((st == int(PointStatus.OK)) & ~(v > 0), np.int8(PointStatus.NO_SLIDING), st)
+    return st.astype(np.int8)

@@ -31,10 +31,16 @@ Routes, chosen per point by what the model allows:
   Every pad must touch and slide at the zero state (checked with the
   generated contact function; :attr:`~brakesqueal.status.PointStatus.CONTACT_LOSS`,
   :attr:`~brakesqueal.status.PointStatus.NO_SLIDING`).
-* **Non-trivial silent motion** — point by point,
-  :func:`~.linear.linearize` (the full :class:`~.linear.LinearModel`, pad
-  states included) and :func:`linear_verdict` on every eigenvalue; a failure
-  of the silent motion gives the status of its type
+* **Non-trivial silent motion** — batched: the silent motions from
+  :func:`~.equilibrium.silent_motions` (a compiled Newton stage with the
+  per-point globalised solver for every point it does not accept cleanly, so
+  statuses are those of :func:`~.equilibrium.silent_motion`), the
+  linearization of :func:`~.linear.linearize` at them (exact Jacobians,
+  pad states kept where they have rate terms) and the verdict of
+  :func:`linear_verdict` on every eigenvalue, all batched; points the batch
+  cannot take (a trivial silent motion found there, an algebraic pad row, a
+  singular pad block) go through :func:`~.linear.linearize` one by one.  A
+  failure of the silent motion gives the status of its type
   (:func:`~brakesqueal.status.status_of_error`).
 
 Consistency by construction: a point with status ``OK`` or ``OK_NONTRIVIAL``
@@ -66,7 +72,7 @@ __all__ = ["PointVerdict", "Points", "evaluate", "evaluate_arrays", "evaluate_po
 ROUTES = {
     "closed": "closed form: certified Hurwitz test of the exact quartic (generated kernels; exact rational fallback)",
     "points": "per point: certified eigenvalue verdicts (trivial silent motions batched at the zero state, "
-              "non-trivial ones linearized one by one with the pads' states kept)",
+              "non-trivial ones batched: compiled Newton silent motions, linearized with the pads' states kept)",
 }
 
 _BATCH_CLOSED = 1 << 16
@@ -357,6 +363,114 @@ def _nontrivial_point(model: _Model, values: dict[str, float]) -> tuple[int, boo
     return int(ok), code == STABLE, mr, fr
 
 
+def _nontrivial_batch(model: _Model, P: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(status, stable, max_real, frequency, redo)`` of points without a trivial zero state (rows of ``P``).
+
+    The silent motions come from :func:`~.equilibrium.silent_motions` (compiled
+    Newton stage, the per-point solver wherever it is not clean: statuses as
+    :func:`~.equilibrium.silent_motion`); the linearization at them is
+    :func:`~.linear.linearize`'s, batched (exact Jacobians from the same
+    generated code, quasi-static pads eliminated, pads with rate terms kept as
+    states), and the verdict :func:`linear_verdict`'s.  ``redo`` marks the
+    points left to the per-point route: a trivial silent motion found there,
+    a kept pad without rate terms (an algebraic row, eliminated per point by
+    :func:`eliminate_algebraic`), or a singular pad block.
+    """
+    from .equilibrium import silent_motions
+
+    N = P.shape[0]
+    status = np.full(N, int(PointStatus.UNDECIDED), dtype=np.int8)
+    stable = np.zeros(N, dtype=bool)
+    mr = np.full(N, np.nan)
+    fr = np.full(N, np.nan)
+    redo = np.zeros(N, dtype=bool)
+    sms = silent_motions(model.cm, P)
+    found = (sms.status == int(PointStatus.OK)) | (sms.status == int(PointStatus.OK_NONTRIVIAL))
+    status[~found] = sms.status[~found]
+    redo |= sms.status == int(PointStatus.OK)  # trivial after all: zero-state blocks and exact fallbacks per point
+    ok = np.flatnonzero(sms.status == int(PointStatus.OK_NONTRIVIAL))
+    if ok.size:
+        codes, m1, f1, back = _linear_batch(model.cm, np.ascontiguousarray(P[ok]), np.ascontiguousarray(sms.z[ok]))
+        done = ok[~back]
+        c = codes[~back]
+        status[done] = np.where(c == UNDECIDED, int(PointStatus.UNDECIDED), int(PointStatus.OK_NONTRIVIAL))
+        stable[done] = c == STABLE
+        mr[done], fr[done] = m1[~back], f1[~back]
+        redo[ok[back]] = True
+    return status, stable, mr, fr, redo
+
+
+def _linear_batch(cm: Any, P: np.ndarray, Z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Batched :func:`~.linear.linearize` at silent motions ``Z = (Q0, L0)`` and :func:`linear_verdict`.
+
+    Returns ``(codes, max_real, frequency, back)``; ``back`` marks points
+    the per-point route decides (see :func:`_nontrivial_batch`).
+    """
+    from .silent_batch import load_kernel
+
+    N = P.shape[0]
+    n, m, nx = cm.n, cm.m, cm.nx
+    codes = np.full(N, UNDECIDED, dtype=np.uint8)
+    mr = np.full(N, np.nan)
+    fr = np.full(N, np.nan)
+    back = np.zeros(N, dtype=bool)
+    Jf = np.empty((N, (n + m) * nx))
+    with np.errstate(all="ignore"):
+        load_kernel(cm.spec).jacobian_batch(P, Z, Jf)
+    J = Jf.reshape(N, n + m, nx)
+    M, D, K = J[:, :n, 2 * n:3 * n], J[:, :n, n:2 * n], J[:, :n, :n]
+    R_L, R_dL = J[:, :n, 3 * n:3 * n + m], J[:, :n, 3 * n + m:]
+    G_Q, G_dQ, G_ddQ = J[:, n:, :n], J[:, n:, n:2 * n], J[:, n:, 2 * n:3 * n]
+    G_L, G_dL = J[:, n:, 3 * n:3 * n + m], J[:, n:, 3 * n + m:]
+
+    def second_order(idx: np.ndarray, M: np.ndarray, D: np.ndarray, K: np.ndarray) -> None:
+        c, a, f = matrix_verdicts(M, D, K) if n == 2 else eigen_verdicts(M, D, K)
+        codes[idx], mr[idx], fr[idx] = c, a, f
+
+    if m == 0:
+        second_order(np.arange(N), M, D, K)
+        return codes, mr, fr, back
+    dyn_all = np.any(R_dL != 0.0, axis=1) | np.any(G_dL != 0.0, axis=1) | np.any(G_dL != 0.0, axis=2)
+    patterns, which = np.unique(dyn_all, axis=0, return_inverse=True)
+    for g, dyn in enumerate(patterns):
+        idx = np.flatnonzero(which.reshape(-1) == g)
+        qs = ~dyn
+        Mg, Dg, Kg = M[idx], D[idx], K[idx]
+        RL, RdL, GQ, GdQ, GddQ, GL, GdL = (X[idx] for X in (R_L, R_dL, G_Q, G_dQ, G_ddQ, G_L, G_dL))
+        try:
+            if qs.any():
+                Gss = GL[:, qs][:, :, qs]
+                Pq = np.swapaxes(np.linalg.solve(np.swapaxes(Gss, 1, 2), np.swapaxes(RL[:, :, qs], 1, 2)), 1, 2)
+                Mg, Dg, Kg = Mg - Pq @ GddQ[:, qs], Dg - Pq @ GdQ[:, qs], Kg - Pq @ GQ[:, qs]
+                if not dyn.any():
+                    second_order(idx, Mg, Dg, Kg)
+                    continue
+                Pd = np.swapaxes(np.linalg.solve(np.swapaxes(Gss, 1, 2), np.swapaxes(GL[:, dyn][:, :, qs], 1, 2)),
+                                 1, 2)
+                RL, RdL = RL[:, :, dyn] - Pq @ GL[:, qs][:, :, dyn], RdL[:, :, dyn]
+                GQ, GdQ = GQ[:, dyn] - Pd @ GQ[:, qs], GdQ[:, dyn] - Pd @ GdQ[:, qs]
+                GddQ = GddQ[:, dyn] - Pd @ GddQ[:, qs]
+                GL, GdL = GL[:, dyn][:, :, dyn] - Pd @ GL[:, qs][:, :, dyn], GdL[:, dyn][:, :, dyn]
+        except np.linalg.LinAlgError:
+            back[idx] = True  # a singular pad block: the per-point route reports it
+            continue
+        k, G = int(dyn.sum()), idx.size
+        I, Zn = np.broadcast_to(np.eye(n), (G, n, n)), np.zeros((G, n, n))
+        Znk, Zkn = np.zeros((G, n, k)), np.zeros((G, k, n))
+        E = np.concatenate([np.concatenate([I, Zn, Znk], 2), np.concatenate([Zn, Mg, RdL], 2),
+                            np.concatenate([Zkn, GddQ, GdL], 2)], 1)
+        A = np.concatenate([np.concatenate([Zn, I, Znk], 2), np.concatenate([-Kg, -Dg, -RL], 2),
+                            np.concatenate([-GQ, -GdQ, -GL], 2)], 1)
+        alg = np.any(np.all(E == 0.0, axis=2), axis=1)  # an algebraic row: eliminate_algebraic, per point
+        back[idx[alg]] = True
+        keep = ~alg
+        if keep.any():
+            c, a, f = descriptor_verdicts(E[keep], A[keep])
+            codes[idx[keep]], mr[idx[keep]], fr[idx[keep]] = c, a, f
+    return codes, mr, fr, back
+
+
 def _zero_descriptor(cm: Any, cols: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Batched descriptor ``(E, A)`` at the zero state with the rate-free pads eliminated.
 
@@ -557,7 +671,13 @@ def evaluate_arrays(space: Any, arr: Mapping[str, Any], *, eigen: bool = True, c
         mr[tix], fr[tix] = m, f
         triv[t[st == -1]] = False  # some kept pads without rate terms here: the per-point route decides
     names = list(space.model.parameters)
-    for j in np.flatnonzero(~triv):
+    nt = np.flatnonzero(~triv)
+    if nt.size:
+        b_st, b_sb, b_mr, b_fr, redo = _nontrivial_batch(model, P[nt])
+        nix = tuple(a[nt] for a in ix)
+        status[nix], stable[nix], mr[nix], fr[nix] = b_st, b_sb, b_mr, b_fr
+        nt = nt[redo]
+    for j in nt:
         i = flat[j]
         pi = np.unravel_index(i, shape)
         values = {n: float(np.broadcast_to(arr[n], shape)[pi]) for n in names}

@@ -71,6 +71,7 @@ GENERATOR_MODULES: tuple[str, ...] = (
     "analysis/kernels.py",  # stability kernel generators
     "analysis/_compiled.py",  # numba root isolation linked with the stability kernels
     "analysis/_rows.py",  # numba row evaluation of the stability kernels' coefficient tables
+    "analysis/silent_batch.py",  # batched silent-motion Newton kernel (numba template around the model source)
     "simulation/_kernels.py",  # simulation kernels and their static template
     "export/*.py",  # exported code and LaTeX
     "render.py",  # the rendered closed forms cached by ``derive``
