@@ -62,3 +62,26 @@ def test_a_full_disk_keeps_the_old_file_and_says_so_in_one_line(tmp_path, case):
     assert len(lines) == 1 and "error" in lines[0] and name in lines[0], out.stderr[-2000:]
     assert target.read_bytes() == b"the previous result"
     assert sorted(p.name for p in tmp_path.iterdir()) == before  # no temporary or partial file left
+
+
+def test_reproduce_on_a_full_disk_keeps_the_whole_previous_set(tmp_path):
+    """The figure's files form one set: a write failing part-way (the PNG fits, the NetCDF does not) replaces none."""
+    warm = _run(["reproduce", "fig2", "--out", "warm", "--no-progress"], tmp_path, None)
+    assert warm.returncode == 0, warm.stderr
+    sizes = {p.name: p.stat().st_size for p in (tmp_path / "warm").iterdir()}
+    assert sorted(sizes) == ["fig2.csv", "fig2.json", "fig2.nc", "fig2.png"]
+    limit = 1 << 20
+    assert sizes["fig2.png"] < limit < sizes["fig2.nc"]  # some files of the set fit, others do not
+    out_dir = tmp_path / "R"
+    out_dir.mkdir()
+    for name in sizes:
+        (out_dir / name).write_text(f"previous {name}")
+    out = _run(["reproduce", "fig2", "--out", "R", "--no-progress"], tmp_path, limit)
+    assert out.returncode == 2, (out.returncode, out.stderr[-2000:])
+    lines = [ln for ln in out.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "error" in lines[0] and "'R'" in lines[0] and "unchanged" in lines[0], out.stderr
+    assert {p.name: p.read_text() for p in out_dir.iterdir()} == {n: f"previous {n}" for n in sizes}
+    rerun = _run(["reproduce", "fig2", "--out", "R", "--no-progress"], tmp_path, None)  # and a later run succeeds
+    assert rerun.returncode == 0, rerun.stderr
+    new = {p.name: p.stat().st_size for p in out_dir.iterdir()}
+    assert sorted(new) == sorted(sizes) and all(new[n] == sizes[n] for n in ("fig2.png", "fig2.nc", "fig2.csv"))

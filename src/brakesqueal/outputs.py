@@ -24,7 +24,7 @@ from typing import Any
 from .errors import OutputError
 from .interrupts import critical, remove_on_exit
 
-__all__ = ["check_output", "check_output_dir", "atomic_write", "write_with", "describe_oserror"]
+__all__ = ["check_output", "check_output_dir", "atomic_write", "write_with", "write_set", "describe_oserror"]
 
 
 def describe_oserror(exc: OSError) -> str:
@@ -152,6 +152,77 @@ def write_with(path: str | os.PathLike[str], writer: Callable[[Path], Any], *, w
     with atomic_write(path, what=what) as tmp:
         out = writer(tmp)
     return out
+
+
+@contextlib.contextmanager
+def write_set(directory: str | os.PathLike[str], *, what: str = "output directory") -> Iterator[Path]:
+    """Write a set of files that belong together: all of them replace their predecessors, or none does.
+
+    Yields a temporary directory inside ``directory``; the caller writes
+    every file of the set into it under its final name.  When the block
+    succeeds, each file is synced and the files are renamed into
+    ``directory`` (a rename needs no space, so a full disk fails before
+    any file is replaced; the renames run in a
+    :func:`~brakesqueal.interrupts.critical` section, so a Ctrl-C never
+    stops them half-way).  On any failure or interrupt the temporary
+    directory is removed and the files already in ``directory`` are left
+    as they were.
+
+    Parameters
+    ----------
+    directory : str or path-like
+        An existing, writable directory (see :func:`check_output_dir`).
+    what : str, optional
+        The option or role, for messages (e.g. ``"--out"``).
+
+    Yields
+    ------
+    pathlib.Path
+        The temporary directory to write the files into.
+
+    Raises
+    ------
+    OutputError
+        One line naming ``directory`` and the reason (``OSError`` of the
+        writers or of the renames); the previous files are unchanged.
+
+    Examples
+    --------
+    >>> with write_set("results") as tmp:                 # doctest: +SKIP
+    ...     (tmp / "fig2.json").write_text(text)
+    ...     figure.savefig(tmp / "fig2.png")
+    """
+    final = Path(os.fspath(directory))
+    try:
+        stage = Path(tempfile.mkdtemp(prefix=".brakesqueal-", suffix=".part", dir=final))
+    except OSError as exc:
+        raise OutputError(f"{what}: cannot write into '{directory}': {describe_oserror(exc)}") from None
+    try:
+        with remove_on_exit(stage):
+            try:
+                yield stage
+                files = sorted(p for p in stage.iterdir() if p.is_file())
+                for f in files:
+                    with open(f, "rb+") as fh:
+                        os.fsync(fh.fileno())
+                    os.chmod(f, 0o666 & ~_umask())
+                with critical():
+                    for i, f in enumerate(files):
+                        try:
+                            os.replace(f, final / f.name)
+                        except OSError as exc:
+                            if not i:
+                                raise
+                            raise OutputError(f"{what}: cannot move '{f.name}' into '{directory}': "
+                                              f"{describe_oserror(exc)}; {i} of {len(files)} files were "
+                                              "replaced") from None
+            except OSError as exc:
+                raise OutputError(f"{what}: cannot write the files into '{directory}': {describe_oserror(exc)}; "
+                                  "the previous files are unchanged") from None
+    finally:
+        import shutil
+
+        shutil.rmtree(stage, ignore_errors=True)
 
 
 def _umask() -> int:

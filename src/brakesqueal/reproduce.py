@@ -30,11 +30,14 @@ def _noop(frac: float) -> None:
     pass
 
 
-def _write(path: Path, writer: Any) -> None:
-    """Write one output file atomically (a failure never leaves a truncated file)."""
-    from .outputs import write_with
+def _grid_csv(ds: Any, dims: tuple[str, ...], path: Path) -> None:
+    """Long-format CSV of the variables on the map's grid (one row per grid point; the boundary is in the NetCDF).
 
-    write_with(path, writer)
+    ``Dataset.to_dataframe`` of the whole map would form the product of the
+    grid with the stored boundary's own dimension (gigabytes).
+    """
+    names = [v for v in ds.data_vars if set(ds[v].dims) == set(dims)]
+    ds[names].to_dataframe().reset_index().to_csv(str(path), index=False)
 
 
 def reproduce_fig2(out: str | Path, *, n_kip: int = 301, n_mu: int = 241, mu_line: float = FIG2_MU,
@@ -45,7 +48,7 @@ def reproduce_fig2(out: str | Path, *, n_kip: int = 301, n_mu: int = 241, mu_lin
     from .model.parameters import ParameterSpace
     from .plotting import save
 
-    from .outputs import check_output_dir
+    from .outputs import check_output_dir, write_set
 
     out = check_output_dir(out, what="--out")
     space = ParameterSpace.from_preset("paper-fig2")
@@ -66,16 +69,17 @@ def reproduce_fig2(out: str | Path, *, n_kip: int = 301, n_mu: int = 241, mu_lin
         if v is not None:
             ax.plot([v], [mu_line], "ko", ms=5)
             ax.annotate(label, (v, mu_line), textcoords="offset points", xytext=(4, 6))
-    _write(out / "fig2.png", lambda t: save(fig, str(t)))
-    _write(out / "fig2.nc", lambda t: m.to_netcdf(str(t)))
-    _write(out / "fig2.csv", lambda t: m.to_csv(str(t)))
     st = m.data["stable"].values
     summary = {"figure": "fig2", "preset": "paper-fig2", "mu_line": mu_line, "A_k_ip": A, "B_k_ip": B,
                "line_crossings": line.to_dict(), "grid": {"k_ip": [kip.start, kip.stop, n_kip, "log"],
                                                           "mu": [0.05, 1.0, n_mu, "linear"]},
                "stable_fraction": float(st.mean()),
                "files": [str(out / f"fig2.{e}") for e in ("png", "nc", "csv", "json")]}
-    _write(out / "fig2.json", lambda t: t.write_text(json.dumps(summary, indent=2) + "\n"))
+    with write_set(out, what="--out") as tmp:  # all four files replace the previous ones, or none does
+        save(fig, str(tmp / "fig2.png"))
+        m.to_netcdf(str(tmp / "fig2.nc"))
+        _grid_csv(m.data, tuple(m.dims), tmp / "fig2.csv")
+        (tmp / "fig2.json").write_text(json.dumps(summary, indent=2) + "\n")
     progress(1.0)
     return summary
 
@@ -141,7 +145,7 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
     from .model.parameters import ParameterSpace
     from .plotting import plot_critical_curves, save
 
-    from .outputs import check_output_dir
+    from .outputs import check_output_dir, write_set
 
     out = check_output_dir(out, what="--out")
     diff = np.linspace(-0.98, 0.98, n_diff)
@@ -166,9 +170,7 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
         tips[kip] = fig3_tips(space, diff, first, certain[kip], omega_range)
         progress((q + 1) / len(FIG3_KIP))
     fig = plot_critical_curves(diff, crit, restab=restab, tips=tips, title="Fig. 3: squeal region (paper-fig3)")
-    _write(out / "fig3.png", lambda t: save(fig, str(t)))
     fig_lin = plot_critical_curves(diff, crit, tips=tips, title="Fig. 3: onset of squeal (paper-fig3)")
-    _write(out / "fig3_onset.png", lambda t: save(fig_lin, str(t)))
     kvals = [math.inf if k == "inf" else float(k) for k in FIG3_KIP]
     ds = xr.Dataset(
         {"Omega_crit": (("k_ip", "mu_diff"), np.array([crit[k] for k in FIG3_KIP]), {"units": "rad/s"}),
@@ -178,8 +180,6 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
                      {"long_name": "every crossing in the range established (1) or a part undecided (0)"})},
         coords={"k_ip": ("k_ip", kvals, {"units": "N/m"}), "mu_diff": ("mu_diff", diff, {"long_name": "mu1 - mu2"})},
         attrs={"preset": "paper-fig3", "constraint": "mu1 + mu2 = 1", "omega_range": list(omega_range)})
-    _write(out / "fig3.nc", lambda t: ds.to_netcdf(str(t), engine="scipy"))
-    _write(out / "fig3.csv", lambda t: ds.to_dataframe().reset_index().to_csv(str(t), index=False))
     mid = int(np.argmin(np.abs(diff)))
     summary: dict[str, Any] = {"figure": "fig3", "preset": "paper-fig3", "omega_range": list(omega_range),
                                "files": [str(out / f) for f in ("fig3.png", "fig3_onset.png",
@@ -198,5 +198,10 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
             "Omega_restab_at_equal_mu": float(restab[k][mid]),
             "tips": [{"mu_diff": d, "Omega": w} for d, w in tips[k]],
         }
-    _write(out / "fig3.json", lambda t: t.write_text(json.dumps(summary, indent=2) + "\n"))
+    with write_set(out, what="--out") as tmp:  # all five files replace the previous ones, or none does
+        save(fig, str(tmp / "fig3.png"))
+        save(fig_lin, str(tmp / "fig3_onset.png"))
+        ds.to_netcdf(str(tmp / "fig3.nc"), engine="scipy")
+        ds.to_dataframe().reset_index().to_csv(str(tmp / "fig3.csv"), index=False)
+        (tmp / "fig3.json").write_text(json.dumps(summary, indent=2) + "\n")
     return summary
