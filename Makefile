@@ -41,3 +41,12 @@ docs: $(DOCS_STAMP)
 
 clean:
 	rm -rf $(VENV) build src/*.egg-info .pytest_cache
+
+# The explorer measured in a real browser (needs chromium: apt-get install chromium); not part of `make bench`.
+.PHONY: bench-explorer explorer-screenshots
+bench-explorer: $(STAMP)
+	$(BIN)/python benchmarks/browser_explorer.py
+
+# Screenshots of the explorer's browser tests into the docs' gallery (docs/figures/explorer-*.png).
+explorer-screenshots: $(STAMP)
+	BRAKESQUEAL_EXPLORER_SCREENSHOTS=docs/figures $(BIN)/python -m pytest -q tests/explorer/test_browser.py

@@ -129,7 +129,7 @@ class Page:
         """Save ``explorer-<name>.png`` when screenshots are requested."""
         if SHOTS:
             Path(SHOTS).mkdir(parents=True, exist_ok=True)
-            self.page.screenshot(path=str(Path(SHOTS) / f"explorer-{name}.png"))
+            self.page.screenshot(path=str(Path(SHOTS) / f"explorer-{name}.png"), full_page=True)
 
 
 @pytest.fixture

@@ -67,7 +67,7 @@ def test_map_click_moves_every_view(page):
     box = canvas.bounding_box()
     page.page.mouse.click(box["x"] + 0.3 * box["width"], box["y"] + 0.75 * box["height"])
     after = page.wait(lambda s: set(dict(v.split("=") for v in sets_of(s["locus"]["state"]))) == {"k_ip", "mu"}
-                      and s.get("lane_state", {}).get("set") == s["locus"]["state"]["set"])
+                      and s.get("info_state", {}).get("set") == s["locus"]["state"]["set"])
     values = dict(v.split("=") for v in sets_of(after["locus"]["state"]))
     assert page.page.locator(".bs-input-mu input").input_value() == values["mu"]
     assert page.page.locator(".bs-input-k_ip input").input_value() == values["k_ip"]

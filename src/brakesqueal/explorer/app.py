@@ -17,6 +17,7 @@ import json
 import logging
 import math
 from dataclasses import replace
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -90,6 +91,9 @@ class Explorer:
         self.space = origin.space_of(state)
         self.shown: dict[str, Any] = {}
         self._map_key: Any = None
+        self._tracks_key: Any = None
+        self._tracks: Any = None
+        self._drawn_tracks: Any = None
         self._cs_key: Any = None
         self._hopf_key: Any = None
         self._building = False
@@ -103,6 +107,7 @@ class Explorer:
         self.locus_lane = LatestWorker(self._compute_locus, self._show_locus, schedule, name="explorer-locus")
         self.map_lane = LatestWorker(self._compute_map, self._show_map, schedule,
                                      progress=self._map_progress, name="explorer-map")
+        self.info_lane = LatestWorker(self._compute_info, self._show_info, schedule, name="explorer-info")
         self.sim_lane = LatestWorker(self._compute_sim, self._show_sim, schedule,
                                      progress=self._sim_progress, name="explorer-sim")
         self.page = self._layout()
@@ -124,7 +129,7 @@ class Explorer:
 
     def stop(self) -> None:
         """End the session's worker threads."""
-        for lane in (getattr(self, n, None) for n in ("locus_lane", "map_lane", "sim_lane")):
+        for lane in (getattr(self, n, None) for n in ("locus_lane", "map_lane", "info_lane", "sim_lane")):
             if lane is not None:
                 lane.stop()
 
@@ -141,9 +146,9 @@ class Explorer:
                                    css_classes=["bs-alert"])
         self.params_box = pn.Column(sizing_mode="stretch_width")
         self.fixed_box = pn.Card(title="fixed parameters", collapsed=True, sizing_mode="stretch_width")
-        self.along_select = pn.widgets.Select(name="root locus along", width=150)
-        self.x_select = pn.widgets.Select(name="map x", width=110)
-        self.y_select = pn.widgets.Select(name="map y", width=110)
+        self.along_select = pn.widgets.Select(name="root locus along", width=130)
+        self.x_select = pn.widgets.Select(name="map x", width=100)
+        self.y_select = pn.widgets.Select(name="map y", width=100)
         self.nx_input = pn.widgets.IntInput(name="x points", value=self.state.nx, start=2, width=90)
         self.ny_input = pn.widgets.IntInput(name="y points", value=self.state.ny, start=2, width=90)
         for w in (self.along_select, self.x_select, self.y_select, self.nx_input, self.ny_input):
@@ -436,16 +441,29 @@ class Explorer:
     def _on_cancel(self, event: Any) -> None:
         self.sim_lane.cancel()
         self.map_lane.cancel()
+        self.info_lane.cancel()
 
     def _submit(self) -> None:
         """The eigenvalues first; the map lane follows each delivered locus (so it never delays the first view)."""
         self.locus_lane.submit(self.state)
 
     # ------------------------------------------------------------------------------------------ lanes
-    def _compute_locus(self, state: ViewState, check: Any) -> tuple[Any, LocusView]:
+    def _compute_locus(self, state: ViewState, check: Any) -> tuple[Any, LocusView, bool]:
+        """The current eigenvalues, then the modes along the path (reused while only ``along`` itself moves)."""
         space = self.origin.space_of(state)
         rng = slider_range(space, state.along) if state.along not in self.ranges else self.ranges[state.along]
-        return space, locus_view(space, state.along, rng)
+        defs = {k: str(v) for k, v in space.definitions().items() if k != state.along}
+        key = (state.model, state.preset, state.along, rng, tuple(sorted(defs.items())))
+        if key == self._tracks_key:
+            return space, locus_view(space, state.along, rng, tracks=self._tracks), True
+        now = locus_view(space, state.along, rng, path=False)
+        self._schedule(partial(self._show_locus, state, (space, now, False), None))  # the eigenvalues at once
+        if self.locus_lane.superseded:  # a newer value waits: its path, not this one, is worth computing
+            return space, now, False
+        lv = locus_view(space, state.along, rng)
+        if lv.tracks is not None:
+            self._tracks_key, self._tracks = key, lv.tracks
+        return space, lv, True
 
     def _mark(self) -> None:
         self.count += 1
@@ -457,13 +475,14 @@ class Explorer:
                 "style='display:none'></div>")
 
     def _show_locus(self, state: ViewState, result: Any, error: BaseException | None) -> None:
-        self.map_lane.submit(self.state)
+        self.map_lane.submit(self.state)  # the other lanes follow the eigenvalues (latest request only)
+        self.info_lane.submit(self.state)
         if error is not None:
             self.leading_text.object = f"<b>leading eigenvalue:</b> {html.escape(str(error))}"
             self.shown["locus"] = {"state": state.to_query(), "error": str(error)}
             self._mark()
             return
-        space, lv = result
+        space, lv, complete = result
         lead = format_eigenvalue(lv.leading)
         verdict = "unstable (squeal)" if lv.leading.real > 0 else "stable"
         self.leading_text.object = (f"<b>leading eigenvalue</b> λ = <span id='bs-leading'>{lead}</span> 1/s "
@@ -473,7 +492,8 @@ class Explorer:
         current = space.value(state.along)
         self.span_f.location = self.span_r.location = current if math.isfinite(current) else None
         tr = lv.tracks
-        if tr is not None:
+        if tr is not None and tr is not self._drawn_tracks:  # unchanged paths are not sent again
+            self._drawn_tracks = tr
             lam = tr.eigenvalues
             xs, ys, mode, vx, fr, re_ = [], [], [], [], [], []
             for k in range(lam.shape[1]):
@@ -490,12 +510,17 @@ class Explorer:
                 self._modes_key = (state.along, log_now, state.model, state.preset)
                 self.pane_modes.object = self._modes_figure(log_now)
             self.src_modes.data = {"xs": vx, "freq": fr, "real": re_}
-        if lv.message:
+        if lv.message:  # no path: clear the previous one rather than show it for another point
+            self._drawn_tracks = None
+            self.src_locus.data = {"xs": [], "ys": [], "mode": []}
+            self.src_modes.data = {"xs": [], "freq": [], "real": []}
             self.leading_text.object += f"<br><i>{html.escape(lv.message)}</i>"
         x, y = self._map_point(space, state)
         self.src_point.data = {"x": [x], "y": [y]}
+        previous = self.shown.get("locus", {}).get("tracks_state")
         self.shown["locus"] = {"state": state.to_query(), "leading": lead, "re": lv.leading.real,
-                               "im": lv.leading.imag, "point": [x, y]}
+                               "im": lv.leading.imag, "point": [x, y],
+                               "tracks_state": state.to_query() if complete else previous}
         self._mark()
 
     def _map_point(self, space: Any, state: ViewState) -> tuple[float, float]:
@@ -510,7 +535,7 @@ class Explorer:
 
     def _compute_map(self, state: ViewState, check: Any) -> dict[str, Any]:
         space = self.origin.space_of(state)
-        ranges = {n: (self.ranges.get(n) or slider_range(space, n)) for n in (state.x, state.y, state.along)}
+        ranges = {n: (self.ranges.get(n) or slider_range(space, n)) for n in (state.x, state.y)}
         out: dict[str, Any] = {}
         defs = {k: str(v) for k, v in space.definitions().items()}
         map_key = (state.model, state.preset, state.x, state.y, state.nx, state.ny,
@@ -523,19 +548,39 @@ class Explorer:
             except BrakesquealError as exc:
                 out["map_error"] = str(exc)
                 self._map_key = None
+        return out
+
+    def _compute_info(self, state: ViewState, check: Any) -> dict[str, Any]:
+        """Critical speeds and the Hopf point nearest the current value (each recomputed when its inputs change)."""
+        space = self.origin.space_of(state)
+        rng = self.ranges.get(state.along) or slider_range(space, state.along)
+        out: dict[str, Any] = {}
+        defs = {k: str(v) for k, v in space.definitions().items()}
         cs_key = (state.model, state.preset, tuple(sorted(defs.items())))
         if cs_key != self._cs_key:
-            check(1.0)
             out["cs"] = critical_speed_text(space)
             self._cs_key = cs_key
+        check(0.5)
         hopf_key = (state.model, state.preset, state.along,
                     tuple(sorted((k, v) for k, v in defs.items() if k != state.along)))
         if hopf_key != self._hopf_key:
-            check(1.0)
-            self._hopf_points = hopf_scan(space, state.along, ranges[state.along])
+            self._hopf_points = hopf_scan(space, state.along, rng)
             self._hopf_key = hopf_key
-        out["hopf"] = hopf_text(self._hopf_points, state.along, space.value(state.along), ranges[state.along])
+        out["hopf"] = hopf_text(self._hopf_points, state.along, space.value(state.along), rng)
         return out
+
+    def _show_info(self, state: ViewState, out: Any, error: BaseException | None) -> None:
+        if error is not None:
+            self._cs_key = self._hopf_key = None
+            self.hopf_text.object = f"<b>Hopf:</b> {html.escape(str(error))}"
+        else:
+            if "cs" in out:
+                self.cs_text.object = html.escape(out["cs"])
+                self.shown["cs"] = out["cs"]
+            self.hopf_text.object = html.escape(out["hopf"])
+            self.shown["hopf"] = out["hopf"]
+        self.shown["info_state"] = state.to_query()
+        self._mark()
 
     def _map_progress(self, fraction: float) -> None:
         self.map_progress.visible = fraction < 1.0
@@ -544,7 +589,7 @@ class Explorer:
     def _show_map(self, state: ViewState, out: Any, error: BaseException | None) -> None:
         self.map_progress.visible = False
         if error is not None:
-            self._map_key = self._cs_key = self._hopf_key = None
+            self._map_key = None
             if not isinstance(error, Cancelled):
                 self.map_text.object = f"<b>map:</b> {html.escape(str(error))}"
             else:
@@ -557,13 +602,6 @@ class Explorer:
         if "map" in out:
             mv: MapView = out["map"]
             self._draw_map(state, mv)
-        if "cs" in out:
-            self.cs_text.object = html.escape(out["cs"])
-            self.shown["cs"] = out["cs"]
-        if "hopf" in out:
-            self.hopf_text.object = html.escape(out["hopf"])
-            self.shown["hopf"] = out["hopf"]
-        self.shown["lane_state"] = state.to_query()
         self._mark()
 
     def _draw_map(self, state: ViewState, mv: MapView) -> None:

@@ -273,8 +273,25 @@ class LocusView:
     message: str = ""
 
 
-def locus_view(space: Any, along: str, rng: SliderRange, num: int = LOCUS_POINTS) -> LocusView:
+def locus_view(space: Any, along: str, rng: SliderRange, num: int = LOCUS_POINTS, *, tracks: Any = None,
+               path: bool = True) -> LocusView:
     """Linearize at the current point and track every mode along ``along`` over ``rng``.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The current point.
+    along : str
+        The path parameter.
+    rng : SliderRange
+        The path.
+    num : int
+        Points of the path.
+    tracks : ModeTracks, optional
+        The modes along the path when known (the path does not depend on the
+        current value of ``along``): reused instead of recomputed.
+    path : bool
+        Compute the path (``False``: only the current eigenvalues, ``tracks`` stays as given).
 
     Raises
     ------
@@ -287,6 +304,8 @@ def locus_view(space: Any, along: str, rng: SliderRange, num: int = LOCUS_POINTS
 
     lm = linearize(space.resolve({}))
     lam = np.asarray(lm.eigenvalues, dtype=complex)
+    if tracks is not None or not path:
+        return LocusView(lam, leading_eigenvalue(lam), tracks)
     try:
         tracks = modes_along(space, along, rng.low, rng.high, num=num, log=rng.log)
         message = ""

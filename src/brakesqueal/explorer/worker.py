@@ -68,6 +68,11 @@ class LatestWorker:
             self._has_pending = True
             self._cv.notify()
 
+    @property
+    def superseded(self) -> bool:
+        """Whether a newer job waits (the running one may stop early)."""
+        return self._has_pending
+
     def cancel(self) -> None:
         """Cancel the running job and drop the pending one."""
         with self._cv:
