@@ -19,13 +19,19 @@ used by the Routh test (:func:`routh_interval`), by interval Horner
 from __future__ import annotations
 
 import math
+import os
 
 import numba
 import numpy as np
 
+# the parallel drivers below run on numba's OpenMP layer on this platform: idle threads sleep instead of spinning
+# (the default spin-wait burns a core on a shared machine); numba loads the layer at the first parallel call
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
 __all__ = ["peval", "real_roots", "routh_interval", "routh_batch", "quartic_interval_batch", "horner_interval",
            "descartes", "isolate_roots", "critical_batch", "quartic_factor", "quartic_top_grid", "quartic_top_rows",
-           "charpoly_grid", "UNSTABLE", "STABLE", "UNDECIDED"]
+           "charpoly_grid", "critical_batch_chunks", "charpoly_grid_chunks", "PARALLEL_MIN", "UNSTABLE", "STABLE",
+           "UNDECIDED"]
 
 _JIT = dict(cache=True, error_model="numpy")
 
@@ -406,7 +412,7 @@ def _illinois(c, rc, d, a, b, fa, fb, certified):  # type: ignore[no-untyped-def
     sa = 1.0 if fa > 0.0 else -1.0
     side = 0
     for _ in range(100):
-        if b - a <= 2.0 ** -51 * max(abs(a), abs(b)):
+        if b - a <= 2.0 ** -46 * max(abs(a), abs(b)):  # the caller certifies x (1 ± 2^-44)
             break
         if a > 0.0 and b > 2.0 * a:
             x = math.sqrt(a) * math.sqrt(b)  # wide positive bracket: bisect in log scale first
@@ -459,7 +465,7 @@ def _refine(c, rc, d, a, b, sa):  # type: ignore[no-untyped-def]
     if fa != 0.0 and fb != 0.0 and (fa > 0.0) != (fb > 0.0):
         lo, hi = _illinois(c, rc, d, a, b, fa, fb, False)
         x = 0.5 * (lo + hi)
-        for _ in range(3):
+        for _ in range(1):  # one Newton step polishes the estimate
             p, dp = _horner_d(c, d, x)
             if p == 0.0 or dp == 0.0:
                 break
@@ -948,7 +954,7 @@ def quartic_top_grid(A, lam_e, mr, fr, ok):  # type: ignore[no-untyped-def]
     The roots of row ``row`` are scaled by ``2^lam_e[row]``.
 
     Neighbouring points warm-start each other: along a row from the factors
-    of the two previous points (extrapolated), a row's first point from the
+    of the three previous points (quadratic extrapolation), a row's first point from the
     previous row's first point; a start that does not converge falls back to
     the Aberth cold start.  ``ok[row, j] = 0`` where no clean factorization
     was found (the caller recomputes those points by a robust route).
@@ -957,6 +963,7 @@ def quartic_top_grid(A, lam_e, mr, fr, ok):  # type: ignore[no-untyped-def]
     g = np.empty(4)
     p1 = np.empty(4)
     p2 = np.empty(4)
+    p3 = np.empty(4)
     first = np.empty(4)
     out = np.empty(2)
     have_first = False
@@ -965,7 +972,10 @@ def quartic_top_grid(A, lam_e, mr, fr, ok):  # type: ignore[no-untyped-def]
         hv = 0
         for j in range(n):
             warm = True
-            if hv >= 2:
+            if hv >= 3:  # quadratic extrapolation: on fine grids the start is within Newton's tolerance
+                for k in range(4):
+                    g[k] = 3.0 * (p1[k] - p2[k]) + p3[k]
+            elif hv == 2:
                 for k in range(4):
                     g[k] = 2.0 * p1[k] - p2[k]
             elif hv == 1:
@@ -982,6 +992,7 @@ def quartic_top_grid(A, lam_e, mr, fr, ok):  # type: ignore[no-untyped-def]
                 if hv == 0:
                     first[:] = g
                     have_first = True
+                p3[:] = p2
                 p2[:] = p1
                 p1[:] = g
                 hv += 1
@@ -1383,6 +1394,34 @@ def charpoly_grid(Q, RQ, xo, yi, valid, eigen, acc, codes, mr, fr):  # type: ign
                 have0 = True
                 first = False
             have = min(have + 1, 3)
+
+
+# ---------------------------------------------------------------- parallel drivers (independent chunks)
+#: Smallest batch split over threads (below it the thread start-up costs more than it saves).
+PARALLEL_MIN = 4096
+
+
+@numba.njit(parallel=True, **_JIT)
+def critical_batch_chunks(E_all, R_all, bounds, roots_out, dirs_out, counts, start_stable, flags, nchunk):  # type: ignore[no-untyped-def]  # noqa: E501
+    """:func:`critical_batch` on ``nchunk`` contiguous chunks of rows in parallel (identical results)."""
+    n = E_all.shape[0]
+    for q in numba.prange(nchunk):
+        a = q * n // nchunk
+        b = (q + 1) * n // nchunk
+        critical_batch(E_all[a:b], R_all[a:b], bounds, roots_out[a:b], dirs_out[a:b], counts[a:b],
+                       start_stable[a:b], flags[a:b])
+
+
+@numba.njit(parallel=True, **_JIT)
+def charpoly_grid_chunks(Q, RQ, xo, yi, valid, eigen, acc, codes, mr, fr, block):  # type: ignore[no-untyped-def]
+    """:func:`charpoly_grid` on blocks of ``block`` rows in parallel (each block warm-starts itself, so the
+    results do not depend on the number of threads)."""
+    n = xo.shape[0]
+    nchunk = (n + block - 1) // block
+    for q in numba.prange(nchunk):
+        a = q * block
+        b = min(n, a + block)
+        charpoly_grid(Q, RQ, xo[a:b], yi, valid[a:b], eigen, acc, codes[a:b], mr[a:b], fr[a:b])
 
 
 def _guard() -> None:

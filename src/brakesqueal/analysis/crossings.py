@@ -630,7 +630,7 @@ def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossing
     status : ndarray (n,) int8, only with ``return_status``
         0 if the result is complete, 5 if a part of the range stayed undecided.
     """
-    from ._compiled import critical_batch
+    from ._compiled import PARALLEL_MIN, critical_batch, critical_batch_chunks
 
     P = np.ascontiguousarray(np.atleast_2d(params), dtype=float)
     n = P.shape[0]
@@ -642,7 +642,10 @@ def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossing
     flags = np.zeros(n, dtype=np.uint8)
     status = np.zeros(n, dtype=np.int8)
     E, R = omega_entries(P, spec)
-    critical_batch(E, R, bounds, roots, dirs, counts, start, flags)
+    if n >= PARALLEL_MIN:
+        critical_batch_chunks(E, R, bounds, roots, dirs, counts, start, flags, max(1, n // (PARALLEL_MIN // 4)))
+    else:
+        critical_batch(E, R, bounds, roots, dirs, counts, start, flags)
     for i in np.flatnonzero(flags):
         st, found, undecided = exact_omega_crossings(P[i], float(lo), float(hi), spec)
         roots[i] = np.nan

@@ -1435,6 +1435,8 @@ def omega_subranges(lo: float, hi: float, decades: float = 6.0) -> np.ndarray:
 #: Relative accuracy of every root (Gerschgorin disk radius / |root|) that the characteristic-polynomial route
 #: requires before it reports ``max_real`` and the frequency (otherwise the point goes to the eigenvalue route).
 CHARPOLY_ACCURACY = 1e-9
+#: Rows per block of the characteristic-polynomial kernel (blocks run in parallel; each warm-starts itself).
+CHARPOLY_BLOCK = 64
 #: The route's name in results' ``method``.
 CHARPOLY_ROUTE = ("per point, compiled: certified roots of the exact characteristic polynomial det(λ²M + λD + K) "
                   "(Weierstrass/Gerschgorin inclusion disks, warm-started along rows); certified eigenvalue verdicts "
@@ -1634,7 +1636,7 @@ def charpoly_verdicts(table: CharpolyTable, outer_values: np.ndarray, inner_valu
     matrix ``diag(z) - 1 Wᵀ``, which contain every root of every polynomial
     within the coefficient bounds (:func:`~._compiled.charpoly_grid`).
     """
-    from ._compiled import charpoly_grid
+    from ._compiled import PARALLEL_MIN, charpoly_grid, charpoly_grid_chunks
 
     xo = np.ascontiguousarray(outer_values, dtype=float)
     yi = np.ascontiguousarray(inner_values, dtype=float)
@@ -1643,5 +1645,10 @@ def charpoly_verdicts(table: CharpolyTable, outer_values: np.ndarray, inner_valu
     codes = np.empty(shape, dtype=np.uint8)
     mr = np.empty(shape)
     fr = np.empty(shape)
-    charpoly_grid(table.Q, table.RQ, xo, yi, ok, bool(eigen), CHARPOLY_ACCURACY, codes, mr, fr)
+    if xo.size * yi.size >= PARALLEL_MIN and xo.size > CHARPOLY_BLOCK:
+        # blocks of rows in parallel; each block warm-starts itself (results independent of the thread count)
+        charpoly_grid_chunks(table.Q, table.RQ, xo, yi, ok, bool(eigen), CHARPOLY_ACCURACY, codes, mr, fr,
+                             CHARPOLY_BLOCK)
+    else:
+        charpoly_grid(table.Q, table.RQ, xo, yi, ok, bool(eigen), CHARPOLY_ACCURACY, codes, mr, fr)
     return codes, mr, fr
