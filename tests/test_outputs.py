@@ -65,7 +65,9 @@ def test_output_directory_below_a_regular_file_is_refused(tmp_path):
     (tmp_path / "file").write_text("x")
     with pytest.raises(OutputError, match="is a regular file"):
         check_output_dir(tmp_path / "file" / "results", what="--out")
-    assert check_output_dir(tmp_path / "a" / "b").is_dir()
+    assert check_output_dir(tmp_path / "a").is_dir()  # the output directory itself is created, not its parents
+    with pytest.raises(OutputError, match="directory '.*b' does not exist"):
+        check_output_dir(tmp_path / "b" / "a")
 
 
 @pytest.mark.skipif(os.geteuid() == 0, reason="root can write into read-only directories")

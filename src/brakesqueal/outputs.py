@@ -3,7 +3,9 @@
 Every command that writes a file checks its path first (:func:`check_output`)
 — the directory exists and is writable, the name is not a directory, the
 suffix is one the writer supports — so a typo fails in one line *before* a
-long computation.  Files are written through :func:`atomic_write`: the
+long computation.  One rule for every output, file, output directory
+(:func:`check_output_dir`) or sweep store: the directory that holds it must
+exist; missing parents are never created.  Files are written through :func:`atomic_write`: the
 content goes to a temporary file in the same directory which is renamed over
 the final name only when it is complete, so an interrupted or failed write
 (Ctrl-C, a full disk) never leaves a truncated file under the final name and
@@ -84,21 +86,36 @@ def check_output(path: str | os.PathLike[str], *, what: str = "output file",
 def check_output_dir(path: str | os.PathLike[str], *, what: str = "output directory") -> Path:
     """Check that ``path`` is (or can be created as) a writable directory; create it.
 
+    The rule of every output (:func:`check_output` for files, sweep stores):
+    the directory that *holds* the output must exist; the output directory
+    itself is created if missing, but never its parents (a typo in a path
+    fails in one line instead of creating a tree somewhere).
+
     Raises
     ------
     OutputError
-        One line when a regular file is in the way or the location is not writable.
+        One line when a regular file is in the way, the parent directory does
+        not exist, or the location is not writable.
     """
     p = Path(os.fspath(path))
-    for anc in [p, *p.parents]:
+    if p.exists():
+        if not p.is_dir():
+            raise OutputError(f"{what}: cannot use '{path}': it is a regular file, not a directory")
+        if not os.access(p, os.W_OK | os.X_OK):
+            raise OutputError(f"{what}: cannot use '{path}': the directory is not writable")
+        return p
+    parent = p.parent if str(p.parent) else Path(".")
+    for anc in [parent, *parent.parents]:
+        if anc.exists() and not anc.is_dir():
+            raise OutputError(f"{what}: cannot use '{path}': '{anc}' is a regular file, not a directory")
         if anc.exists():
-            if not anc.is_dir():
-                raise OutputError(f"{what}: cannot use '{path}': '{anc}' is a regular file, not a directory")
-            if not os.access(anc, os.W_OK | os.X_OK):
-                raise OutputError(f"{what}: cannot use '{path}': '{anc}' is not writable")
             break
+    if not parent.is_dir():
+        raise OutputError(f"{what}: cannot create '{path}': the directory '{parent}' does not exist")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise OutputError(f"{what}: cannot create '{path}': the directory '{parent}' is not writable")
     try:
-        p.mkdir(parents=True, exist_ok=True)
+        p.mkdir(exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{what}: cannot create '{path}': {describe_oserror(exc)}") from None
     return p

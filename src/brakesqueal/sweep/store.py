@@ -562,25 +562,26 @@ def remove_store(path: Path) -> None:
 
 # ---------------------------------------------------------------- location checks
 def check_location(path: Path) -> None:
-    """Check, before anything is computed, that a store can be made at ``path`` (creating missing parents).
+    """Check, before anything is computed, that a store can be made at ``path``.
+
+    The rule of every output (:mod:`brakesqueal.outputs`): the directory that
+    holds the store must exist; missing parents are never created.
 
     Raises
     ------
     StoreError
-        ``path`` is a file, a parent is not a directory or cannot be created.
+        ``path`` is a file, or its parent does not exist or is not a directory.
     """
     if path.exists() and not path.is_dir():
         raise StoreError(f"'{path}' is a file, not a sweep store; choose another store (--out)")
-    anc = path.parent
-    while not anc.exists() and anc != anc.parent:
-        anc = anc.parent
-    if not anc.is_dir():
-        raise StoreError(f"cannot create the store '{path}': '{anc}' is not a directory")
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise _NotWritable(f"cannot create the store '{path}': cannot create directory '{path.parent}' "
-                           f"({(exc.strerror or str(exc)).lower()})") from None
+    parent = path.parent
+    for anc in [parent, *parent.parents]:
+        if anc.exists() and not anc.is_dir():
+            raise StoreError(f"cannot create the store '{path}': '{anc}' is not a directory")
+        if anc.exists():
+            break
+    if not parent.is_dir():
+        raise StoreError(f"cannot create the store '{path}': the directory '{parent}' does not exist")
 
 
 def check_writable(path: Path) -> None:
