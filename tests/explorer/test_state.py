@@ -103,3 +103,21 @@ def test_cli_refuses_bad_input_with_status_2(capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "mu1" in err
     assert main(["explore", "--port", "70000", "--no-browser"]) == 2
+
+
+def test_non_loopback_host_warns():
+    import subprocess
+    import sys
+
+    pytest.importorskip("panel")
+    proc = subprocess.Popen([sys.executable, "-m", "brakesqueal", "explore", "--host", "0.0.0.0", "--port", "0",
+                             "--no-browser"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    lines: list[str] = []
+    try:
+        while len(lines) < 10 and not (lines and "explorer at" in lines[-1]):
+            lines.append(proc.stderr.readline())
+    finally:
+        proc.terminate()
+        proc.wait(10)
+    assert lines[0].startswith("brakesqueal: warning: serving on 0.0.0.0, not loopback")
+    assert lines[-1].startswith("brakesqueal: explorer at http://0.0.0.0:")
