@@ -28,6 +28,7 @@ CHUNK_SECONDS = 0.1
 #: Output samples post-processed per compiled call (about 0.1 s).
 _POST_BLOCK = 65536
 EventMode = Literal["stop", "continue", "off"]
+ContactLaw = Literal["bilateral", "unilateral"]
 _EPS = float(np.finfo(float).eps)
 
 
@@ -250,7 +251,7 @@ class SimulationModel:
         self.kernels.contact(yy, l, dl, p, cb)
         return cb.reshape(len(self.pads), 7)
 
-    def vector_field(self, params: Any, silent: SilentState | None = None
+    def vector_field(self, params: Any, silent: SilentState | None = None, engaged: Sequence[bool] | None = None
                      ) -> tuple[Callable[[np.ndarray], np.ndarray], Callable[[np.ndarray], np.ndarray]]:
         """``f(y)`` and its exact Jacobian ``f_y(y)`` at fixed parameters (the pad unknowns solved, warm-started).
 
@@ -263,6 +264,12 @@ class SimulationModel:
             The parameters.
         silent : SilentState, optional
             The silent motion (default: computed).
+        engaged : sequence of bool, optional
+            Unilateral contact: which pads are pressed (default all).  With a
+            lifted pad ``f`` is the integrator's right-hand side without that
+            pad's contact force and ``f_y`` is a fourth-order central
+            difference of it (steps ``1e-4`` of each component's scale:
+            relative error about ``1e-12``-``1e-10``).
 
         Returns
         -------
@@ -281,14 +288,34 @@ class SimulationModel:
         l, dl = st.l.copy(), st.dl.copy()
         g, mw = np.empty(2 * len(l) + 1), np.empty(n * n + n)
         ny = st.y.size
+        eng = np.ones(len(self.pads), dtype=np.int64) if engaged is None else np.asarray(engaged, dtype=np.int64)
+        if eng.shape != (len(self.pads),):
+            raise ParameterError(f"'engaged' must have one entry per pad ({len(self.pads)}); got {eng.size}")
+        D = np.empty(len(self.pads) * n + 1)
 
         def f(y: np.ndarray) -> np.ndarray:
             out = np.empty(ny)
-            k.rhs(np.ascontiguousarray(y, dtype=float), l, dl, p, st.ztol, g, mw, out)
+            k.rhs_u(np.ascontiguousarray(y, dtype=float), l, dl, p, st.ztol, g, mw, eng, D, out)
             if not np.all(np.isfinite(out)):
                 raise ParameterError("the equations of motion cannot be solved at this state (pad equations or "
                                      "a singular mass matrix)")
             return out
+
+        if not eng.all():
+            scale = np.abs(st.y) + np.concatenate([_scales(self, params)[:n], _scales(self, params)[:n] * 1e3,
+                                                   _scales(self, params)[n:]]) * 1e-3
+
+            def jac_fd(y: np.ndarray) -> np.ndarray:
+                y = np.asarray(y, dtype=float)
+                J = np.empty((ny, ny))
+                for i in range(ny):
+                    h = 1e-4 * max(scale[i], abs(y[i]))
+                    e = np.zeros(ny)
+                    e[i] = h
+                    J[:, i] = (8 * (f(y + e) - f(y - e)) - (f(y + 2 * e) - f(y - 2 * e))) / (12 * h)
+                return J
+
+            return f, jac_fd
 
         def jac(y: np.ndarray) -> np.ndarray:
             y = np.ascontiguousarray(y, dtype=float)
@@ -555,6 +582,7 @@ def simulate(
     max_steps: int = 50_000_000,
     progress: Callable[[float], None] | None = None,
     estimate_samples: int = 65536,
+    contact: ContactLaw = "bilateral",
 ) -> Trajectory:
     r"""Integrate the nonlinear equations of any model (eq. 44 generalized) from a perturbed silent motion.
 
@@ -612,6 +640,23 @@ def simulate(
         fastest linear mode (:func:`estimation_rate`), of which the last
         ``estimate_samples`` are kept (a ring buffer).  :attr:`Trajectory.summary`
         is computed from it.
+    contact : {"bilateral", "unilateral"}
+        ``"bilateral"`` (default): the equations hold with any sign of ``F_n``
+        (``events`` decides what happens at a contact loss).
+        ``"unilateral"``: the normal force of every pad is ``max(0, F_n)``
+        (``docs/simulation.md``, unilateral contact): at ``F_n = 0`` the pad
+        lifts off (its contact force and friction vanish, the run goes on), and it
+        comes back when its ``F_n`` (the force the support would exert at
+        the disk's surface) turns positive again; lift-offs and re-contacts
+        are recorded in :attr:`Trajectory.event_times`
+        (``contact-loss-pad-<name>``, ``re-contact-pad-<name>``) and the
+        contact state per sample in :attr:`Trajectory.engaged`.  Needs
+        ``method="DOP853-jit"`` and events ``"stop"`` (the run stops at a
+        sliding reversal, where Coulomb friction would stick) or
+        ``"continue"`` (sliding reversals recorded, the friction direction
+        follows ``v_r/|v_r|``).  Not available for pads with rate-dependent
+        friction (their tangential deformation is a state whose law while
+        lifted off is not modelled).
 
     Returns
     -------
@@ -641,6 +686,11 @@ def simulate(
         raise ParameterError(f"The option 'method' must be one of {', '.join(METHODS)}; got {method!r}")
     if events not in ("stop", "continue", "off"):
         raise ParameterError(f"The option 'events' must be one of stop, continue, off; got {events!r}")
+    if contact not in ("bilateral", "unilateral"):
+        raise ParameterError(f"The option 'contact' must be bilateral or unilateral; got {contact!r}")
+    if contact == "unilateral" and (method != "DOP853-jit" or events == "off"):
+        raise ParameterError("contact='unilateral' needs method='DOP853-jit' and events 'stop' or 'continue'; got "
+                             f"method={method!r}, events={events!r}")
     if np.ndim(t_span) == 0:
         t0, t1 = 0.0, float(t_span)  # type: ignore[arg-type]
     else:
@@ -661,11 +711,11 @@ def simulate(
 
     with interrupt_guard():
         return _simulate(model, as_parameters(params), t0, t1, x0, perturbation, method, rtol, atol, sample_rate,
-                         events, max_step, max_steps, progress, estimate_samples, n_out)
+                         events, max_step, max_steps, progress, estimate_samples, n_out, contact)
 
 
 def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sample_rate, events, max_step,
-              max_steps, progress, estimate_samples, n_out):  # type: ignore[no-untyped-def]
+              max_steps, progress, estimate_samples, n_out, contact="bilateral"):  # type: ignore[no-untyped-def]
     from ._interrupt import check_interrupt
 
     if not isinstance(model, SimulationModel):
@@ -673,6 +723,11 @@ def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sampl
     check_interrupt()
     params = model.parameters(params)
     p = model.parameter_vector(params)
+    unilateral = contact == "unilateral"
+    if unilateral and model.dynamic:
+        raise ParameterError(f"contact='unilateral' is not available for pads with rate-dependent friction "
+                             f"({', '.join(model.dynamic)}): their tangential deformation is a state whose law "
+                             "while lifted off is not modelled; use coulomb friction or contact='bilateral'")
     try:
         st = model.silent(params)
     except SilentMotionError as exc:
@@ -691,16 +746,22 @@ def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sampl
     k.event_values(y0, l0, dl0, p, st.vr0, np.empty(7 * npad), ev0)
     if not np.all(np.isfinite(f0)) or not np.all(np.isfinite(ev0)):
         raise ParameterError(f"the equations cannot be evaluated at the initial state {y0.tolist()}")
+    eng0 = (ev0[:npad] > 0).astype(np.int64) if unilateral else np.ones(npad, dtype=np.int64)
     for j, pad in enumerate(model.pads):
-        if ev0[j] <= 0:
+        if ev0[j] <= 0 and not unilateral:
             raise ParameterError(f"pad '{pad}' is out of contact at the initial state (F_n = {ev0[j]:.6g} N <= 0); "
                                  "use a smaller initial perturbation")
-        if ev0[npad + j] <= 0 and events != "off":
+        if ev0[npad + j] <= 0 and events != "off" and eng0[j]:
             raise ParameterError(f"pad '{pad}' does not slide forward at the initial state; use a smaller "
                                  "perturbation")
     t_out = t0 + np.arange(n_out) / sample_rate
     est = _EstimationGrid(t0, 1.0 / estimation_rate(modes, t1 - t0), int(estimate_samples), y0.size)
-    run = _Run(model, p, st, y0, l0, dl0, f0, ev0, t0, t1, rtol, atol_v, max_step, t_out, est, events, progress)
+    if unilateral and not eng0.all():
+        D0 = np.empty(npad * model.n + 1)
+        k.rhs_u(y0, l0, dl0, p, st.ztol, g, mw, eng0, D0, f0)
+        k.event_values_u(y0, l0, dl0, p, st.vr0, np.empty(7 * npad), eng0, ev0)
+    run = _Run(model, p, st, y0, l0, dl0, f0, ev0, t0, t1, rtol, atol_v, max_step, t_out, est, events, progress,
+               eng0 if unilateral else None)
     wall = time.perf_counter()
     res = run.jit(max_steps) if method == "DOP853-jit" else run.scipy(method)
     wall = time.perf_counter() - wall
@@ -715,6 +776,10 @@ def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sampl
         b = min(a + _POST_BLOCK, n)
         k.post_process(Y[a:b], b - a, lw, dlw, p, st.ztol, L[a:b], dL[a:b], C[a:b], E[a:b])
         check_interrupt()
+    engaged = None
+    if unilateral:
+        engaged = engagement_at(t_out[:n], eng0.astype(bool), res.get("switch_times", [[] for _ in range(npad)]))
+        C[:, 0::7] = np.where(engaged, C[:, 0::7], 0.0)  # the acting normal force max(0, F_n)
     return Trajectory(
         status=res["status"], message=res["message"], t=t_out[:n], y=Y, l=L, contact=C.reshape(n, npad, 7),
         energy_terms=E, params=params, q0=np.asarray(st.silent.q0, dtype=float).copy(), method=method, rtol=rtol,
@@ -723,7 +788,32 @@ def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sampl
         model=model.name, record=est.record(), modes=modes, sample_rate=float(sample_rate), y_start=y0.copy(),
         start=start, coords=model.coords, pads=model.pads, pad_unknowns=model.pad_unknowns, dynamic=model.dynamic,
         tilting=model.tilting, y_silent=st.y.copy(), l_rates=dL, event_pad=res.get("event_pad"),
+        contact_law=contact, engaged=engaged,
     )  # fmt: skip
+
+
+def engagement_at(t: np.ndarray, engaged0: np.ndarray, switch_times: Sequence[Sequence[float]]) -> np.ndarray:
+    """Contact state of every pad at the times ``t`` from its initial state and its switching times.
+
+    Parameters
+    ----------
+    t : ndarray, shape (N,)
+        Times (increasing).
+    engaged0 : ndarray of bool, shape (n_pads,)
+        Whether each pad is pressed at the start.
+    switch_times : sequence of sequences
+        Per pad, its lift-off and re-contact times in increasing order.
+
+    Returns
+    -------
+    ndarray of bool, shape (N, n_pads)
+        A pad switched at time ``t_s`` has its new state from ``t > t_s`` on.
+    """
+    out = np.empty((t.size, engaged0.size), dtype=bool)
+    for j in range(engaged0.size):
+        flips = np.searchsorted(np.asarray(switch_times[j], dtype=float), t)  # switches at times < t
+        out[:, j] = engaged0[j] ^ (flips % 2 == 1)
+    return out
 
 
 class _EstimationGrid:
@@ -775,16 +865,17 @@ class _Run:
     """One integration: the compiled DOP853 in calls of bounded wall time, or SciPy's ``solve_ivp``."""
 
     def __init__(self, model, p, st, y0, l0, dl0, f0, ev0, t0, t1, rtol, atol, max_step, t_out, est, events,
-                 progress):  # type: ignore[no-untyped-def]
+                 progress, engaged=None):  # type: ignore[no-untyped-def]
         self.model, self.p, self.st = model, p, st
         self.y0, self.l0, self.dl0, self.f0, self.ev0 = y0, l0, dl0, f0, ev0
         self.t0, self.t1, self.rtol, self.atol, self.max_step = t0, t1, rtol, atol, max_step
         self.t_out, self.est, self.events, self.progress = t_out, est, events, progress
         self.npad = len(model.pads)
+        self.engaged = engaged
 
     def _event_name(self, k: int) -> tuple[str, str]:
         pad = self.model.pads[k % self.npad]
-        return ("contact-loss" if k < self.npad else "sliding-reversal"), pad
+        return (("contact-loss", "sliding-reversal", "re-contact")[k // self.npad]), pad
 
     def _status(self, code: int, t: float, k_event: int, t_event: float | None) -> tuple[str, str]:
         if code == 0:
@@ -798,6 +889,8 @@ class _Run:
             -1: "step size became too small",
             -2: "the state became non-finite or the pad equations G = 0 could not be solved",
             -3: "the step budget max_steps was exhausted",
+            -4: "a pad's contact switched twice within 10 minimal steps (chattering contact, e.g. a pad pressed "
+                "with zero force while the disk moves along its surface)",
         }.get(code, f"integrator error {code}")
         return "failed", f"integration failed at t = {t:.6g} s: {reason}"
 
@@ -809,8 +902,14 @@ class _Run:
         N = self.y0.size
         Y = np.full((self.t_out.size, N), np.nan)
         mode = {"off": 0, "stop": 1, "continue": 2}[self.events]
+        eng = np.ones(self.npad, dtype=np.int64)
+        if self.engaged is not None:
+            mode = 4 if self.events == "stop" else 3
+            eng = self.engaged.copy()
         ev_t = np.zeros(10000)
         ev_k = np.zeros(10000, dtype=np.int64)
+        drained_t: list[np.ndarray] = []
+        drained_k: list[np.ndarray] = []
         y, f, l, dl, ev_old = self.y0.copy(), self.f0.copy(), self.l0.copy(), self.dl0.copy(), self.ev0.copy()
         ev_prev = np.full(ev_old.size, np.inf)
         stats = np.zeros(3, dtype=np.int64)
@@ -828,7 +927,11 @@ class _Run:
             status, t, h, i_out, i_est, n_ev, k_event, t_event = k.dop853(
                 y, f, l, dl, ev_old, ev_prev, self.p, st.ztol, st.vr0, t, self.t1, h, self.rtol, self.atol,
                 self.max_step, self.t_out, i_out, Y, est.t0, est.dt, i_est, est.buf, mode, ev_t, ev_k, n_ev, chunk,
-                stats, y_event, *tables)  # fmt: skip
+                stats, y_event, eng, *tables)  # fmt: skip
+            if mode >= 3:  # unilateral: every switch is kept (the buffer is drained after each call)
+                drained_t.append(ev_t[:n_ev].copy())
+                drained_k.append(ev_k[:n_ev].copy())
+                n_ev = 0
             dt = time.perf_counter() - w0
             check_interrupt()
             est.count = int(i_est)
@@ -837,15 +940,22 @@ class _Run:
             if status != 2:
                 break
             budget = int(min(max(budget * CHUNK_SECONDS / max(dt, 1e-4), 16), 10_000_000))
+        if mode >= 3:
+            ev_t = np.concatenate(drained_t) if drained_t else np.zeros(0)
+            ev_k = np.concatenate(drained_k) if drained_k else np.zeros(0, dtype=np.int64)
+            n_ev = ev_t.size
         recorded: dict[str, list[float]] = {}
+        switches: list[list[float]] = [[] for _ in range(self.npad)]
         for i in range(min(n_ev, ev_t.size)):
             kind, pad = self._event_name(int(ev_k[i]))
             recorded.setdefault(f"{kind}-pad-{pad}", []).append(float(ev_t[i]))
+            if mode >= 3 and kind != "sliding-reversal":
+                switches[int(ev_k[i]) % self.npad].append(float(ev_t[i]))
         te = float(t_event) if status == 1 else None
         st_, msg = self._status(status, t, k_event, te)
         return {"status": st_, "message": msg, "Y": Y, "n": i_out, "nfev": int(stats[0]), "t_event": te,
                 "y_event": y_event.copy() if status == 1 else None, "event_times": recorded,
-                "event_pad": self._event_name(k_event)[1] if status == 1 else None,
+                "event_pad": self._event_name(k_event)[1] if status == 1 else None, "switch_times": switches,
                 "stats": {"steps": int(stats[1]), "rejected": int(stats[2])}}  # fmt: skip
 
     def scipy(self, method: str) -> dict[str, Any]:

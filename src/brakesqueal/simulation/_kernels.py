@@ -151,8 +151,18 @@ def _expressions(spec: Any) -> dict[str, Any]:
     for c, l in zip(eq.pads, eq.tangential):
         contact += [qs(c.F_n), qs(c.v_r[0]), qs(c.v_r[1]), qs(c.v_r[2]), qs(c.h), qs(c.hdot), qs(l)]
     energy = _energy(se, eq)
+    # unilateral contact: R = R(chi = 0) + sum_j chi_j D_j with chi_j the factor of pad j's contact force f_p
+    chi = [se.Symbol(f"chi__{j}") for j in range(len(spec.pads))]
+    eq_u = build_equations(spec, engagement={pad.name: c for pad, c in zip(spec.pads, chi)})
+    release = []
+    for j in range(len(spec.pads)):
+        for i in range(n):
+            r = qs(eq_u.R[i])
+            e = r.diff(chi[j]) if chi[j] in r.free_symbols else se.Integer(0)
+            _check_free(f"dR[{i}]/dchi[{j}]", e, ddQ | set(chi))  # the contact force is linear in chi, free of Qddot
+            release.append(e)
     return {"eq": eq, "kinds": kinds, "mass_force": Mx + f, "pad_balance": bal + dbal, "contact": contact,
-            "energy": [qs(e) for e in energy], "pad_scale": scale}
+            "energy": [qs(e) for e in energy], "pad_scale": scale, "release": release}
 
 
 def _pad_scales(se: Any, eq: Any) -> list[Any]:
@@ -291,6 +301,33 @@ def rhs(y, l, dl, p, ztol, g, mw, out):
     """
     ok = solve_pads(y, l, dl, p, ztol, g)
     mass_force(y, l, dl, p, mw)
+    _accelerations(y, dl, ok, mw, out)
+
+
+@njit(cache=True)
+def rhs_u(y, l, dl, p, ztol, g, mw, eng, D, out):
+    """rhs with unilateral contact: the contact force of every pad with eng[j] == 0 (lifted off) removed.
+
+    f = f0 + sum_j chi_j D_j (the generated ``release``); D: scratch of NPAD * N entries.
+    """
+    ok = solve_pads(y, l, dl, p, ztol, g)
+    mass_force(y, l, dl, p, mw)
+    off = False
+    for j in range(_NPAD):
+        if eng[j] == 0:
+            off = True
+    if off:
+        release(y, l, dl, p, D)
+        for j in range(_NPAD):
+            if eng[j] == 0:
+                for i in range(_N):
+                    mw[_N * _N + i] -= D[j * _N + i]
+    _accelerations(y, dl, ok, mw, out)
+
+
+@njit(cache=True)
+def _accelerations(y, dl, ok, mw, out):
+    """out = (Qdot, Qddot, Ldot_dyn) from M, f in mw (M Qddot = -f, partial pivoting); NaN if singular or not ok."""
     n = _N
     f0 = n * n
     for i in range(n):
@@ -342,6 +379,17 @@ def event_values(y, l, dl, p, vr0, cb, out):
         b = 7 * j
         out[j] = cb[b]
         out[_NPAD + j] = cb[b + 1] * vr0[3 * j] + cb[b + 2] * vr0[3 * j + 1] + cb[b + 3] * vr0[3 * j + 2]
+
+
+@njit(cache=True)
+def event_values_u(y, l, dl, p, vr0, cb, eng, out):
+    """event_values with unilateral contact: a lifted pad's contact function is -F_n (re-contact at <= 0) and its
+    sliding-reversal function is 1 (no friction)."""
+    event_values(y, l, dl, p, vr0, cb, out)
+    for j in range(_NPAD):
+        if eng[j] == 0:
+            out[j] = -out[j]
+            out[_NPAD + j] = 1.0
 
 
 @njit(cache=True)
@@ -413,22 +461,22 @@ def _error_norm(K, E5, E3, h, scale):
 
 
 @njit(cache=True)
-def _event_at(k, x, F, y, l, dl, p, ztol, vr0, g, cb, ev, yint):
+def _event_at(k, x, F, y, l, dl, p, ztol, vr0, g, cb, ev, yint, eng):
     """Event function k at normalized time x of the step (pad unknowns solved from l, dl, updated)."""
     dense_eval(F, y, x, yint)
     solve_pads(yint, l, dl, p, ztol, g)
-    event_values(yint, l, dl, p, vr0, cb, ev)
+    event_values_u(yint, l, dl, p, vr0, cb, eng, ev)
     return ev[k]
 
 
 @njit(cache=True)
-def _bisect(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb):
+def _bisect(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb, eng):
     """First x in [a, b] with event k <= 0, given event k > 0 at a and <= 0 at b (60 halvings; returns the <= 0 end)."""
     lb[:] = l0
     dlb[:] = dl0
     for _ in range(60):
         c = 0.5 * (a + b)
-        if _event_at(k, c, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint) > 0.0:
+        if _event_at(k, c, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint, eng) > 0.0:
             a = c
         else:
             b = c
@@ -436,15 +484,15 @@ def _bisect(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb):
 
 
 @njit(cache=True)
-def _golden(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb):
+def _golden(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb, eng):
     """Minimum of event k on [a, b] (48 golden-section steps): returns (x, value); stops early at a value <= 0."""
     lb[:] = l0
     dlb[:] = dl0
     r = 0.6180339887498949
     c = b - r * (b - a)
     d = a + r * (b - a)
-    fc = _event_at(k, c, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint)
-    fd = _event_at(k, d, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint)
+    fc = _event_at(k, c, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint, eng)
+    fd = _event_at(k, d, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint, eng)
     for _ in range(48):
         if fc <= 0.0:
             return c, fc
@@ -455,13 +503,13 @@ def _golden(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb):
             d = c
             fd = fc
             c = b - r * (b - a)
-            fc = _event_at(k, c, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint)
+            fc = _event_at(k, c, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint, eng)
         else:
             a = c
             c = d
             fc = fd
             d = a + r * (b - a)
-            fd = _event_at(k, d, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint)
+            fd = _event_at(k, d, F, y, lb, dlb, p, ztol, vr0, g, cb, ev, yint, eng)
     if fc < fd:
         return c, fc
     return d, fd
@@ -469,7 +517,7 @@ def _golden(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb):
 
 @njit(cache=True)
 def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol, max_step, t_out, i_out, Y, te0, dte,
-           i_est, Yest, event_mode, ev_t, ev_k, n_ev, budget, stats, y_event, A, B, C, E3, E5, D):
+           i_est, Yest, event_mode, ev_t, ev_k, n_ev, budget, stats, y_event, eng, A, B, C, E3, E5, D):
     """Adaptive DOP853 from t towards t1 (SciPy's algorithm), at most ``budget`` accepted steps per call.
 
     Integrator state, updated in place: y (state), f (its derivative), l, dl (pad unknowns, solved at y),
@@ -478,10 +526,14 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
     per step are bisected; a sampled minimum within twice the second difference of zero (a grazing dip) is
     located by golden-section search and, if it is <= 0, the crossing before it is bisected.
     Dense output at t_out[i_out:] goes into Y; at te0 + i dte (i = i_est, ...) into the ring buffer Yest
-    (row i % Yest.shape[0]).  event_mode: 0 = none, 1 = stop at the first event, 2 = record and continue.
+    (row i % Yest.shape[0]).  event_mode: 0 = none, 1 = stop at the first event, 2 = record and continue,
+    3 = unilateral contact (eng[j] = 1 pressed, 0 lifted; a contact event ends the step there and switches the
+    pad: recorded as k = j for a lift-off, 2 NPAD + j for a re-contact), sliding reversals recorded, 4 = the same
+    but stop at a sliding reversal.
     Returns (status, t, h_abs, i_out, i_est, n_ev, k_event, t_event): status 0 = reached t1,
-    1 = stopped at an event (state in y_event), 2 = budget used (call again to continue),
-    -1 = step size too small, -2 = non-finite state or pad equations unsolvable.
+    1 = stopped at an event (state in y_event), 2 = budget used or event buffer full (call again to continue),
+    -1 = step size too small, -2 = non-finite state or pad equations unsolvable, -4 = a pad switched twice
+    within 10 minimal steps (chattering contact).
     """
     n = y.shape[0]
     SAFETY = 0.9
@@ -512,11 +564,14 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
     dlint = dl.copy()
     lb = l.copy()
     dlb = dl.copy()
+    Dw = np.empty(_NPAD * _N + 1)
+    t_switch = np.full(_NPAD, -math.inf)
+    slide_t = np.empty(_NPAD)
     k_event = -1
     t_event = math.nan
     steps = 0
     while t < t1:
-        if steps >= budget:
+        if steps >= budget or (event_mode >= 3 and n_ev + 2 * _NPAD + 2 > ev_t.shape[0]):
             return (2, t, h_abs, i_out, i_est, n_ev, k_event, t_event)
         min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
         if h_abs > max_step:
@@ -542,13 +597,13 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
                     for q in range(s):
                         acc += K[q, j] * A[s, q]
                     ystage[j] = y[j] + h * acc
-                rhs(ystage, lnew, dlnew, p, ztol, g, mw, K[s])
+                rhs_u(ystage, lnew, dlnew, p, ztol, g, mw, eng, Dw, K[s])
             for j in range(n):
                 acc = 0.0
                 for q in range(12):
                     acc += K[q, j] * B[q]
                 ynew[j] = y[j] + h * acc
-            rhs(ynew, lnew, dlnew, p, ztol, g, mw, fnew)
+            rhs_u(ynew, lnew, dlnew, p, ztol, g, mw, eng, Dw, fnew)
             stats[0] += 12
             for j in range(n):
                 K[12, j] = fnew[j]
@@ -590,7 +645,7 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
                     for q in range(s):
                         acc += K[q, j] * A[s, q]
                     ystage[j] = y[j] + h * acc
-                rhs(ystage, lnew, dlnew, p, ztol, g, mw, K[s])
+                rhs_u(ystage, lnew, dlnew, p, ztol, g, mw, eng, Dw, K[s])
             stats[0] += 3
             for j in range(n):
                 dy = ynew[j] - y[j]
@@ -604,6 +659,7 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
                     F[3 + r, j] = h * acc
         t_stop = t_new
         stop = False
+        switch = -1
         if event_mode > 0:
             # event values at NSUB + 1 points of the step (dense output; the end with the saved pad unknowns)
             for k in range(_NEV):
@@ -614,19 +670,21 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
             dlint[:] = dl
             for sub in range(1, NSUB + 1):
                 if sub == NSUB:
-                    event_values(ynew, lsave, dlsave, p, vr0, cb, ev_new)
+                    event_values_u(ynew, lsave, dlsave, p, vr0, cb, eng, ev_new)
                     Ls[sub, :] = lsave
                     dLs[sub, :] = dlsave
                 else:
                     dense_eval(F, y, sub / NSUB, yint)
                     solve_pads(yint, lint, dlint, p, ztol, g)
-                    event_values(yint, lint, dlint, p, vr0, cb, ev_new)
+                    event_values_u(yint, lint, dlint, p, vr0, cb, eng, ev_new)
                     Ls[sub, :] = lint
                     dLs[sub, :] = dlint
                 for k in range(_NEV):
                     evs[sub, k] = ev_new[k]
             first = -1
             tf = t_new
+            for k in range(_NPAD):
+                slide_t[k] = math.nan
             for k in range(_NEV):
                 # in time order: a sign change between two points (bisected), or a sampled minimum close to zero
                 # (a grazing dip: the minimum is located by golden-section search, and a crossing before it bisected)
@@ -636,7 +694,7 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
                     nxt = i + 1
                     if i >= 1 and evs[i - 1, k] > 0.0 and evs[i, k] <= 0.0:
                         xc = _bisect(k, (i - 1) / NSUB, i / NSUB, F, y, Ls[i - 1], dLs[i - 1], p, ztol, vr0, g, cb,
-                                     ev_mid, yint, lb, dlb)
+                                     ev_mid, yint, lb, dlb, eng)
                     elif evs[i, k] > 0.0:
                         left = evs[i - 1, k] if i >= 1 else ev_prev[k]
                         right = evs[i + 1, k] if i < NSUB else math.inf
@@ -647,13 +705,16 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
                                 lo = max(i - 1, 0)
                                 hi = min(i + 1, NSUB)
                                 xm, vm = _golden(k, lo / NSUB, hi / NSUB, F, y, Ls[i], dLs[i], p, ztol, vr0, g, cb,
-                                                 ev_mid, yint, lb, dlb)
+                                                 ev_mid, yint, lb, dlb, eng)
                                 if vm <= 0.0:
                                     xc = _bisect(k, lo / NSUB, xm, F, y, Ls[lo], dLs[lo], p, ztol, vr0, g, cb,
-                                                 ev_mid, yint, lb, dlb)
+                                                 ev_mid, yint, lb, dlb, eng)
                                     nxt = hi + 1
                     if xc >= 0.0:
                         tk = t + xc * h
+                        if event_mode == 3 and k >= _NPAD:
+                            slide_t[k - _NPAD] = tk  # recorded below if before a contact switch
+                            break
                         if event_mode == 2:
                             if n_ev < ev_t.shape[0]:
                                 ev_t[n_ev] = tk
@@ -671,6 +732,26 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
                 t_stop = tf
                 k_event = first
                 t_event = tf
+            if event_mode >= 3:
+                for k in range(_NPAD):
+                    if slide_t[k] == slide_t[k] and slide_t[k] <= tf:
+                        ev_t[n_ev] = slide_t[k]
+                        ev_k[n_ev] = _NPAD + k
+                        n_ev += 1
+                if first >= _NPAD:  # a sliding reversal (event_mode 4): stop
+                    stop = True
+                    t_stop = tf
+                    k_event = first
+                    t_event = tf
+                elif first >= 0:  # lift-off or re-contact of pad `first`: end the step there and switch
+                    if tf - t_switch[first] <= 10.0 * min_step:
+                        return (-4, tf, h_abs, i_out, i_est, n_ev, first, tf)
+                    t_switch[first] = tf
+                    switch = first
+                    t_stop = tf
+                    ev_t[n_ev] = tf
+                    ev_k[n_ev] = first if eng[first] == 1 else 2 * _NPAD + first
+                    n_ev += 1
             for k in range(_NEV):
                 ev_prev[k] = evs[NSUB - 1, k]
                 ev_old[k] = evs[NSUB, k]
@@ -688,6 +769,18 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
             for j in range(n):
                 Yest[r, j] = yint[j]
             i_est += 1
+        if switch >= 0:
+            # continue from the switching point in the other contact state (the step beyond it is discarded)
+            t = t_stop
+            eng[switch] = 1 - eng[switch]
+            for j in range(n):
+                y[j] = y_event[j]
+            rhs_u(y, l, dl, p, ztol, g, mw, eng, Dw, f)
+            stats[0] += 1
+            event_values_u(y, l, dl, p, vr0, cb, eng, ev_old)
+            for k in range(_NEV):
+                ev_prev[k] = ev_old[k]  # no grazing test at the switching point itself
+            continue
         t = t_new
         for j in range(n):
             y[j] = ynew[j]
@@ -742,6 +835,9 @@ def kernel_source(spec: Any) -> str:
         FunctionSpec("contact", args, ex["contact"],
                      "Per pad: F_n [N], v_r (3) [m/s], h [m], hdot [m/s], l [m] (eqs. 12-34)."),
         FunctionSpec("energy", args, ex["energy"], "T2, T1, T0, V_support, V_pads [J]."),
+        FunctionSpec("release", args, ex["release"],
+                     "Per pad j, the part D_j of the forcing f due to its contact force f_p (n entries): f = f0 + "
+                     "sum_j chi_j D_j; a lifted pad (chi_j = 0) is removed by f - D_j."),
         FunctionSpec("pad_scale", args, ex["pad_scale"],
                      "Per pad unknown: |l| + |u_m| + |c f_t| + |c mu* N0|, the size of the terms of G_j [m]."),
     ]

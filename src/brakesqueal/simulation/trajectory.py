@@ -452,8 +452,9 @@ class Trajectory:
     t_event, y_event : float or None, ndarray or None
         Time and state of the terminal event, if the run stopped at one.
     event_times : dict
-        Recorded event times by name (``events="continue"``):
-        ``contact-loss-pad-<name>``, ``sliding-reversal-pad-<name>``.
+        Recorded event times by name (``events="continue"`` or unilateral
+        contact): ``contact-loss-pad-<name>``, ``sliding-reversal-pad-<name>``,
+        ``re-contact-pad-<name>``.
     stats : dict
         ``nfev``, ``wall_s`` and (compiled method) ``steps``, ``rejected``.
     model : str
@@ -518,6 +519,8 @@ class Trajectory:
     y_silent: np.ndarray | None = None
     l_rates: np.ndarray | None = None
     event_pad: str | None = None
+    contact_law: str = "bilateral"
+    engaged: np.ndarray | None = None
 
     # ---------------------------------------------------------------- structure
     @property
@@ -559,8 +562,13 @@ class Trajectory:
 
     @property
     def normal_forces(self) -> np.ndarray:
-        """``F_n`` of every pad [N], shape (N, n_pads)."""
+        """``F_n`` of every pad [N], shape (N, n_pads) (unilateral contact: the acting force, 0 while lifted off)."""
         return self.contact[:, :, 0]
+
+    @property
+    def duty_cycle(self) -> np.ndarray | None:
+        """Fraction of the output samples each pad is pressed, shape (n_pads,) (``None`` for bilateral contact)."""
+        return None if self.engaged is None else self.engaged.mean(axis=0)
 
     @property
     def sliding_velocities(self) -> np.ndarray:
@@ -784,7 +792,7 @@ class Trajectory:
             "event_times": json.dumps(self.event_times),
             "pad_treatment": json.dumps({name: ("dynamic" if name in self.dynamic else "quasi-static")
                                          for name in self.pad_unknowns}),
-            "audio_velocity": what,
+            "audio_velocity": what, "contact_law": self.contact_law,
         }  # fmt: skip
         for k, v in self.summary.to_dict().items():
             if k == "status":
@@ -813,6 +821,9 @@ class Trajectory:
         coords: dict[str, Any] = {"time": ("time", self.t, {"units": "s"}), "coord": list(self.coords),
                                   "pad": list(self.pads), "component": ["x0", "y0", "z0"],
                                   "Q0": ("coord", self.q0)}  # fmt: skip
+        if self.engaged is not None:
+            data["engaged"] = (("time", "pad"), self.engaged.astype(np.int8),
+                               {"long_name": "pad pressed (1) or lifted off (0)"})
         if self.dynamic:
             data["L_state"] = (("time", "pad_state"), self.y[:, 2 * n:], {"units": "m"})
             coords["pad_state"] = list(self.dynamic)

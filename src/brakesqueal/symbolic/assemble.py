@@ -155,7 +155,7 @@ class _Values:
 
 
 def build_equations(spec: Any, backend: Backend = "symengine", *, kronecker: bool = True,
-                    keep_q3: bool = False) -> Equations:
+                    keep_q3: bool = False, engagement: Any = None) -> Equations:
     """Assemble the nonlinear equations of a model.
 
     Parameters
@@ -172,6 +172,9 @@ def build_equations(spec: Any, backend: Backend = "symengine", *, kronecker: boo
     keep_q3 : bool
         Keep the spin angle ``q3`` as a symbol (it drops out for an
         axisymmetric disk; tests check that).  Default: ``q3 = 0``.
+    engagement : mapping, optional
+        Pad name -> factor of that pad's contact force (unilateral contact in
+        the simulation kernels); default: every pad pressed.
 
     Returns
     -------
@@ -255,6 +258,7 @@ def build_equations(spec: Any, backend: Backend = "symengine", *, kronecker: boo
             N0=N0, nominal_speed=Omega * r, k=val(pad.k), d=val(pad.d), w_m=w_m,
             normal_dof=Q[_name("w", pad.name)] if normal else None, k_c=val(pad.k_c) if normal else None,
             d_c=val(pad.d_c) if normal else None, u_m=u_m, compliance=val.compliance(pad.k_ip) if quasi else None,
+            engaged=engagement.get(pad.name) if engagement else None,
         )  # fmt: skip
         if normal:
             n = _name("w", pad.name)

@@ -130,6 +130,7 @@ def pad_contact(
     d_c: Any = None,
     u_m: Any = None,
     compliance: Any = None,
+    engaged: Any = None,
 ) -> PadContact:
     """Build the contact quantities of one pad.
 
@@ -168,6 +169,9 @@ def pad_contact(
         Tangential displacement of the mount along ``e_t`` (for ``g``).
     compliance : expression, optional
         ``1/k_ip`` of a massless pad with a finite tangential stiffness (``g`` is built).
+    engaged : expression, optional
+        Factor of the contact force ``f_p`` (a symbol ``chi`` for unilateral
+        contact: 1 pressed, 0 lifted off); ``None`` (default) is 1.
 
     Returns
     -------
@@ -193,7 +197,8 @@ def pad_contact(
     else:
         F_s = s * N0 - k * (h - w_m) - d * (hdot - wdot_m)
         F_n = F_s / (s * z3[2] + mu * t_p[2])  # eqs. (29)-(30)
-    f_p = z3 * (s * F_n) + t_p * (mu * F_n)  # eqs. (27)-(28), (31)-(32)
+    F_e = F_n if engaged is None else F_n * engaged
+    f_p = z3 * (s * F_e) + t_p * (mu * F_e)  # eqs. (27)-(28), (31)-(32)
     f_t = e_t[0] * f_p[0] + e_t[1] * f_p[1] + e_t[2] * f_p[2]
     if normal_dof is None:
         F_s = f_p[2]  # massless: the support carries the contact force
