@@ -101,3 +101,19 @@ def test_charpoly_route_refused_for_nontrivial_silent_motion():
     space = resolve_space("eight-dof")
     # mu1 alone breaks mu1 h10 = mu2 h20: the silent motion is not the zero state on the whole map
     assert charpoly_table(space, "mu1", "k_c") is None
+
+
+def test_write_map_file_of_an_ndof_model(tmp_path):
+    """The route's map is written by the NetCDF3 writer (ASCII attributes) and reads back with the same verdicts."""
+    from brakesqueal.analysis.maps import write_map
+    from brakesqueal.results import open_map
+
+    space = resolve_space("eight-dof")
+    x, y = Axis("k_c", 1e8, 1e10, 9, log=True), Axis("k_cn", 5e6, 5e8, 7, log=True)
+    path = tmp_path / "m8.nc"
+    s = write_map(space, x, y, str(path), boundary=False)
+    assert s.method == CHARPOLY_ROUTE
+    d = stability_map(space, x, y, boundary=False).data
+    data = open_map(str(path)).data
+    assert data.attrs["method"] == CHARPOLY_ROUTE
+    np.testing.assert_array_equal(np.asarray(data["stable"].values, dtype=bool), d["stable"].values)

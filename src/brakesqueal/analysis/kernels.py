@@ -1437,10 +1437,10 @@ def omega_subranges(lo: float, hi: float, decades: float = 6.0) -> np.ndarray:
 CHARPOLY_ACCURACY = 1e-9
 #: Rows per block of the characteristic-polynomial kernel (blocks run in parallel; each warm-starts itself).
 CHARPOLY_BLOCK = 64
-#: The route's name in results' ``method``.
-CHARPOLY_ROUTE = ("per point, compiled: certified roots of the exact characteristic polynomial det(λ²M + λD + K) "
-                  "(Weierstrass/Gerschgorin inclusion disks, warm-started along rows); certified eigenvalue verdicts "
-                  "where the disks do not decide")
+#: The route's name in results' ``method`` (ASCII: NetCDF3 attributes).
+CHARPOLY_ROUTE = ("per point, compiled: certified roots of the exact characteristic polynomial "
+                  "det(lam^2 M + lam D + K) (Weierstrass/Gerschgorin inclusion disks, warm-started along rows); "
+                  "certified eigenvalue verdicts where the disks do not decide")
 
 
 @dataclass(frozen=True, eq=False)
@@ -1507,7 +1507,21 @@ def _nd_form(spec: Any) -> tuple[Any, ...] | None:
 
 
 def _charpoly_data(space: ParameterSpace, names: tuple[str, str]) -> dict[str, Any] | None:
-    """The exact characteristic polynomial on the axes ``names`` as JSON-able data (hex floats), or ``None``."""
+    """The exact characteristic polynomial on the axes ``names`` as JSON-able data (hex floats), or ``None``.
+
+    ``None`` also where SymPy cannot carry out a step (an expression it cannot
+    convert): the route is an optimisation, and the eigenvalue route decides
+    those maps.
+    """
+    import sympy as sp
+
+    try:
+        return _charpoly_exact(space, names)
+    except (NotImplementedError, ValueError, TypeError, ArithmeticError, sp.PolynomialError, sp.SympifyError):
+        return None
+
+
+def _charpoly_exact(space: ParameterSpace, names: tuple[str, str]) -> dict[str, Any] | None:
     import sympy as sp
     from sympy.polys.matrices import DomainMatrix
 
