@@ -263,6 +263,16 @@ def _compute(node: ast.AST, names: Mapping[str, float]) -> float:
     return _call(node.func.id, _compute(node.args[0], names))
 
 
+
+def _tree_over(expr: str, names: Mapping[str, Any], what: str) -> tuple[ast.expr, set[str]]:
+    """The checked tree of ``expr`` and the names it uses, which must all be keys of ``names``."""
+    tree, used = _checked_tree(expr, what)
+    unknown = sorted(used - set(names))
+    if unknown:
+        known = ", ".join([*sorted(names), *CONSTANTS]) or "none"
+        raise _reject(what, expr, f"unknown name '{unknown[0]}'", f"known names: {known}")
+    return tree, used
+
 def evaluate(expr: str, names: Mapping[str, float], *, what: str) -> float:
     """Evaluate an arithmetic expression safely.
 
@@ -290,11 +300,7 @@ def evaluate(expr: str, names: Mapping[str, float], *, what: str) -> float:
         the arithmetic fails or gives NaN, e.g. ``"tied parameter 'N0' =
         1800/mu cannot be evaluated at mu=0: division by zero"``.
     """
-    tree, used = _checked_tree(expr, what)
-    unknown = sorted(used - set(names))
-    if unknown:
-        known = ", ".join([*sorted(names), *CONSTANTS]) or "none"
-        raise _reject(what, expr, f"unknown name '{unknown[0]}'", f"known names: {known}")
+    tree, used = _tree_over(expr, names, what)
     at = ", ".join(f"{name}={_format_value(float(names[name]))}" for name in sorted(used))
     where = f" at {at}" if at else ""
     try:
@@ -417,10 +423,7 @@ def evaluate_array(expr: str, names: Mapping[str, Any], *, what: str) -> Any:
     """
     import numpy as np
 
-    tree, used = _checked_tree(expr, what)
-    unknown = sorted(used - set(names))
-    if unknown:
-        raise _reject(what, expr, f"unknown name '{unknown[0]}'")
+    tree, used = _tree_over(expr, names, what)
     with np.errstate(all="ignore"):
         out = _compute_array(tree, names)
         finite_in = np.ones(np.shape(out), dtype=bool)
@@ -455,10 +458,7 @@ def to_sympy(expr: str, symbols: Mapping[str, Any], *, what: str = "expression")
     """
     import sympy as sp
 
-    tree, used = _checked_tree(expr, what)
-    unknown = sorted(used - set(symbols))
-    if unknown:
-        raise _reject(what, expr, f"unknown name '{unknown[0]}'")
+    tree, _ = _tree_over(expr, symbols, what)
     funcs = {"sqrt": sp.sqrt, "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "exp": sp.exp, "log": sp.log,
              "abs": sp.Abs}
 
