@@ -178,9 +178,16 @@ def show(name: Annotated[str, typer.Argument(help="A preset or a model (built-in
     from ..errors import ParameterError
     from ..model import get_preset, resolve_model
 
+    import os
+
     try:
-        pr = get_preset(name)
+        if name.lower().endswith(".toml") or os.path.isfile(name):
+            pr = resolve_model(name).get_preset()  # a model file: its own error (TOML syntax, a bad field)
+        else:
+            pr = get_preset(name)
     except ParameterError:
+        if name.lower().endswith(".toml") or os.path.isfile(name):
+            raise
         try:
             pr = resolve_model(name).get_preset()
         except ParameterError:

@@ -454,24 +454,26 @@ class ModelSpec:
             raise ParameterError(f"{where}: has no degree of freedom (a non-tilting disk needs a pad with mass)")
         if n > MAX_COORDINATES:
             raise ParameterError(f"{where}: has {n} coordinates; at most {MAX_COORDINATES} are supported")
+        # the numbers written in the components first, then the default values, then unused names: the most
+        # specific problem is reported (a literal edited in place often leaves its former parameter unused)
+        r = self.roles()
+        for role, owner, v in r.fixed:
+            msg = _roles.role_message(role, owner, f"{owner}: {role.key.split('.')[1]}", v)
+            if msg is not None:
+                raise ParameterError(msg)
         missing = sorted(n for n in self.parameter_names() if n not in self.parameters)
         if missing:
             raise ParameterError(f"{where}: no default value for parameter(s) {', '.join(missing)}")
-        unused = sorted(set(self.parameters) - set(self.parameter_names()))
-        if unused:
-            raise ParameterError(f"{where}: parameter(s) {', '.join(unused)} are not used by any component")
         for k, v in self.parameters.items():
             if isinstance(v, bool) or not isinstance(v, (int, float)):
                 raise ParameterError(f"{where}: default value of parameter '{k}' must be a number; got {v!r}")
-        r = self.roles()
-        for role, owner, v in r.fixed:
-            if not bool(role.contains(v)):
-                unit = f" {role.unit}" if role.unit else ""
-                raise ParameterError(f"{owner}: {role.key.split('.')[1]} ({role.description.format(owner=owner)}) "
-                                     f"must be in {role.interval()}{unit}; got {v!r}")
-        probs = _roles.problems(r, self.parameters)
+        used = {k: v for k, v in self.parameters.items() if k in r.uses}
+        probs = _roles.problems(r, used)
         if probs:
             raise ParameterError(f"{where}: default values: " + "; ".join(m for _, m in probs))
+        unused = sorted(set(self.parameters) - set(self.parameter_names()))
+        if unused:
+            raise ParameterError(f"{where}: parameter(s) {', '.join(unused)} are not used by any component")
         from .parameters import Preset
 
         seen = {self.name}

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 __all__ = ["Role", "ROLES", "MAX_MAGNITUDE", "ParameterRoles", "parameter_roles", "problems", "valid_mask",
-           "format_interval"]
+           "format_interval", "role_message"]
 
 #: Largest magnitude of a finite parameter value.
 MAX_MAGNITUDE = 1e100
@@ -264,6 +264,35 @@ def parameter_roles(spec: Any) -> ParameterRoles:
     )
 
 
+def role_message(role: Role, owner: str, subject: str, v: float) -> str | None:
+    """Why ``v`` is not allowed in ``role`` (one line starting with ``subject``), or ``None`` when it is.
+
+    Parameters
+    ----------
+    role : Role
+        The field's role.
+    owner : str
+        The component, for the description (``"pad '1' (upper face)"``).
+    subject : str
+        How the value is named: ``"The parameter 'k1'"`` or ``"pad '1': k"``.
+    v : float
+        The value.
+
+    Returns
+    -------
+    str or None
+        The message: the allowed range (or the magnitude bound) and the value.
+    """
+    if bool(role.contains(v)):
+        return None
+    what = role.description.format(owner=owner)
+    if math.isfinite(v) and abs(v) > MAX_MAGNITUDE:
+        return (f"{subject} ({what}) must have a magnitude of at most {MAX_MAGNITUDE:.0e}"
+                f"{' or be inf' if role.allows_inf else ''}; got {v!r}")
+    unit = f" {role.unit}" if role.unit else ""
+    return f"{subject} ({what}) must be in {role.interval()}{unit}; got {v!r}"
+
+
 def _value_message(name: str, value: Any, roles: ParameterRoles) -> str | None:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
         return f"The parameter '{name}' must be a real number; got {value!r} ({type(value).__name__})"
@@ -271,14 +300,23 @@ def _value_message(name: str, value: Any, roles: ParameterRoles) -> str | None:
     if math.isnan(v):
         return f"The parameter '{name}' must be a number; got nan"
     for role, owner in roles.uses.get(name, ()):
-        if not bool(role.contains(v)):
-            unit = f" {role.unit}" if role.unit else ""
-            what = role.description.format(owner=owner)
-            if math.isfinite(v) and abs(v) > MAX_MAGNITUDE:
-                return (f"The parameter '{name}' ({what}) must have a magnitude of at most "
-                        f"{MAX_MAGNITUDE:.0e}{' or be inf' if role.allows_inf else ''}; got {v!r}")
-            return f"The parameter '{name}' ({what}) must be in {role.interval()}{unit}; got {v!r}"
+        msg = role_message(role, owner, f"The parameter '{name}'", v)
+        if msg is not None:
+            return msg
     return None
+
+
+def _thickness_message(hu: Any, hl: Any, a: float, b: float) -> str:
+    """The disk thickness ``h_upper + h_lower <= 0``: name the parameters, or the literal field and its range."""
+    if isinstance(hu, str) and isinstance(hl, str):
+        return (f"The parameters '{hu}' and '{hl}' must satisfy {hu} + {hl} > 0 (disk thickness, eq. 58); "
+                f"got {hu} = {a!r}, {hl} = {b!r}")
+    # a number written in the model file: name that field and the range its partner leaves it
+    field, value, other, ov, oval = (("h_upper", a, "h_lower", hl, b) if not isinstance(hu, str)
+                                     else ("h_lower", b, "h_upper", hu, a))
+    partner = f"'{ov}' = {oval!r}" if isinstance(ov, str) else f"{oval!r}"
+    return (f"disk: {field} = {value!r} must be in ({-oval!r}, inf) m: the disk thickness h_upper + h_lower must "
+            f"be positive (eq. 58) and {other} = {partner}")
 
 
 def _lookup(v: Any, values: Mapping[str, Any]) -> Any:
@@ -307,9 +345,7 @@ def problems(roles: ParameterRoles, values: Mapping[str, Any]) -> list[tuple[str
         a, b = float(_lookup(hu, values)), float(_lookup(hl, values))
         if not a + b > 0.0:
             names = [x for x in (hu, hl) if isinstance(x, str)]
-            out.append((names[0] if names else "h_upper",
-                        f"The parameters '{hu}' and '{hl}' must satisfy {hu} + {hl} > 0 (disk thickness, "
-                        f"eq. 58); got {hu} = {a!r}, {hl} = {b!r}"))
+            out.append((names[0] if names else "h_upper", _thickness_message(hu, hl, a, b)))
     R = roles.disk_radius
     if not (isinstance(R, str) and R in bad):
         Rv = float(_lookup(R, values))
