@@ -45,7 +45,9 @@ def test_slider_moves_the_leading_eigenvalue(page):
     shown = page.page.locator("#bs-leading").text_content()
     assert shown == library_leading([f"mu={value}"])
     assert shown != library_leading([])
-    # the link holds the state
+    # the link holds the state (written once the state rests)
+    page.page.wait_for_function("v => new URLSearchParams(location.search).get('set') === v", arg=f"mu={value}",
+                                timeout=30_000)
     query = parse_qs(urlparse(page.page.url).query)
     assert query["set"] == [f"mu={value}"] and query["preset"] == ["paper-fig2"]
     page.screenshot("slider")

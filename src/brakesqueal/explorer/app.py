@@ -48,6 +48,8 @@ __all__ = ["Explorer", "build_page"]
 
 log = logging.getLogger(__name__)
 
+#: Milliseconds the state must rest before it is written to the URL.
+URL_DELAY_MS = 400
 _LOG_FORMAT = "return Number((10 ** tick).toPrecision(3)).toExponential();"
 _MAP_PALETTE = ["#f3a5a5", "#a9cdf5", "#c8c8c8"]  # unstable, stable, no verdict
 
@@ -91,6 +93,7 @@ class Explorer:
         self.space = origin.space_of(state)
         self.shown: dict[str, Any] = {}
         self._map_key: Any = None
+        self._url_pending = False
         self._tracks_key: Any = None
         self._tracks: Any = None
         self._drawn_tracks: Any = None
@@ -114,7 +117,7 @@ class Explorer:
         self._refresh_alert()
         self._submit()
         if pn.state.curdoc is not None:
-            pn.state.onload(self._write_url)
+            pn.state.onload(self._write_url_now)
 
     # ------------------------------------------------------------------------------------------ plumbing
     def _schedule(self, fn: Any) -> None:
@@ -343,6 +346,24 @@ class Explorer:
         return True
 
     def _write_url(self) -> None:
+        """Write the state to the URL once it has rested for :data:`URL_DELAY_MS` (one history entry per pause,
+        not one per slider step: Panel's location pushes a browser-history entry per change)."""
+        if self.doc is None:
+            self._write_url_now()
+            return
+        if self._url_pending:
+            return
+        self._url_pending = True
+        try:
+            self.doc.add_timeout_callback(self._flush_url, URL_DELAY_MS)
+        except Exception:  # the session is gone
+            self._url_pending = False
+
+    def _flush_url(self) -> None:
+        self._url_pending = False
+        self._write_url_now()
+
+    def _write_url_now(self) -> None:
         loc = self.pn.state.location
         if loc is not None:
             try:
