@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal, Union
 
 from ..errors import ParameterError
+from .expressions import RESERVED_NAMES
 
 if TYPE_CHECKING:
     from .parameters import Preset
@@ -53,8 +54,12 @@ def _check_value(
     if v is None and optional:
         return
     if isinstance(v, str):
-        if not v.isidentifier():
-            raise ParameterError(f"{component}: {field_name} = {v!r} is neither a number nor a parameter name")
+        if not (v.isidentifier() and v.isascii()):
+            raise ParameterError(f"{component}: {field_name} = {v!r} is neither a number nor a parameter name "
+                                 "(an ASCII identifier)")
+        if v in RESERVED_NAMES:
+            raise ParameterError(f"{component}: {field_name} = {v!r}: '{v}' is reserved and cannot name a parameter"
+                                 + (" (for infinity write the number inf)" if v == "inf" else ""))
         return
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise ParameterError(f"{component}: {field_name} must be a number or a parameter name; got {v!r}")

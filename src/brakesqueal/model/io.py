@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import tomllib
 from typing import Any, Mapping
 
@@ -55,6 +56,10 @@ MAX_FILE_BYTES = 1 << 20
 
 _TOP = ("name", "description", "reference", "parameters", "disk", "pads", "calipers", "presets")
 _PRESET_KEYS = ("description", "reference", "free", "fixed", "tied", "auxiliary")
+#: Component fields that hold text, never a number (``"inf"`` there is a name).
+_TEXT_FIELDS = ("name", "face", "mount", "dofs")
+_BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+_ESCAPES = {"\\": "\\\\", '"': '\\"', "\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f", "\r": "\\r"}
 
 
 def _overflow(text: str) -> float:
@@ -134,7 +139,7 @@ def _fields(cls: type, data: Mapping[str, Any], where: str) -> dict[str, Any]:
                              f"{', '.join(names)}")
     out = {}
     for k, v in data.items():
-        if v == "inf":
+        if v == "inf" and k not in _TEXT_FIELDS:  # a component may be named "inf"
             v = math.inf
         if k == "dofs":
             if not isinstance(v, (list, tuple)):
@@ -320,16 +325,36 @@ def load_model(path: str) -> ModelSpec:
     return spec_from_dict(read_toml(path, "model file"), source=f"model file '{path}'")
 
 
+def _toml_string(text: str) -> str:
+    """A TOML basic string: quotes, backslashes and every control character escaped (reads back exactly)."""
+    out = []
+    for ch in text:
+        if ch in _ESCAPES:
+            out.append(_ESCAPES[ch])
+        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
+            out.append(f"\\u{ord(ch):04X}")
+        else:
+            out.append(ch)
+    return '"' + "".join(out) + '"'
+
+
+def _toml_key(key: str) -> str:
+    """A TOML key: bare when it is made of ASCII letters, digits, ``_`` and ``-``, else quoted."""
+    return key if _BARE_KEY.fullmatch(key) else _toml_string(key)
+
+
 def _toml_value(v: Any) -> str:
     if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        return _toml_string(v)
     if isinstance(v, bool):
         return "true" if v else "false"
     if isinstance(v, list):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
     if isinstance(v, dict):
-        return "{ " + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + " }"
-    return repr(float(v)) if isinstance(v, float) else str(v)
+        return "{ " + ", ".join(f"{_toml_key(k)} = {_toml_value(x)}" for k, x in v.items()) + " }"
+    if isinstance(v, float):
+        return "inf" if v == math.inf else "-inf" if v == -math.inf else "nan" if math.isnan(v) else repr(v)
+    return str(v)
 
 
 def model_to_toml(spec: ModelSpec) -> str:
@@ -352,14 +377,14 @@ def model_to_toml(spec: ModelSpec) -> str:
     d = spec_to_dict(spec)
     lines = [f"name = {_toml_value(d['name'])}", f"description = {_toml_value(d['description'])}",
              f"reference = {_toml_value(d['reference'])}", "", "[parameters]"]  # fmt: skip
-    lines += [f"{k} = {_toml_value(v)}" for k, v in d["parameters"].items()]
+    lines += [f"{_toml_key(k)} = {_toml_value(v)}" for k, v in d["parameters"].items()]
     lines += ["", "[disk]"] + [f"{k} = {_toml_value(v)}" for k, v in d["disk"].items()]
     for p in d["pads"]:
         lines += ["", "[[pads]]"] + [f"{k} = {_toml_value(v)}" for k, v in p.items()]
     for c in d["calipers"]:
         lines += ["", "[[calipers]]"] + [f"{k} = {_toml_value(v)}" for k, v in c.items()]
     for name, p in d.get("presets", {}).items():
-        lines += ["", f"[presets.{name}]"] + [f"{k} = {_toml_value(v)}" for k, v in p.items()]
+        lines += ["", f"[presets.{_toml_key(name)}]"] + [f"{k} = {_toml_value(v)}" for k, v in p.items()]
     return "\n".join(lines) + "\n"
 
 
@@ -417,5 +442,6 @@ def parameters_to_toml(params: Any) -> str:
     for name, value in params.to_json_dict().items():
         text = '"inf"' if isinstance(value, str) else repr(float(value))
         unit = spec.unit(name)
-        lines.append(f"{name} = {text}  # {('[' + unit + '] ') if unit else ''}{spec.describe_parameter(name)}")
+        note = f"{('[' + unit + '] ') if unit else ''}{spec.describe_parameter(name)}".replace("\n", " ")
+        lines.append(f"{_toml_key(name)} = {text}  # {note}")
     return "\n".join(lines) + "\n"
