@@ -954,7 +954,7 @@ def quartic_top_grid(A, lam_e, mr, fr, ok):  # type: ignore[no-untyped-def]
     The roots of row ``row`` are scaled by ``2^lam_e[row]``.
 
     Neighbouring points warm-start each other: along a row from the factors
-    of the three previous points (quadratic extrapolation), a row's first point from the
+    of the two previous points (extrapolated), a row's first point from the
     previous row's first point; a start that does not converge falls back to
     the Aberth cold start.  ``ok[row, j] = 0`` where no clean factorization
     was found (the caller recomputes those points by a robust route).
@@ -963,7 +963,6 @@ def quartic_top_grid(A, lam_e, mr, fr, ok):  # type: ignore[no-untyped-def]
     g = np.empty(4)
     p1 = np.empty(4)
     p2 = np.empty(4)
-    p3 = np.empty(4)
     first = np.empty(4)
     out = np.empty(2)
     have_first = False
@@ -972,10 +971,7 @@ def quartic_top_grid(A, lam_e, mr, fr, ok):  # type: ignore[no-untyped-def]
         hv = 0
         for j in range(n):
             warm = True
-            if hv >= 3:  # quadratic extrapolation: on fine grids the start is within Newton's tolerance
-                for k in range(4):
-                    g[k] = 3.0 * (p1[k] - p2[k]) + p3[k]
-            elif hv == 2:
+            if hv >= 2:
                 for k in range(4):
                     g[k] = 2.0 * p1[k] - p2[k]
             elif hv == 1:
@@ -992,7 +988,6 @@ def quartic_top_grid(A, lam_e, mr, fr, ok):  # type: ignore[no-untyped-def]
                 if hv == 0:
                     first[:] = g
                     have_first = True
-                p3[:] = p2
                 p2[:] = p1
                 p1[:] = g
                 hv += 1
