@@ -40,6 +40,8 @@ __all__ = ["SilentMotion", "SilentMotions", "silent_motion", "silent_motion_vect
            "parameter_vector", "as_parameters", "is_trivial", "MAX_TILT"]
 
 _EPS = np.finfo(float).eps
+#: A residual row is zero to rounding when ``|F_i| <= NOISE_FLOOR eps S_i`` (``S_i``: its terms' magnitude).
+NOISE_FLOOR = 64.0
 #: Largest tilt angle [rad] for which the kinematics (eq. 42: 1/(cos q1 cos q2)) is used.
 MAX_TILT = 1.2
 
@@ -111,7 +113,7 @@ def is_trivial(residuals: np.ndarray, scale: np.ndarray) -> Any:
     """Whether residuals at ``x = 0`` vanish to rounding (``|F_i| <= 64 eps S_i`` for all rows; vectorized)."""
     r = np.abs(np.asarray(residuals, dtype=float))
     s = np.abs(np.asarray(scale, dtype=float))
-    return np.all(r <= 64.0 * _EPS * s, axis=0)
+    return np.all(r <= NOISE_FLOOR * _EPS * s, axis=0)
 
 
 def _state(z: np.ndarray, n: int, m: int) -> list[float]:
@@ -159,21 +161,38 @@ class _System:
 
 
 def _newton(sysm: _System, y: np.ndarray, g: np.ndarray, max_iter: int = 30,
-            monotone: bool = False) -> tuple[np.ndarray, int, bool]:
+            monotone: bool = False, tol: np.ndarray | None = None) -> tuple[np.ndarray, int, bool]:
     """Newton on ``f(y) - g = 0`` (scaled unknowns and rows).
 
     Converged when every component's step is at rounding level relative to
     that component (so a tilt of 1e-12 rad next to a deformation of 1e-5 m is
     still resolved to full relative precision), or when the steps stop
-    shrinking at rounding level.  With ``monotone`` the iteration is abandoned
-    as soon as a step is not at most half the previous one (a converged result
-    is then the root Newton's contraction region around the start leads to).
+    shrinking at the noise floor of the residual: steps below ``1e-9`` of the
+    largest component; or (with ``tol``, per scaled row) a residual that is
+    zero to rounding, ``|f_i - g_i| <= tol_i`` (near the trivial silent motion,
+    where the solution is itself of the order of the rounding of ``F(0)``); or
+    steps below ``1e-6`` of the largest component while the residual no longer
+    decreases (by half: near a double root it still drops by four per step) —
+    a component fixed by a small difference of large terms, e.g. a tilt of
+    1e-17 rad beside one of 1e-10 rad, is known only to that noise.
+    With ``monotone`` the iteration is abandoned as soon as a step is not at
+    most half the previous one, converged only if it is at that noise floor (a
+    converged result is then the root Newton's contraction region around the
+    start leads to).
+
+    The compiled batch (:mod:`~.silent_batch`) runs the same iteration.
     """
     last = math.inf
+    floor = False
+    rlast = math.inf
     for it in range(1, max_iter + 1):
         r = sysm.f(y) - g
         if not np.all(np.isfinite(r)):
             return y, it, False
+        resid = tol is not None and bool(np.all(np.abs(r) <= tol))
+        rsize = float(np.max(np.abs(r)))
+        stalled = rsize >= 0.5 * rlast  # the residual no longer decreases (slow convergence still halves it)
+        rlast = rsize
         try:
             step = np.linalg.solve(sysm.jac(y), -r)
         except np.linalg.LinAlgError:
@@ -184,17 +203,17 @@ def _newton(sysm: _System, y: np.ndarray, g: np.ndarray, max_iter: int = 30,
         size = float(np.max(np.abs(step)))
         if np.all(np.abs(step) <= 8 * _EPS * np.abs(y)) or size == 0.0:
             return y, it, True
-        if size > 0.9 * last and size <= 1e-9 * float(np.max(np.abs(y))):
+        ymax = float(np.max(np.abs(y)))
+        floor = size <= 1e-9 * ymax or resid or (stalled and size <= 1e-6 * ymax)
+        if size > 0.9 * last and floor:
             return y, it, True  # no longer contracting: at the noise floor of the residual
         if monotone and it > 1 and size > 0.5 * last:
-            # no longer contracting: converged only if already at the noise floor of the residual (components
-            # resolved far below rounding relative to the largest, e.g. a tilt of 1e-13 rad beside 2e-7 m)
-            return y, it, bool(size <= 1e-9 * float(np.max(np.abs(y))))
+            return y, it, floor  # no longer contracting: converged only at the noise floor
         last = size
-    return y, max_iter, bool(last <= 1e-9 * float(np.max(np.abs(y))))
+    return y, max_iter, floor
 
 
-def _continuation(sysm: _System, F0s: np.ndarray) -> tuple[np.ndarray, int, str]:
+def _continuation(sysm: _System, F0s: np.ndarray, tol: np.ndarray | None = None) -> tuple[np.ndarray, int, str]:
     """Follow ``f(y) - (1 - s) F0s = 0`` from ``(0, 0)`` to ``s = 1`` by pseudo-arclength continuation.
 
     Returns ``(y at s = 1, corrector iterations, "")``; raises on a fold or a failure.
@@ -263,7 +282,7 @@ def _continuation(sysm: _System, F0s: np.ndarray) -> tuple[np.ndarray, int, str]
             # land exactly on s = 1 from the bracketing points; if Newton fails there, approach in smaller steps
             frac = (1.0 - s) / (sc - s) if sc > s else 1.0
             yg = y + frac * (yc - y)
-            yf, it, conv = _newton(sysm, yg, np.zeros(N))
+            yf, it, conv = _newton(sysm, yg, np.zeros(N), tol=tol)
             total += it
             if conv and sysm.admissible(yf):
                 return yf, total, ""
@@ -343,11 +362,12 @@ def silent_motion_vector(model: Any, p: list[float]) -> SilentMotion:
         z, its, method, trivial = np.zeros(n + m), 0, "trivial (F(0) = 0 to rounding)", True
     else:
         sysm = _System(cm, p)
-        y, its, ok = _newton(sysm, np.zeros(n + m), np.zeros(n + m), max_iter=12, monotone=True)
+        tol = NOISE_FLOOR * _EPS * np.abs(S0) / sysm.row  # a residual zero to rounding (as the triviality test)
+        y, its, ok = _newton(sysm, np.zeros(n + m), np.zeros(n + m), max_iter=12, monotone=True, tol=tol)
         if ok and sysm.admissible(y):
             method = "Newton's method from the trivial state"
         else:
-            y, its2, _ = _continuation(sysm, F0 / sysm.row)
+            y, its2, _ = _continuation(sysm, F0 / sysm.row, tol)
             its += its2
             method = "pseudo-arclength continuation of the Newton homotopy from the trivial state"
         z, trivial = sysm.z(y), False
@@ -405,15 +425,15 @@ class SilentMotions:
         return np.concatenate([self.q0, self.l0], axis=1)
 
 
-def _trivial_rows(cm: Any, P: np.ndarray) -> np.ndarray:
-    """Rows whose zero-state residuals vanish to rounding (the criterion of ``silent_motion``)."""
+def _trivial_rows(cm: Any, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows whose zero-state residuals vanish to rounding (the criterion of ``silent_motion``), and ``S`` (N, n + m)."""
     N = P.shape[0]
     cols = [np.ascontiguousarray(P[:, k]) for k in range(P.shape[1])]
     with np.errstate(all="ignore"):
         F = np.stack([np.broadcast_to(np.asarray(v, dtype=float), (N,)) for v in cm.zero_residuals(cols)])
         S = np.stack([np.broadcast_to(np.asarray(v, dtype=float), (N,))
                       for v in cm.zero_residual_scale(cols)])
-    return np.asarray(is_trivial(F, S), dtype=bool) & np.all(np.isfinite(F), axis=0)
+    return np.asarray(is_trivial(F, S), dtype=bool) & np.all(np.isfinite(F), axis=0), np.ascontiguousarray(S.T)
 
 
 def silent_motions(model: Any, P: Any, *, use_cache: bool = True, compiled: bool = True) -> SilentMotions:
@@ -444,7 +464,7 @@ def silent_motions(model: Any, P: Any, *, use_cache: bool = True, compiled: bool
     """
     from ..codegen import CompiledModel, compile_model
     from ..status import PointStatus, status_of_error
-    from .silent_batch import load_kernel
+    from .silent_batch import load_kernel, mark_ready
 
     cm = model if isinstance(model, CompiledModel) else compile_model(model, use_cache=use_cache)
     P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=float)))
@@ -455,7 +475,7 @@ def silent_motions(model: Any, P: Any, *, use_cache: bool = True, compiled: bool
     code = np.ones(N, dtype=np.int8)
     iters = np.zeros(N, dtype=np.int64)
     status = np.full(N, int(PointStatus.OK_NONTRIVIAL), dtype=np.int8)
-    triv = _trivial_rows(cm, P) if N else np.zeros(0, dtype=bool)
+    triv, S = _trivial_rows(cm, P) if N else (np.zeros(0, dtype=bool), np.zeros((0, K)))
     code[triv] = 4
     Z[triv] = 0.0
     rest = np.flatnonzero(~triv)
@@ -468,7 +488,9 @@ def silent_motions(model: Any, P: Any, *, use_cache: bool = True, compiled: bool
         fn = np.full((rest.size, max(npad, 1)), np.nan)
         sp = np.full((rest.size, max(npad, 1)), np.nan)
         with np.errstate(all="ignore"):
-            kern.newton_batch(sub, MAX_TILT, 12, Zs, cs, its, fn, sp)
+            kern.newton_batch(sub, np.ascontiguousarray(np.abs(S[rest])), NOISE_FLOOR, MAX_TILT, 12, Zs, cs, its,
+                              fn, sp)
+        mark_ready(cm.spec, use_cache)
         Z[rest], code[rest], iters[rest] = Zs, cs, its
     # the trivial points: contact and sliding at the zero state decide (vectorized, as silent_motion does)
     t = np.flatnonzero(triv)

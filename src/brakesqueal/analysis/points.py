@@ -373,11 +373,14 @@ def _nontrivial_batch(model: _Model, P: np.ndarray
     :func:`~.linear.linearize`'s, batched (exact Jacobians from the same
     generated code, quasi-static pads eliminated, pads with rate terms kept as
     states), and the verdict :func:`linear_verdict`'s.  ``redo`` marks the
-    points left to the per-point route: a trivial silent motion found there,
+    points left to the per-point route: all of them when they are fewer than
+    :data:`~.silent_batch.COMPILE_MIN` and the kernel is not compiled yet; a
+    trivial silent motion found there,
     a kept pad without rate terms (an algebraic row, eliminated per point by
     :func:`eliminate_algebraic`), or a singular pad block.
     """
     from .equilibrium import silent_motions
+    from .silent_batch import COMPILE_MIN, kernel_ready
 
     N = P.shape[0]
     status = np.full(N, int(PointStatus.UNDECIDED), dtype=np.int8)
@@ -385,6 +388,9 @@ def _nontrivial_batch(model: _Model, P: np.ndarray
     mr = np.full(N, np.nan)
     fr = np.full(N, np.nan)
     redo = np.zeros(N, dtype=bool)
+    if N < COMPILE_MIN and not kernel_ready(model.spec):
+        redo[:] = True  # a few points on a cold cache: compiling the kernel would cost more than it saves
+        return status, stable, mr, fr, redo
     sms = silent_motions(model.cm, P)
     found = (sms.status == int(PointStatus.OK)) | (sms.status == int(PointStatus.OK_NONTRIVIAL))
     status[~found] = sms.status[~found]
@@ -462,12 +468,32 @@ def _linear_batch(cm: Any, P: np.ndarray, Z: np.ndarray) -> tuple[np.ndarray, np
                             np.concatenate([Zkn, GddQ, GdL], 2)], 1)
         A = np.concatenate([np.concatenate([Zn, I, Znk], 2), np.concatenate([-Kg, -Dg, -RL], 2),
                             np.concatenate([-GQ, -GdQ, -GL], 2)], 1)
-        alg = np.any(np.all(E == 0.0, axis=2), axis=1)  # an algebraic row: eliminate_algebraic, per point
-        back[idx[alg]] = True
+        zero_rows = np.all(E == 0.0, axis=2)
+        alg = np.any(zero_rows, axis=1)
+        # every kept pad's row algebraic (rigid supports, 1/k_ip = 0): eliminate_algebraic solves for all pad
+        # states, batched here; other patterns of algebraic rows go point by point
+        pads_only = alg & np.all(zero_rows[:, 2 * n:], axis=1) & ~np.any(zero_rows[:, :2 * n], axis=1)
+        back[idx[alg & ~pads_only]] = True
         keep = ~alg
         if keep.any():
             c, a, f = descriptor_verdicts(E[keep], A[keep])
             codes[idx[keep]], mr[idx[keep]], fr[idx[keep]] = c, a, f
+        if pads_only.any():
+            sel = np.flatnonzero(pads_only)
+            Aa = A[sel]
+            try:
+                X = np.linalg.solve(Aa[:, 2 * n:, 2 * n:], Aa[:, 2 * n:, :2 * n])
+            except np.linalg.LinAlgError:
+                back[idx[sel]] = True
+                continue
+            fin = np.all(np.isfinite(X), axis=(1, 2))
+            back[idx[sel[~fin]]] = True
+            if fin.any():
+                f_ = sel[fin]
+                E2 = E[f_, :2 * n, :2 * n] - E[f_, :2 * n, 2 * n:] @ X[fin]
+                A2 = A[f_, :2 * n, :2 * n] - A[f_, :2 * n, 2 * n:] @ X[fin]
+                c, a, f = descriptor_verdicts(E2, A2)
+                codes[idx[f_]], mr[idx[f_]], fr[idx[f_]] = c, a, f
     return codes, mr, fr, back
 
 

@@ -28,6 +28,11 @@ Statuses are therefore those of the per-point route by construction: the
 batched stage never reports a failure (no false failures); it only skips the
 per-point solver where that solver's first stage would have succeeded.
 
+The kernel is compiled by numba on first use per model (seconds; cached on
+disk beside the generated source).  :func:`brakesqueal.analysis.points.evaluate_arrays`
+therefore sends fewer than :data:`COMPILE_MIN` points through the per-point
+solver unless the kernel is ready (:func:`kernel_ready`).
+
 **Why the Newton stage starts from the trivial state, not from a neighbour's
 solution.**  The silent motion of a point is the one connected to the trivial
 state (:mod:`~.equilibrium`).  A Newton iteration warm-started from the
@@ -49,7 +54,7 @@ from typing import Any
 
 from ..numeric import cache
 
-__all__ = ["kernel_source", "load_kernel", "KERNEL_NAME", "HANDOVER"]
+__all__ = ["kernel_source", "load_kernel", "kernel_ready", "KERNEL_NAME", "HANDOVER", "COMPILE_MIN"]
 
 #: File name of the kernel module in the model's cache entry.
 KERNEL_NAME = "silent.py"
@@ -63,7 +68,12 @@ HANDOVER = {
     4: "trivial silent motion (decided to rounding, no Newton)",
 }
 
+#: Fewest points for which the batched route compiles its kernel (numba, seconds on first use per model) when its
+#: machine code is not at hand; fewer points go through the per-point solver (~1 ms each).
+COMPILE_MIN = 2000
+
 _DECORATOR = '@njit(cache=True, error_model="numpy")'
+_READY: set[tuple[str, bool]] = set()
 
 _PREAMBLE = '''import math
 from math import sin, cos, tan, sqrt, exp, log, pi
@@ -117,8 +127,11 @@ def _lu_solve(A, b, x):
 
 
 @njit(cache=True, error_model="numpy")
-def newton_batch(P, max_tilt, max_iter, Z, code, iters, FN, SPEED):
+def newton_batch(P, S, floor, max_tilt, max_iter, Z, code, iters, FN, SPEED):
     """Newton from the trivial state for every row of P (scaled as equilibrium._System).
+
+    S[i]: per residual row the magnitude of its terms at z = 0 (a residual is zero to rounding when
+    |F_k| <= floor eps S_k).
 
     Z[i] = (Q0, L0); code[i] = 0 accepted, 1 not converged / inadmissible, 2 contact or sliding near its limit,
     3 non-finite residual or Jacobian; FN, SPEED: per pad at the solution (accepted points).
@@ -164,6 +177,7 @@ def newton_batch(P, max_tilt, max_iter, Z, code, iters, FN, SPEED):
             continue
         ok = False
         last = math.inf
+        rlast = math.inf
         it = 0
         while it < max_iter:
             it += 1
@@ -171,12 +185,21 @@ def newton_batch(P, max_tilt, max_iter, Z, code, iters, FN, SPEED):
                 z[k] = y[k] / col[k]
             static_residuals(z, p, r)
             finite = True
+            resid = True
             for k in range(K):
+                if not abs(r[k]) <= floor * eps * S[i, k]:
+                    resid = False
                 r[k] = -r[k] / row[k]
                 if not abs(r[k]) < math.inf:
                     finite = False
             if not finite:
                 break
+            rsize = 0.0
+            for k in range(K):
+                if abs(r[k]) > rsize:
+                    rsize = abs(r[k])
+            stalled = rsize >= 0.5 * rlast
+            rlast = rsize
             static_jacobian(z, p, J)
             for a in range(K):
                 for b in range(K):
@@ -203,15 +226,16 @@ def newton_batch(P, max_tilt, max_iter, Z, code, iters, FN, SPEED):
             if small or size == 0.0:
                 ok = True
                 break
-            if size > 0.9 * last and size <= 1e-9 * ymax:
+            at_floor = size <= 1e-9 * ymax or resid or (stalled and size <= 1e-6 * ymax)
+            if size > 0.9 * last and at_floor:
                 ok = True
                 break
             if it > 1 and size > 0.5 * last:
-                ok = size <= 1e-9 * ymax  # no longer contracting: converged only at the noise floor
+                ok = at_floor  # no longer contracting: converged only at the noise floor
                 break
             last = size
             if it == max_iter:
-                ok = last <= 1e-9 * ymax
+                ok = at_floor
         iters[i] = it
         for k in range(K):
             z[k] = y[k] / col[k]
@@ -350,3 +374,38 @@ def load_kernel(spec: Any, use_cache: bool = True) -> types.ModuleType:
 
     return cache.load_module(model_key(spec), KERNEL_NAME, lambda: kernel_source(spec, use_cache=use_cache),
                              use_cache=use_cache)
+
+
+def kernel_ready(spec: Any, *, use_cache: bool = True) -> bool:
+    """Whether a model's kernel runs without compiling: already run in this process, or in numba's disk cache.
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+    use_cache : bool, optional
+        Whether the on-disk cache may be used.
+
+    Returns
+    -------
+    bool
+    """
+    from ..codegen.compiled import model_key
+
+    key = model_key(spec)
+    if (key, use_cache) in _READY:
+        return True
+    if not use_cache:
+        return False
+    try:
+        d = cache.entry_dir(key) / "__pycache__"
+        return any(d.glob("silent.newton_batch-*.nbi")) and any(d.glob("silent.jacobian_batch-*.nbi"))
+    except OSError:
+        return False
+
+
+def mark_ready(spec: Any, use_cache: bool = True) -> None:
+    """Record that the model's kernel has run in this process (its machine code is loaded)."""
+    from ..codegen.compiled import model_key
+
+    _READY.add((model_key(spec), use_cache))
