@@ -117,3 +117,34 @@ def test_write_map_file_of_an_ndof_model(tmp_path):
     data = open_map(str(path)).data
     assert data.attrs["method"] == CHARPOLY_ROUTE
     np.testing.assert_array_equal(np.asarray(data["stable"].values, dtype=bool), d["stable"].values)
+
+
+def test_boundary_bisection_by_the_route_equals_the_eigenvalue_route():
+    """The map's boundary refined with the route's point evaluator is the one :func:`points.evaluate` gives."""
+    from brakesqueal.analysis.boundary import stability_boundary
+    from brakesqueal.analysis.kernels import charpoly_point_verdicts
+    from brakesqueal.analysis.maps import _charpoly_points, _plan
+
+    space = resolve_space("eight-dof")
+    x, y = Axis("k_c", 1e8, 1e10, 17, log=True), Axis("k_cn", 5e6, 5e8, 13, log=True)
+    m = stability_map(space, x, y, boundary=False).data
+    plan = _plan(space, x, y, False, False)
+    st, ss = m["stable"].values, m["status"].values
+    ref = stability_boundary(space, plan.outer, plan.inner, st, ss, iterations=12)
+    fast = stability_boundary(space, plan.outer, plan.inner, st, ss, iterations=12,
+                              evaluator=lambda v: _charpoly_points(space, plan, v))
+    assert ref.refined.sum() > 5
+    for a, b in zip(ref.coords, fast.coords):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(ref.width, fast.width)
+    # scattered points against LAPACK
+    rng = np.random.default_rng(3)
+    ov = np.exp(rng.uniform(np.log(5e6), np.log(5e8), 60))
+    iv = np.exp(rng.uniform(np.log(1e8), np.log(1e10), 60))
+    codes, mr, _ = charpoly_point_verdicts(plan.charpoly, ov, iv)
+    ev = np.array([_lapack(space, "k_cn", "k_c", ov[k:k + 1], iv[k:k + 1])[0, 0] for k in range(ov.size)])
+    top = ev[np.arange(ov.size), np.argmax(ev.real, axis=1)]
+    done = codes != UNDECIDED
+    assert done.mean() > 0.9
+    np.testing.assert_array_equal(codes[done] == STABLE, top.real[done] < 0)
+    np.testing.assert_array_less(np.abs(mr - top.real)[done], 1e-9 * np.abs(top[done]))

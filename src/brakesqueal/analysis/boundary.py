@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -91,7 +92,8 @@ def _nearest(grid: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def stability_boundary(space: Any, outer: Any, inner: Any, stable: np.ndarray, status: np.ndarray, *,
-                       iterations: int = 40, budget: float | None = None) -> Boundary:
+                       iterations: int = 40, budget: float | None = None,
+                       evaluator: Callable[[dict[str, np.ndarray]], Any] | None = None) -> Boundary:
     """Stability boundary of a map, refined onto the boundary by bisection along grid edges.
 
     Parameters
@@ -111,6 +113,10 @@ def stability_boundary(space: Any, outer: Any, inner: Any, stable: np.ndarray, s
         bisection stops and every vertex keeps its current bracket (its
         ``width`` says how far it got).  The default, no budget, keeps the
         result independent of the machine's speed.
+    evaluator : callable, optional
+        ``evaluator({outer: values, inner: values}) -> Points`` for the bisection
+        points (default :func:`~.points.evaluate`; maps pass their route's own
+        certified evaluator).
 
     Returns
     -------
@@ -181,7 +187,8 @@ def stability_boundary(space: Any, outer: Any, inner: Any, stable: np.ndarray, s
             sel = np.flatnonzero(alive)
             if sel.size == 0:
                 break
-            r = evaluate(space, {names[0]: _v(vo[sel], outer.log), names[1]: _v(vi[sel], inner.log)})
+            vals = {names[0]: _v(vo[sel], outer.log), names[1]: _v(vi[sel], inner.log)}
+            r = evaluate(space, vals) if evaluator is None else evaluator(vals)
             good = np.isin(r.status, _DECIDED)
             same = np.asarray(r.stable, bool) == sa[sel]
             upd = sel[good]

@@ -69,7 +69,7 @@ __all__ = [
     "trivial_entries", "RateBlocks", "zero_rate_blocks", "omega_entries", "omega_coefficients",
     "omega_kernel_available", "omega_subranges", "inner_exponent", "kernel_segments", "run_classify", "kernel_scaling",
     "form_info", "has_model_form", "closed_route", "kernel_eigen", "CharpolyTable", "charpoly_table",
-    "charpoly_verdicts", "CHARPOLY_ACCURACY", "CHARPOLY_ROUTE",
+    "charpoly_verdicts", "charpoly_point_verdicts", "CHARPOLY_ACCURACY", "CHARPOLY_ROUTE",
 ]
 
 _U = 2.0 ** -53
@@ -1665,4 +1665,22 @@ def charpoly_verdicts(table: CharpolyTable, outer_values: np.ndarray, inner_valu
                              CHARPOLY_BLOCK)
     else:
         charpoly_grid(table.Q, table.RQ, xo, yi, ok, bool(eigen), CHARPOLY_ACCURACY, codes, mr, fr)
+    return codes, mr, fr
+
+
+def charpoly_point_verdicts(table: CharpolyTable, outer_values: np.ndarray, inner_values: np.ndarray, *,
+                            eigen: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`charpoly_verdicts` at scattered points ``(outer_values[k], inner_values[k])`` (1-D arrays).
+
+    Each point warm-starts from the previous one (e.g. the vertices of a
+    boundary curve); the verdicts are certified the same way.
+    """
+    from ._compiled import charpoly_points
+
+    xs, ys = np.broadcast_arrays(np.asarray(outer_values, dtype=float), np.asarray(inner_values, dtype=float))
+    xs, ys = np.ascontiguousarray(xs.ravel()), np.ascontiguousarray(ys.ravel())
+    codes = np.empty(xs.size, dtype=np.uint8)
+    mr = np.empty(xs.size)
+    fr = np.empty(xs.size)
+    charpoly_points(table.Q, table.RQ, xs, ys, bool(eigen), CHARPOLY_ACCURACY, codes, mr, fr)
     return codes, mr, fr

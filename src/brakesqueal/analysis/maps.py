@@ -40,10 +40,10 @@ from ..errors import ParameterError
 from ..status import PointStatus
 from .robust import STABLE, UNDECIDED, UNSTABLE
 from .kernels import (
-    CHARPOLY_ROUTE, CharpolyTable, charpoly_table, charpoly_verdicts, kernel_eigen, kernel_scaling, kernel_segments,
-    map_kernel,
+    CHARPOLY_ROUTE, CharpolyTable, charpoly_point_verdicts, charpoly_table, charpoly_verdicts, kernel_eigen,
+    kernel_scaling, kernel_segments, map_kernel,
 )
-from .points import ROUTES, closed_form_route, evaluate_arrays, valid_points
+from .points import ROUTES, Points, closed_form_route, evaluate_arrays, valid_points
 
 __all__ = ["Axis", "parse_axis", "stability_map", "write_map", "MapSummary", "classify_grid", "STATUS", "MAX_POINTS",
            "MAX_MAP_BYTES", "map_bytes"]
@@ -410,7 +410,32 @@ def _boundary(space: object, plan: _Plan, stable: np.ndarray, status: np.ndarray
 
     if plan.outer.num * plan.inner.num > BOUNDARY_MAX_POINTS:
         return None
-    return stability_boundary(space, plan.outer, plan.inner, stable, status, iterations=BOUNDARY_ITERATIONS)
+    ev = None
+    if plan.charpoly is not None:
+        def ev(values: dict[str, np.ndarray]) -> Points:
+            return _charpoly_points(space, plan, values)
+    return stability_boundary(space, plan.outer, plan.inner, stable, status, iterations=BOUNDARY_ITERATIONS,
+                              evaluator=ev)
+
+
+def _charpoly_points(space: object, plan: _Plan, values: dict[str, np.ndarray]) -> Points:
+    """Verdicts at scattered points of a map's axes by its characteristic-polynomial route (bisection points
+    of the boundary); undecided points go through :func:`~.points.evaluate_arrays` as on the grid."""
+    assert plan.charpoly is not None
+    xo = np.asarray(values[plan.outer.name], dtype=float)
+    yi = np.asarray(values[plan.inner.name], dtype=float)
+    arr = space.arrays({plan.outer.name: xo, plan.inner.name: yi})  # type: ignore[attr-defined]
+    valid = np.broadcast_to(valid_points(space, arr), xo.shape)
+    codes, mr, fr = charpoly_point_verdicts(plan.charpoly, xo, yi, eigen=False)
+    stable = valid & (codes == STABLE)
+    status = np.where(valid, np.int8(PointStatus.OK), np.int8(PointStatus.INVALID))
+    redo = np.flatnonzero(valid & (codes == UNDECIDED))
+    if redo.size:
+        sub = space.arrays({plan.outer.name: xo[redo], plan.inner.name: yi[redo]})  # type: ignore[attr-defined]
+        res = evaluate_arrays(space, sub, eigen=False, valid=np.ones(redo.size, dtype=bool))
+        stable[redo] = res.stable
+        status[redo] = res.status
+    return Points(status, stable, mr, fr)
 
 
 @dataclass(frozen=True)
