@@ -81,3 +81,34 @@ def test_charpoly_blocks_equal_serial_sweep_for_any_thread_count():
         numba.set_num_threads(before)
     for a, b in zip(again, (codes, mr, fr)):
         np.testing.assert_array_equal(a, b)
+
+
+def test_quartic_roots_blocks_equal_serial_for_any_thread_count():
+    from brakesqueal.analysis.kernels import kernel_eigen, kernel_scaling, map_kernel
+
+    space = ParameterSpace.from_preset("paper-fig2")
+    x, y = Axis("k_ip", 1e5, 1e10, 90, True), Axis("mu", 0.05, 1.0, 300)
+    kern = map_kernel(space, x.name, y.name)
+    assert kern is not None
+    ax = {x.name: x, y.name: y}
+    ov, iv = ax[kern.outer].values(), ax[kern.inner].values()
+    e, t = kernel_scaling(kern, iv)
+    C, _, lam_e = kern.row_tables(ov, e)
+    assert C.shape[0] > 64 and C.shape[0] * t.size >= _compiled.PARALLEL_MIN
+    mr, fr, ok = kernel_eigen(kern, C, t, lam_e)  # blocks of rows in parallel
+    A = np.empty((5, C.shape[0], t.size))
+    kern.coefficients(C, t, A)
+    m1, f1, o1 = np.empty_like(mr), np.empty_like(fr), np.empty_like(ok)
+    _compiled.quartic_top_grid(A, np.ascontiguousarray(lam_e, dtype=np.int64), m1, f1, o1)
+    both = (ok == 1) & (o1 == 1)
+    assert both.mean() > 0.999
+    scale = np.abs(mr) + 2 * np.pi * fr
+    np.testing.assert_array_less(np.abs(mr - m1)[both], 1e-11 * scale[both])
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        again = kernel_eigen(kern, C, t, lam_e)
+    finally:
+        numba.set_num_threads(before)
+    for a, b in zip(again, (mr, fr, ok)):
+        np.testing.assert_array_equal(a, b)

@@ -30,8 +30,8 @@ os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 __all__ = ["peval", "real_roots", "routh_interval", "routh_batch", "quartic_interval_batch", "horner_interval",
            "descartes", "isolate_roots", "critical_batch", "quartic_factor", "quartic_top_grid", "quartic_top_rows",
-           "charpoly_grid", "charpoly_points", "critical_batch_chunks", "charpoly_grid_chunks", "PARALLEL_MIN",
-           "UNSTABLE", "STABLE", "UNDECIDED"]
+           "charpoly_grid", "charpoly_points", "critical_batch_chunks", "charpoly_grid_chunks",
+           "quartic_top_grid_chunks", "PARALLEL_MIN", "UNSTABLE", "STABLE", "UNDECIDED"]
 
 _JIT = dict(cache=True, error_model="numpy")
 
@@ -1472,6 +1472,18 @@ def charpoly_grid_chunks(Q, RQ, xo, yi, valid, eigen, acc, codes, mr, fr, block)
         a = q * block
         b = min(n, a + block)
         charpoly_grid(Q, RQ, xo[a:b], yi, valid[a:b], eigen, acc, codes[a:b], mr[a:b], fr[a:b])
+
+
+@numba.njit(parallel=True, **_JIT)
+def quartic_top_grid_chunks(A, lam_e, mr, fr, ok, block):  # type: ignore[no-untyped-def]
+    """:func:`quartic_top_grid` on blocks of ``block`` rows in parallel (each block warm-starts itself, so the
+    results do not depend on the number of threads)."""
+    n = A.shape[1]
+    nchunk = (n + block - 1) // block
+    for q in numba.prange(nchunk):
+        a = q * block
+        b = min(n, a + block)
+        quartic_top_grid(A[:, a:b], lam_e[a:b], mr[a:b], fr[a:b], ok[a:b])
 
 
 def _guard() -> None:

@@ -1065,7 +1065,7 @@ def kernel_eigen(kern: GridKernel | MapKernel, C: np.ndarray, t: np.ndarray, lam
     ok : ndarray of uint8
         0 where the roots were not found cleanly (NaN there; the caller recomputes those points).
     """
-    from ._compiled import quartic_top_grid
+    from ._compiled import PARALLEL_MIN, quartic_top_grid, quartic_top_grid_chunks
 
     t = np.ascontiguousarray(t, dtype=float)
     rows = C.shape[0]
@@ -1074,8 +1074,13 @@ def kernel_eigen(kern: GridKernel | MapKernel, C: np.ndarray, t: np.ndarray, lam
     mr = np.empty((rows, t.size))
     fr = np.empty((rows, t.size))
     ok = np.empty((rows, t.size), dtype=np.uint8)
+    le = np.ascontiguousarray(lam_e, dtype=np.int64)
     with np.errstate(all="ignore"):
-        quartic_top_grid(A, np.ascontiguousarray(lam_e, dtype=np.int64), mr, fr, ok)
+        if rows * t.size >= PARALLEL_MIN and rows > CHARPOLY_BLOCK:
+            # blocks of rows in parallel, each warm-starting itself (results independent of the thread count)
+            quartic_top_grid_chunks(A, le, mr, fr, ok, CHARPOLY_BLOCK)
+        else:
+            quartic_top_grid(A, le, mr, fr, ok)
     return mr, fr, ok
 
 
