@@ -141,3 +141,29 @@ def test_squeal_branch_finds_contact_loss(tmp_path, capsys):
 
     with xr.open_dataset(out, engine="scipy") as f:
         assert "F_n_min" in f and f.sizes["point"] == d["points"]
+        assert "duty_cycle" in f and "tilt_amplitude" in f and "summary" in f.attrs
+    # the engineer's summary (issue 14 item 4), checked against quantities computed here
+    sm = b.summary
+    assert sm is not None and sm.criticality == "supercritical" and sm.onset == b.hopf.hopf.p0
+    assert sm.squeal_range is not None and sm.squeal_range[0] == pytest.approx(sm.onset)
+    assert sm.squeal_range[1] <= b.contact_loss  # bilateral: no valid squeal beyond the first lift-off
+    assert sm.hysteresis_range is None and sm.folds == []  # supercritical, no fold on the bilateral branch
+    N0 = 3000.0
+    assert sm.table[0]["F_n_max"] == pytest.approx([N0, N0], rel=1e-9)  # the Hopf row: the silent motion
+    for i, row in enumerate(sm.table):
+        orbit = ds["orbit"].values[i]
+        if i > 0:  # first-harmonic tilt amplitude by a DFT of the orbit's samples, here
+            X = np.fft.rfft(orbit[:, :2], axis=0)
+            assert row["tilt_amplitude"] == pytest.approx(float((2 * np.abs(X[1]) / orbit.shape[0]).max()),
+                                                          rel=1e-9)
+        params = space.resolve({"Omega": row["p"]})
+        F = np.array([sim.contact_at(params, y, sim.silent(params))[:, 0] for y in orbit])
+        if np.all(F > 0):
+            assert row["duty_cycle"] == [1.0, 1.0] and row["F_n_max"] == pytest.approx(F.max(axis=0), rel=1e-12)
+        else:
+            assert row["duty_cycle"] == [None, None]
+    assert main(["cycles", "--preset", "paper-fig3", "--set", "mu1=0.5", "--set", "mu2=0.5", "--along",
+                 "Omega=30:40", "--max-points", "6"]) == 0
+    text = capsys.readouterr().out
+    assert "squeal onset (linear): Omega = 35.740780" in text and "stable squeal" in text and "duty" in text
+    assert main(["cycles", "--along", "Omega=30:40", "--contact", "sometimes"]) == 2

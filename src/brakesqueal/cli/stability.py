@@ -201,6 +201,9 @@ def cycles(
     out: Annotated[Optional[str], typer.Option("--out", help="NetCDF file of the branch (.nc).")] = None,
     max_points: Annotated[int, typer.Option("--max-points", min=2, max=2000,
                                             help="Largest number of branch points.")] = 60,
+    contact: Annotated[str, typer.Option("--contact", help="bilateral: the branch is valid up to the first contact "
+                                         "loss (located); unilateral: continued through lift-off and re-contact "
+                                         "(F_n = max(0, .), slower).")] = "bilateral",
 ) -> None:
     """Limit cycles from the first Hopf point on a path: amplitude, frequency, stability, where a pad lifts off."""
     from ..analysis.maps import parse_axis
@@ -208,11 +211,13 @@ def cycles(
     from ..outputs import atomic_write, check_output
 
     axis = parse_axis(along, with_num=False)
+    if contact not in ("bilateral", "unilateral"):
+        raise ParameterError(f"The option '--contact' must be bilateral or unilateral; got {contact!r}")
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     if out:
         check_output(out, what="--out", suffixes=(".nc",))
-    b = squeal_branch(space_from(model, preset, params, set_), axis, max_points=max_points)
+    b = squeal_branch(space_from(model, preset, params, set_), axis, max_points=max_points, contact=contact)
     if out:
         ds = b.data.copy()
         ds.attrs = {k: (json.dumps(v) if isinstance(v, (dict, list, tuple)) or v is None else v)
@@ -233,17 +238,19 @@ def cycles(
     lines = [f"Hopf point {axis.name} = {h.p0:.12g}: {h.criticality} (l1 = {h.l1:.6g} ± {h.l1_error:.2g}), "
              f"{h.frequency0_hz:.6g} Hz",
              f"{d['points']} branch points ({d['status']}: {d['message']})"]
-    if b.contact_loss is not None:
+    if b.contact_loss is not None and b.contact == "bilateral":
         amp = ", ".join(f"{k}: {v:.4g}" for k, v in list(d["amplitude_at_last_contact_point"].items())[:2])
         lines.append(f"a pad loses contact at {axis.name} = {b.contact_loss:.8g} (first-harmonic amplitude {amp} "
-                     f"at {d['in_contact_up_to']:.8g}; the bilateral equations do not hold beyond)")
-    else:
+                     f"at {d['in_contact_up_to']:.8g}; the bilateral equations do not hold beyond; "
+                     "--contact unilateral continues)")
+    elif b.contact_loss is None:
         lines.append("the pads stay in contact along the whole branch")
     lines += [f"special point {sp['kind']} at {axis.name} = {sp['p']:.10g}" for sp in d["special_points"]
               if sp["kind"] != "H"]
     if b.hopf.message:
         lines.append(f"note: {b.hopf.message}")
-    sys.stdout.write("\n".join(lines) + "\n")
+    summary = b.summary.text() if b.summary is not None else ""
+    sys.stdout.write("\n".join(lines) + "\n" + summary)
 
 
 def register(app: typer.Typer) -> None:

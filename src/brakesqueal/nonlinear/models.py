@@ -31,6 +31,7 @@ rate-dependent friction have no such approximation.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -39,9 +40,10 @@ import numpy as np
 
 from ..errors import BrakesquealError
 from .hopf import HopfResult, first_lyapunov
-from .system import SmoothSystem
+from .system import PiecewiseSystem, SmoothSystem, Transition
 
-__all__ = ["model_system", "hopf_points", "HopfPoint", "squeal_branch", "SquealBranch"]
+__all__ = ["model_system", "model_piecewise_system", "hopf_points", "HopfPoint",
+           "squeal_branch", "SquealBranch", "SquealSummary", "squeal_summary"]
 
 
 def model_system(space: Any, name: str, *, use_cache: bool = True) -> SmoothSystem:
@@ -93,6 +95,110 @@ def model_system(space: Any, name: str, *, use_cache: bool = True) -> SmoothSyst
                           parameter_name=name)
     object.__setattr__(system, "simulation_model", sim)
     return system
+
+
+def model_piecewise_system(space: Any, name: str, *, use_cache: bool = True) -> PiecewiseSystem:
+    """A model with unilateral contact as a :class:`~.system.PiecewiseSystem` in the parameter ``name``.
+
+    Mode ``m`` (a bit mask: bit ``j`` set when pad ``j`` is lifted off; mode 0
+    is every pad pressed, the smooth system of :func:`model_system`) has the
+    vector field of the simulation with ``contact="unilateral"``
+    (:meth:`SimulationModel.vector_field <brakesqueal.simulation.SimulationModel.vector_field>`
+    with ``engaged``): a lifted pad exerts no force.  A pressed pad lifts off
+    when its ``F_n`` (the bilateral normal force) falls through 0, a lifted
+    pad comes back when it rises through 0.  The vector field is continuous
+    across these surfaces (the force is 0 there), so the saltation matrices
+    are the identity and no reset is applied.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides (pads with coulomb friction, or with
+        their own degrees of freedom; rate-dependent friction is refused).
+    name : str
+        The continuation parameter.
+    use_cache : bool
+        Use the on-disk code cache.
+
+    Returns
+    -------
+    PiecewiseSystem
+        ``2**n_pads`` modes named by their lifted pads (``"pressed"``,
+        ``"lifted 1"``, ``"lifted 1,2"``, ...).
+
+    Raises
+    ------
+    ParameterError
+        ``name`` not settable, or a pad with rate-dependent friction.
+    """
+    from ..errors import ParameterError
+
+    smooth = model_system(space, name, use_cache=use_cache)
+    sim = smooth.simulation_model  # type: ignore[attr-defined]
+    if sim.dynamic:
+        raise ParameterError(f"unilateral contact is not available for pads with rate-dependent friction "
+                             f"({', '.join(sim.dynamic)})")
+    pads = sim.pads
+    npad = len(pads)
+    cache: dict[tuple[float, int], Any] = {}
+    states: dict[float, tuple[Any, Any]] = {}
+
+    def state(p: float) -> tuple[Any, Any]:
+        key = float(p)
+        if key not in states:
+            if len(states) > 8:
+                states.clear()
+            params = space.resolve({name: key})
+            states[key] = (params, sim.silent(params))
+        return states[key]
+
+    def fields(p: float, mode: int) -> Any:
+        key = (float(p), mode)
+        if key not in cache:
+            if len(cache) > 8 * 2 ** npad:
+                cache.clear()
+            params, st = state(p)
+            cache[key] = sim.vector_field(params, st, engaged=[not (mode >> j) & 1 for j in range(npad)])
+        return cache[key]
+
+    def normal_force(j: int) -> Any:
+        def h(x: np.ndarray, p: float) -> float:
+            params, st = state(p)
+            return float(sim.contact_at(params, x, st)[j, 0])
+
+        return h
+
+    def mode_of(x: np.ndarray, p: float) -> int:
+        params, st = state(p)
+        F = sim.contact_at(params, x, st)[:, 0]
+        return int(sum(1 << j for j in range(npad) if not F[j] > 0))
+
+    guards = [normal_force(j) for j in range(npad)]
+    modes, transitions, names = [], [], []
+    for m in range(2 ** npad):
+        if m == 0:
+            modes.append(smooth)
+        else:
+            def f(x: np.ndarray, p: float, _m: int = m) -> np.ndarray:
+                return fields(p, _m)[0](x)
+
+            def jac(x: np.ndarray, p: float, _m: int = m) -> np.ndarray:
+                return fields(p, _m)[1](x)
+
+            modes.append(SmoothSystem(f=f, jac=jac, n=smooth.n, state_names=smooth.state_names,
+                                      parameter_name=name))
+        tr = []
+        for j in range(npad):
+            if (m >> j) & 1:
+                tr.append(Transition(guards[j], m & ~(1 << j), +1, name=f"re-contact-pad-{pads[j]}"))
+            else:
+                tr.append(Transition(guards[j], m | (1 << j), -1, name=f"contact-loss-pad-{pads[j]}"))
+        transitions.append(tuple(tr))
+        lifted = [pads[j] for j in range(npad) if (m >> j) & 1]
+        names.append("lifted " + ",".join(lifted) if lifted else "pressed")
+    pw = PiecewiseSystem(tuple(modes), tuple(transitions), mode_of, tuple(names))
+    object.__setattr__(pw, "simulation_model", sim)
+    return pw
 
 
 @dataclass(frozen=True)
@@ -195,6 +301,117 @@ def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = 
 
 
 
+def _duty_cycle(orbit: Any, mode0: int, npad: int) -> np.ndarray:
+    """Fraction of the period each pad is pressed, from the orbit's switching events (mode bit j = pad j lifted)."""
+    T = float(orbit.period)
+    off = np.zeros(npad)
+    mode, t_prev = mode0, 0.0
+    for e in sorted(orbit.events, key=lambda e: e.t):
+        t = min(max(float(e.t), 0.0), T)
+        for j in range(npad):
+            if (mode >> j) & 1:
+                off[j] += t - t_prev
+        mode, t_prev = int(e.target), t
+    for j in range(npad):
+        if (mode >> j) & 1:
+            off[j] += T - t_prev
+    return 1.0 - off / T
+
+
+@dataclass(frozen=True)
+class SquealSummary:
+    """What a brake engineer needs from a limit-cycle branch: where squeal exists, how loud, at what frequency.
+
+    Attributes
+    ----------
+    parameter : str
+        The path parameter.
+    onset : float
+        The linear onset (Hopf point).
+    criticality : str
+        ``"supercritical"`` (soft onset), ``"subcritical"`` (hard onset) or ``"degenerate"``.
+    squeal_range : (float, float) or None
+        Parameter range of the computed branch where a *stable* limit cycle exists (squeal can be heard);
+        ``None`` when no computed cycle is stable.
+    hysteresis_range : (float, float) or None
+        Range below (or above) the linear onset where the silent motion is stable but stable squeal coexists
+        (between a fold of cycles and the Hopf point); ``None`` when the branch has no such fold.
+    folds : list of float
+        Parameter values of the folds of cycles (``LPC``).
+    contact : str
+        ``"unilateral"`` (pads lift off and come back) or ``"bilateral"``.
+    contact_loss : float or None
+        Where a pad first lifts off along the branch.
+    validity_end : float or None
+        Where the model first leaves its validity range along the branch: a pad's sliding velocity
+        reverses on the cycle (Coulomb friction would stick; not modelled).  ``None`` if never on the branch.
+    table : list of dict
+        Per branch point: ``p``, ``frequency_hz``, ``tilt_amplitude`` [rad] (largest first-harmonic tilt),
+        ``F_n_max``, ``F_n_min`` [N] per pad (acting force), ``duty_cycle`` per pad (``None`` where a
+        bilateral branch is not valid: a pad would pull), ``stable``, ``sliding_reversal``.
+    pads : tuple of str
+        Pad names.
+    """
+
+    parameter: str
+    onset: float
+    criticality: str
+    squeal_range: tuple[float, float] | None
+    hysteresis_range: tuple[float, float] | None
+    folds: list[float]
+    contact: str
+    contact_loss: float | None
+    validity_end: float | None
+    table: list[dict[str, Any]]
+    pads: tuple[str, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dictionary (all fields)."""
+        return {"parameter": self.parameter, "onset": self.onset, "criticality": self.criticality,
+                "squeal_range": self.squeal_range, "hysteresis_range": self.hysteresis_range, "folds": self.folds,
+                "contact": self.contact, "contact_loss": self.contact_loss, "validity_end": self.validity_end,
+                "pads": list(self.pads), "table": self.table}
+
+    def text(self, rows: int = 8) -> str:
+        """A short report: onset, squeal range, hysteresis, and a table of ``rows`` branch points."""
+        P = self.parameter
+        lines = [f"squeal onset (linear): {P} = {self.onset:.10g}, {self.criticality} "
+                 f"({'soft onset' if self.criticality == 'supercritical' else 'hard onset: jump to large squeal'})"]
+        if self.squeal_range is None:
+            lines.append("no stable limit cycle on the computed branch")
+        else:
+            lines.append(f"stable squeal on the computed branch for {P} in [{self.squeal_range[0]:.8g}, "
+                         f"{self.squeal_range[1]:.8g}]")
+        if self.hysteresis_range is not None:
+            lines.append(f"hysteresis: squeal can persist where the linear analysis says stable, {P} in "
+                         f"({self.hysteresis_range[0]:.8g}, {self.hysteresis_range[1]:.8g})")
+        elif self.folds:
+            lines.append("folds of cycles at " + ", ".join(f"{P} = {v:.8g}" for v in self.folds))
+        else:
+            lines.append("no fold of cycles: no hysteresis on the computed branch")
+        if self.contact_loss is not None:
+            lines.append(f"a pad first lifts off at {P} = {self.contact_loss:.8g} ({self.contact} contact"
+                         f"{'' if self.contact == 'unilateral' else '; the branch beyond is not valid'})")
+        if self.validity_end is not None:
+            lines.append(f"model validity ends at {P} = {self.validity_end:.8g}: a pad's sliding velocity "
+                         "reverses on the cycle (stick-slip is not modelled)")
+        pads = self.pads
+        head = (f"{P:>12} {'f [Hz]':>10} {'tilt [rad]':>11} "
+                + " ".join(f"{'Fn max ' + q:>11} {'duty ' + q:>7}" for q in pads) + "  stable")
+        lines.append(head)
+        tab = self.table
+        idx = sorted(set(np.linspace(0, len(tab) - 1, min(rows, len(tab))).round().astype(int).tolist()))
+        for i in idx:
+            r = tab[i]
+            cells = " ".join(f"{r['F_n_max'][j]:11.5g} " + (f"{r['duty_cycle'][j]:7.3f}" if r["duty_cycle"][j]
+                                                                is not None else f"{'-':>7}") for j in range(len(pads)))
+            flag = "yes" if r["stable"] else "no"
+            if r["sliding_reversal"]:
+                flag += " (sliding reverses)"
+            lines.append(f"{r['p']:12.8g} {r['frequency_hz']:10.6g} {r['tilt_amplitude']:11.4g} {cells}  {flag}")
+        return "\n".join(lines) + "\n"
+
+
 @dataclass(frozen=True)
 class SquealBranch:
     """The limit cycles born at a Hopf point of a brake model, with the pads' contact along them.
@@ -214,12 +431,20 @@ class SquealBranch:
         bilateral equations do not describe the brake (the pad lifts off).
     pads : tuple of str
         Pad names (the ``pad`` dimension).
+    contact : str
+        ``"bilateral"`` (the branch is valid up to the contact loss) or
+        ``"unilateral"`` (continued through lift-off and re-contact; its
+        ``data`` also has ``duty_cycle``).
+    summary : SquealSummary or None
+        The engineer's summary (:func:`squeal_summary`).
     """
 
     hopf: HopfPoint
     branch: Any
     contact_loss: float | None
     pads: tuple[str, ...]
+    contact: str = "bilateral"
+    summary: SquealSummary | None = None
 
     @property
     def data(self) -> Any:
@@ -241,7 +466,8 @@ class SquealBranch:
             "frequency_hz_at_last_contact_point": float(ds["frequency"].values[last]),
             "special_points": [{"kind": str(k), "p": float(v)} for k, v in
                                zip(ds["special_kind"].values, ds["special_p"].values)],
-            "hysteresis_range": ds.attrs.get("hysteresis_range"),
+            "hysteresis_range": ds.attrs.get("hysteresis_range"), "contact": self.contact,
+            "summary": None if self.summary is None else self.summary.to_dict(),
         }
 
     def plot(self, coord: str | int | None = None) -> Any:
@@ -256,7 +482,7 @@ class SquealBranch:
 
 
 def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: bool = True,
-                  tol: float = 1e-8) -> SquealBranch:
+                  tol: float = 1e-8, contact: str = "bilateral") -> SquealBranch:
     """Continue the limit cycles from the first Hopf point on a path and find where a pad loses contact.
 
     Parameters
@@ -272,35 +498,68 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
         Use the on-disk code cache.
     tol : float
         Newton tolerance of the shooting (scaled update).
+    contact : {"bilateral", "unilateral"}
+        ``"bilateral"``: the smooth equations (the branch is valid up to the
+        contact loss, which is located); ``"unilateral"``: shooting with the
+        piecewise flow of :func:`model_piecewise_system`, so the branch goes
+        on through lift-off and re-contact (the contact loss is a ``GR``
+        point of the branch).
 
     Returns
     -------
     SquealBranch
+        With the engineer's :class:`SquealSummary` and its fields in ``data``:
+        ``F_n_min`` (smallest bilateral normal force over the period; negative
+        means a pad lifts off), ``F_n_max`` (largest acting force),
+        ``duty_cycle``, ``tilt_amplitude``, ``sliding_reversal``, ``in_contact``.
 
     Raises
     ------
     ParameterError
-        No Hopf point with a cycle prediction on the path.
+        No Hopf point with a cycle prediction on the path, or a bad ``contact``.
     """
     from ..errors import ParameterError
     from .continuation import continue_cycles
 
+    if contact not in ("bilateral", "unilateral"):
+        raise ParameterError(f"The option 'contact' must be bilateral or unilateral; got {contact!r}")
     pts = [hp for hp in hopf_points(space, axis, use_cache=use_cache) if hp.hopf is not None and hp.hopf.side]
     if not pts:
         raise ParameterError(f"no Hopf point with a limit-cycle prediction for {axis.name} in "
                              f"({axis.start:g}, {axis.stop:g}); see brakesqueal hopf")
     hp = pts[0]
-    system = model_system(space, axis.name, use_cache=use_cache)
-    sim = system.simulation_model  # type: ignore[attr-defined]
-    br = continue_cycles(system, hp.hopf, (axis.start, axis.stop), max_points=max_points, tol=tol)
+    if contact == "unilateral":
+        pw = model_piecewise_system(space, axis.name, use_cache=use_cache)
+        sim = pw.simulation_model  # type: ignore[attr-defined]
+        br = continue_cycles(pw, hp.hopf, (axis.start, axis.stop), max_points=max_points, tol=tol)
+    else:
+        system = model_system(space, axis.name, use_cache=use_cache)
+        sim = system.simulation_model  # type: ignore[attr-defined]
+        br = continue_cycles(system, hp.hopf, (axis.start, axis.stop), max_points=max_points, tol=tol)
     ds = br.data
     p = ds["p"].values
     orbits = ds["orbit"].values
-    fmin = np.full((p.size, len(sim.pads)), np.nan)
+    npad = len(sim.pads)
+    fmin = np.full((p.size, npad), np.nan)
+    fmax = np.full((p.size, npad), np.nan)
+    duty = np.full((p.size, npad), np.nan)
+    reversal = np.zeros(p.size, dtype=bool)
     for i in range(p.size):
         params = space.resolve({axis.name: float(p[i])})
         st = sim.silent(params)
-        fmin[i] = np.min([sim.contact_at(params, y, st)[:, 0] for y in orbits[i]], axis=0)
+        cq = np.array([sim.contact_at(params, y, st) for y in orbits[i]])  # (phase, pad, 7)
+        F = cq[:, :, 0]
+        fmin[i] = F.min(axis=0)
+        pressed = F > 0
+        fmax[i] = np.where(pressed, F, 0.0).max(axis=0)
+        vr0 = st.vr0.reshape(npad, 3)
+        slide = np.einsum("spk,pk->sp", cq[:, :, 1:4], vr0)
+        reversal[i] = bool(np.any((slide <= 0) & pressed))
+        if contact == "unilateral" and i < len(br.orbits) and br.orbits[i].events:
+            o = br.orbits[i]
+            duty[i] = _duty_cycle(o, int(o.sample_modes[0]) if o.sample_modes.size else 0, npad)
+        elif np.all(fmin[i] > 0):
+            duty[i] = 1.0
     worst = fmin.min(axis=1)
     loss = None
     bad = np.flatnonzero(~(worst > 0))
@@ -310,10 +569,75 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
         loss = float(p[i - 1] + (p[i] - p[i - 1]) * a / (a - b)) if a != b else float(p[i])
     import xarray as xr
 
-    ds["F_n_min"] = xr.DataArray(fmin, dims=("point", "pad"), coords={"pad": list(sim.pads)},
-                                 attrs={"units": "N", "long_name": "smallest normal force over one period"})
+    pad_c = {"pad": list(sim.pads)}
+    ds["F_n_min"] = xr.DataArray(fmin, dims=("point", "pad"), coords=pad_c,
+                                 attrs={"units": "N", "long_name": "smallest normal force over one period "
+                                                                   "(bilateral: negative where a pad lifts off)"})
+    ds["F_n_max"] = xr.DataArray(fmax, dims=("point", "pad"), coords=pad_c,
+                                 attrs={"units": "N", "long_name": "largest acting normal force over one period"})
+    ds["duty_cycle"] = xr.DataArray(duty, dims=("point", "pad"), coords=pad_c,
+                                    attrs={"long_name": "fraction of the period the pad is pressed (NaN: the "
+                                                        "bilateral branch is not valid there)"})
+    tilt = [c for c in ("q1", "q2") if c in [str(v) for v in ds["coord"].values]]
+    amp = ds["amplitude"].sel(coord=tilt).max("coord").values if tilt else np.full(p.size, np.nan)
+    ds["tilt_amplitude"] = xr.DataArray(amp, dims=("point",), attrs={"units": "rad", "long_name":
+                                        "largest first-harmonic amplitude of the disk tilt"})
+    ds["sliding_reversal"] = xr.DataArray(reversal, dims=("point",), attrs={"long_name": "a pressed pad's sliding "
+                                          "velocity reverses on the cycle (outside the model's validity)"})
     ds["in_contact"] = xr.DataArray(worst > 0, dims=("point",),
                                     attrs={"long_name": "every pad pressed over the whole period (bilateral "
                                                         "equations valid)"})
     ds.attrs["contact_loss"] = np.nan if loss is None else loss
-    return SquealBranch(hp, br, loss, tuple(sim.pads))
+    ds.attrs["contact"] = contact
+    out = SquealBranch(hp, br, loss, tuple(sim.pads), contact)
+    summ = squeal_summary(out)
+    ds.attrs["summary"] = json.dumps(summ.to_dict(), default=float)
+    return SquealBranch(hp, br, loss, tuple(sim.pads), contact, summ)
+
+
+def squeal_summary(branch: SquealBranch) -> SquealSummary:
+    """The engineer's summary of a squeal branch (see :class:`SquealSummary`).
+
+    Parameters
+    ----------
+    branch : SquealBranch
+        From :func:`squeal_branch` (its ``data`` has the contact fields).
+
+    Returns
+    -------
+    SquealSummary
+        The squeal range is the span of the stable points that are valid
+        (every pad pressed for a bilateral branch); the hysteresis range is
+        the branch's (fold to Hopf point), or, for any fold of cycles on the
+        far side of the onset from the cycles' birth, the range between it
+        and the onset.
+    """
+    ds = branch.data
+    p = ds["p"].values
+    stable = ds["stable"].values.astype(bool)
+    valid = np.ones(p.size, dtype=bool) if branch.contact == "unilateral" else ds["in_contact"].values.astype(bool)
+    ok = stable & valid
+    h = branch.hopf.hopf
+    onset = float(h.p0) if h is not None else float(branch.hopf.value)
+    rng = (float(p[ok].min()), float(p[ok].max())) if ok.any() else None
+    folds = [float(v) for k, v in zip(ds["special_kind"].values, ds["special_p"].values) if str(k) == "LPC"]
+    hyst = branch.branch.hysteresis_range
+    if hyst is None and folds and h is not None and h.side:
+        beyond = [f for f in folds if (f - onset) * h.side < 0]  # a fold on the linearly stable side
+        if beyond and ok.any():
+            f = max(beyond, key=lambda v: abs(v - onset))  # the farthest fold bounds the coexistence range
+            hyst = (min(f, onset), max(f, onset))
+    rev = ds["sliding_reversal"].values.astype(bool)
+    validity_end = float(p[np.flatnonzero(rev)[0]]) if rev.any() else None
+    tab = []
+    for i in range(p.size):
+        tab.append({"p": float(p[i]), "frequency_hz": float(ds["frequency"].values[i]),
+                    "tilt_amplitude": float(ds["tilt_amplitude"].values[i]),
+                    "F_n_max": [float(v) for v in ds["F_n_max"].values[i]],
+                    "F_n_min": [float(max(v, 0.0)) if branch.contact == "unilateral" else float(v)
+                                for v in ds["F_n_min"].values[i]],
+                    "duty_cycle": [float(v) if math.isfinite(v) else None for v in ds["duty_cycle"].values[i]],
+                    "stable": bool(stable[i]), "sliding_reversal": bool(rev[i])})
+    crit = h.criticality if h is not None else "unknown"
+    return SquealSummary(str(ds.attrs.get("parameter", branch.hopf.parameter)), onset, crit, rng, hyst, folds,
+                         branch.contact, branch.contact_loss, validity_end, tab, branch.pads)

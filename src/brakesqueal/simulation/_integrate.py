@@ -377,6 +377,14 @@ def state_jacobian(model: SimulationModel, J: np.ndarray) -> np.ndarray:
     dyn = np.array([k == "dynamic" for k in model.pad_kinds], dtype=bool)
     qs = ~dyn
     M, D, K = R[:, ddQ].copy(), R[:, dQ].copy(), R[:, Q].copy()
+    if not dyn.any():  # no pad state: f_y = [[0, I], [-M^-1 K, -M^-1 D]] (the same elimination, fewer operations)
+        if m:
+            P = np.linalg.solve(G[:, L].T, R[:, L].T).T
+            M, D, K = M - P @ G[:, ddQ], D - P @ G[:, dQ], K - P @ G[:, Q]
+        out = np.zeros((2 * n, 2 * n))
+        out[:n, n:] = np.eye(n)
+        out[n:] = -np.linalg.solve(M, np.hstack([K, D]))
+        return out
     R_L, R_dL = R[:, L], R[:, dL]
     G_Q, G_dQ, G_ddQ, G_L, G_dL = G[:, Q], G[:, dQ], G[:, ddQ], G[:, L], G[:, dL]
     if qs.any():

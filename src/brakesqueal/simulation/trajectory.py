@@ -457,6 +457,10 @@ class Trajectory:
         ``re-contact-pad-<name>``.
     stats : dict
         ``nfev``, ``wall_s`` and (compiled method) ``steps``, ``rejected``.
+    contact_law : str
+        ``"bilateral"`` or ``"unilateral"`` (:func:`~brakesqueal.simulation.simulate`'s ``contact``).
+    engaged : ndarray of bool, shape (N, n_pads), or None
+        Unilateral contact: whether each pad is pressed at each output sample.
     model : str
         The model's name.
     record : EstimationRecord or None
