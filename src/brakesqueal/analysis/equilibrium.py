@@ -24,6 +24,10 @@ generalized) and ``G`` (eqs. 33-34) are ``n + m`` equations
 * **Validity.** Every pad must touch (``F_n > 0``) and slide (``|v_r| > 0``)
   at the silent motion (:class:`~brakesqueal.errors.ContactLossError`,
   :class:`~brakesqueal.errors.NoSlidingError`).
+* **Many points** (:func:`silent_motions`): the Newton stage runs compiled
+  for all points in one loop (:mod:`~.silent_batch`, the same iteration and
+  tests); every point it does not accept cleanly goes through
+  :func:`silent_motion_vector`, so statuses are those of the per-point route.
 """
 
 from __future__ import annotations
