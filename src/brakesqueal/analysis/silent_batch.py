@@ -143,6 +143,7 @@ def newton_batch(P, S, floor, max_tilt, max_iter, Z, code, iters, FN, SPEED):
     r = np.zeros(K)
     step = np.zeros(K)
     J = np.zeros((K, K))
+    J0 = np.zeros((K, K))
     row = np.zeros(K)
     col = np.zeros(K)
     c0 = np.zeros((_NPAD, _NF))
@@ -154,12 +155,12 @@ def newton_batch(P, S, floor, max_tilt, max_iter, Z, code, iters, FN, SPEED):
             z[k] = 0.0
             y[k] = 0.0
         # equilibration at z = 0: rows by their largest entry, then columns
-        static_jacobian(z, p, J)
+        static_jacobian(z, p, J0)
         bad = False
         for a in range(K):
             mx = 0.0
             for b in range(K):
-                v = abs(J[a, b])
+                v = abs(J0[a, b])
                 if not v < math.inf:
                     bad = True
                 if v > mx:
@@ -168,7 +169,7 @@ def newton_batch(P, S, floor, max_tilt, max_iter, Z, code, iters, FN, SPEED):
         for b in range(K):
             mx = 0.0
             for a in range(K):
-                v = abs(J[a, b]) / row[a]
+                v = abs(J0[a, b]) / row[a]
                 if v > mx:
                     mx = v
             col[b] = mx if mx > 0.0 else 1.0
@@ -200,7 +201,12 @@ def newton_batch(P, S, floor, max_tilt, max_iter, Z, code, iters, FN, SPEED):
                     rsize = abs(r[k])
             stalled = rsize >= 0.5 * rlast
             rlast = rsize
-            static_jacobian(z, p, J)
+            if it == 1:  # z = 0: the Jacobian of the equilibration
+                for a in range(K):
+                    for b in range(K):
+                        J[a, b] = J0[a, b]
+            else:
+                static_jacobian(z, p, J)
             for a in range(K):
                 for b in range(K):
                     J[a, b] = J[a, b] / row[a] / col[b]
