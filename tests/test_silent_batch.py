@@ -210,3 +210,27 @@ def test_near_the_trivial_line_no_false_failure(mu1, h20):
     F0 = float(np.max(np.abs(np.asarray(cm.zero_residuals([float(v) for v in P[0]]), dtype=float))))
     assert np.max(np.abs(psi)) <= 1e-6 * k_t * np.abs(sm.q0).max() < 1e-3 * F0  # a root, not the zero state
     assert np.max(np.abs(g)) <= 1e-12
+
+
+def test_why_no_warm_start_from_the_neighbour():
+    """Along k_t the branch of a neighbour continues where the homotopy from the trivial state folds (no silent
+    motion on that branch, an established status): a Newton warm-started from the neighbour's solution would
+    report a silent motion there.  The batched route starts from the trivial state and keeps the status."""
+    from brakesqueal.model import get_preset
+
+    base = get_preset("general").resolve().replace(
+        k_t=1e6, mu1=1.6826345592247665, mu2=0.1333800175342028, h10=0.027874097668453765,
+        h20=0.0435995744628355, N0=79101.77744387428, k1=4860663.169200994, k2=597852.128134904,
+        k_ip1=926195.9047145735)
+    cm = compile_model(base.model)
+    kts = np.logspace(np.log10(1.26e4), 3, 6)
+    P = np.array([[float(v) for v in base.replace(k_t=kt).vector()] for kt in kts])
+    a = silent_motions(cm, P)
+    assert a.status[0] == int(PointStatus.OK_NONTRIVIAL)
+    assert np.all(a.status[1:] == int(PointStatus.NO_SILENT_MOTION))
+    prev = a.z[0]
+    for p in P[1:]:  # the warm-started Newton finds admissible roots all along
+        sysm = _System(cm, [float(v) for v in p])
+        y, _, ok = _newton(sysm, prev * sysm.col, np.zeros(cm.n + cm.m))
+        assert ok and sysm.admissible(y)
+        prev = sysm.z(y)
