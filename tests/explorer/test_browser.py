@@ -131,3 +131,40 @@ def test_bad_input_shows_the_message_and_keeps_the_view(page):
     text = message.text_content()
     assert "'mu1'" in text and "[0, inf)" in text
     assert page.page.locator("#bs-leading").text_content() == library_leading([])
+
+
+def test_caps_are_explained_in_the_page(page):
+    page.open("nx=2000&ny=1000")
+    s = page.wait(lambda s: "map" in s)
+    assert "at most 1,000,000 points" in s["map"]["error"]
+    page.page.get_by_text("the explorer computes at most 1,000,000 points").wait_for(timeout=30_000)
+
+
+def test_cancel_stops_a_simulation(page):
+    page.open("t_end=5")
+    page.page.get_by_role("button", name="Simulate").click()
+    page.page.get_by_role("button", name="Cancel").click()
+    s = page.wait(lambda s: "sim" in s, timeout=600)
+    # a run of 5 s takes far longer than the click; the lane reports the cancellation
+    assert s["sim"].get("error") == "cancelled", s["sim"]
+
+
+def test_limit_cycles_end_at_the_contact_loss(page):
+    # paper-fig3 at mu1 = mu2 = 0.5 along Omega in [30, 40]: supercritical onset at 35.74 rad/s (hopf, cycles)
+    page.open("preset=paper-fig3&set=mu1%3D0.5,mu2%3D0.5,Omega%3D36&along=Omega")
+    page.wait(lambda s: s["locus"]["state"]["along"] == "Omega")
+    page.page.get_by_role("button", name="Cycles").click()
+    s = page.wait(lambda s: "cycles" in s, timeout=900)
+    assert "error" not in s["cycles"], s["cycles"]
+    from brakesqueal import resolve_space
+    from brakesqueal.analysis.maps import Axis
+    from brakesqueal.explorer.state import slider_range
+    from brakesqueal.nonlinear.models import hopf_points
+
+    space = resolve_space(None, "paper-fig3", None, ["mu1=0.5", "mu2=0.5", "Omega=36"])
+    rng = slider_range(space, "Omega")
+    onset = next(h for h in hopf_points(space, Axis("Omega", rng.low, rng.high, 2, rng.log)) if h.hopf is not None)
+    assert f"{onset.hopf.p0:.6g}" in s["cycles"]["summary"]
+    assert s["cycles"]["points"] >= 3
+    assert s["cycles"]["contact_loss"] is None or s["cycles"]["contact_loss"] > onset.hopf.p0
+    page.screenshot("cycles")

@@ -34,6 +34,7 @@ from .state import (
     SliderRange,
     ViewState,
     critical_speed_text,
+    cycles_view,
     format_eigenvalue,
     hopf_scan,
     hopf_text,
@@ -111,6 +112,7 @@ class Explorer:
         self.map_lane = LatestWorker(self._compute_map, self._show_map, schedule,
                                      progress=self._map_progress, name="explorer-map")
         self.info_lane = LatestWorker(self._compute_info, self._show_info, schedule, name="explorer-info")
+        self.cycles_lane = LatestWorker(self._compute_cycles, self._show_cycles, schedule, name="explorer-cycles")
         self.sim_lane = LatestWorker(self._compute_sim, self._show_sim, schedule,
                                      progress=self._sim_progress, name="explorer-sim")
         self.page = self._layout()
@@ -132,7 +134,8 @@ class Explorer:
 
     def stop(self) -> None:
         """End the session's worker threads."""
-        for lane in (getattr(self, n, None) for n in ("locus_lane", "map_lane", "info_lane", "sim_lane")):
+        lanes = ("locus_lane", "map_lane", "info_lane", "cycles_lane", "sim_lane")
+        for lane in (getattr(self, n, None) for n in lanes):
             if lane is not None:
                 lane.stop()
 
@@ -161,6 +164,8 @@ class Explorer:
         self.t_end_input.param.watch(self._on_view, "value")
         self.sim_button = pn.widgets.Button(name="Simulate", button_type="primary", width=100)
         self.sim_button.on_click(self._on_simulate)
+        self.cycles_button = pn.widgets.Button(name="Cycles", width=80)
+        self.cycles_button.on_click(self._on_cycles)
         self.cancel_button = pn.widgets.Button(name="Cancel", width=80)
         self.cancel_button.on_click(self._on_cancel)
         self.map_progress = pn.indicators.Progress(value=0, max=100, width=150, visible=False)
@@ -171,6 +176,8 @@ class Explorer:
         self.map_text = pn.pane.HTML("", sizing_mode="stretch_width")
         self.sim_text = pn.pane.HTML("Press Simulate to integrate the nonlinear equations and hear the squeal.",
                                      sizing_mode="stretch_width")
+        self.cycles_text = pn.pane.HTML("Press Cycles to continue the limit cycles from the Hopf point on the path.",
+                                        sizing_mode="stretch_width")
         self.audio = pn.pane.Audio(None, name="squeal", sample_rate=AUDIO_RATE, width=320, css_classes=["bs-audio"])
         self.render = pn.pane.HTML(self._render_html(), width=0, height=0, margin=0)
 
@@ -260,6 +267,17 @@ class Explorer:
                    y_axis_type="log", tools="pan,wheel_zoom,box_zoom,reset")
         s.line("f", "a", source=self.src_spec, line_width=0.8)
         self.fig_spec = s
+        self.src_cycles = ColumnDataSource({"p": [], "a": [], "color": []})
+        self.span_loss = Span(location=None, dimension="height", line_color="#d62728", line_dash="dotted",
+                              line_width=2)
+        c = figure(height=220, width=420,
+                   title="limit cycles (blue: stable, orange: unstable, grey: beyond the contact loss)",
+                   x_axis_label="path parameter", y_axis_label="tilt amplitude [rad]",
+                   tools="pan,wheel_zoom,box_zoom,reset")
+        c.scatter("p", "a", source=self.src_cycles, color="color", size=5)
+        c.add_layout(self.span_loss)
+        c.title.text_font_size = "9pt"
+        self.fig_cycles = c
 
     def _modes_figure(self, log: bool) -> Any:
         from bokeh.layouts import column
@@ -311,16 +329,18 @@ class Explorer:
         left = pn.Column(self.params_box, self.fixed_box,
                          pn.Row(self.along_select, self.x_select, self.y_select),
                          pn.Row(self.nx_input, self.ny_input, self.map_progress),
-                         pn.Row(self.t_end_input, self.sim_button, self.cancel_button), self.sim_progress,
+                         pn.Row(self.t_end_input, self.sim_button),
+                         pn.Row(self.cycles_button, self.cancel_button),
+                         self.sim_progress,
                          width=400)
         legend = pn.pane.HTML("<small>map: <span style='background:#a9cdf5'>&nbsp;stable&nbsp;</span> "
                               "<span style='background:#f3a5a5'>&nbsp;unstable&nbsp;</span> "
                               "<span style='background:#c8c8c8'>&nbsp;no verdict&nbsp;</span>; black: the exact "
                               "boundary (refined by bisection); green cross: the current point</small>")
         texts = pn.Column(self.leading_text, self.cs_text, self.hopf_text, self.map_text, legend, self.sim_text,
-                          width=460)
+                          self.cycles_text, width=460)
         views = pn.Column(pn.Row(self.pane_locus, self.pane_modes), pn.Row(self.pane_map, texts),
-                          pn.Row(self.fig_hist, self.fig_spec), self.audio)
+                          pn.Row(self.fig_hist, self.fig_spec), pn.Row(self.audio, self.fig_cycles))
         return pn.Column(head, self.alert, pn.Row(left, views), self.render, sizing_mode="stretch_width")
 
     # ------------------------------------------------------------------------------------------ state changes
@@ -459,7 +479,38 @@ class Explorer:
         self.sim_progress.value, self.sim_progress.visible = 0, True
         self.sim_lane.submit(self.state)
 
+    def _on_cycles(self, event: Any) -> None:
+        self.cycles_text.object = "continuing the limit cycles … (Cancel drops the result)"
+        self.cycles_lane.submit(self.state)
+
+    def _compute_cycles(self, state: ViewState, check: Any) -> Any:
+        space = self.origin.space_of(state)
+        rng = self.ranges.get(state.along) or slider_range(space, state.along)
+        cv = cycles_view(space, state.along, rng)
+        check(1.0)  # the continuation has no progress reports: a cancel drops its result
+        return cv
+
+    def _show_cycles(self, state: ViewState, cv: Any, error: BaseException | None) -> None:
+        if error is not None:
+            msg = "cancelled" if isinstance(error, Cancelled) else str(error)
+            self.cycles_text.object = f"<b>limit cycles:</b> {html.escape(msg)}"
+            self.shown["cycles"] = {"state": state.to_query(), "error": msg}
+        else:
+            lifted = np.zeros(cv.p.size, dtype=bool)
+            if cv.contact_loss is not None and cv.p.size:  # the branch starts at the Hopf point
+                lifted = np.abs(cv.p - cv.p[0]) > abs(cv.contact_loss - cv.p[0])
+            self.src_cycles.data = {"p": cv.p, "a": cv.amplitude,
+                                    "color": ["#bbbbbb" if off else "#4c72b0" if st else "#dd8452"
+                                              for st, off in zip(cv.stable, lifted)]}
+            self.span_loss.location = cv.contact_loss
+            self.fig_cycles.xaxis.axis_label = _label(self.origin.space_of(state), state.along)
+            self.cycles_text.object = html.escape(cv.summary)
+            self.shown["cycles"] = {"state": state.to_query(), "points": int(cv.p.size),
+                                    "contact_loss": cv.contact_loss, "summary": cv.summary}
+        self._mark()
+
     def _on_cancel(self, event: Any) -> None:
+        self.cycles_lane.cancel()
         self.sim_lane.cancel()
         self.map_lane.cancel()
         self.info_lane.cancel()

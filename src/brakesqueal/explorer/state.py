@@ -32,7 +32,8 @@ from ..errors import ParameterError
 __all__ = ["MAX_MAP_POINTS", "MAX_T_END", "LOCUS_POINTS", "AUDIO_RATE", "SliderRange", "ViewState",
            "slider_range", "format_eigenvalue", "leading_eigenvalue", "MapView", "map_view", "LocusView",
            "locus_view", "critical_speed_text", "hopf_scan", "hopf_text", "SimulationView",
-           "simulation_view", "check_map_size", "check_t_end", "Origin", "audio_samples", "default_axes"]
+           "simulation_view", "check_map_size", "check_t_end", "Origin", "audio_samples", "default_axes", "CyclesView",
+           "cycles_view"]
 
 #: Largest number of map points the explorer computes (``brakesqueal map`` has no such cap).
 MAX_MAP_POINTS = 1_000_000
@@ -610,3 +611,57 @@ class Origin:
         names = space.settable()
         return replace(state, along=state.along if state.along in names else along,
                        x=state.x if state.x in names else x, y=state.y if state.y in names else y)
+
+
+# ---------------------------------------------------------------------------------------------- limit cycles
+@dataclass(frozen=True)
+class CyclesView:
+    """The limit-cycle branch from the first Hopf point on the path, up to the pads' contact loss.
+
+    Attributes
+    ----------
+    p : ndarray
+        Path values of the branch points.
+    amplitude : ndarray
+        Tilt amplitude of each cycle [rad] (a non-tilting disk: NaN).
+    stable : ndarray of bool
+        Stability of each cycle.
+    contact_loss : float or None
+        Where a pad first loses contact along the branch.
+    summary : str
+        One line: onset, criticality, squeal range, contact loss.
+    """
+
+    p: np.ndarray
+    amplitude: np.ndarray
+    stable: np.ndarray
+    contact_loss: float | None
+    summary: str
+
+
+def cycles_view(space: Any, along: str, rng: SliderRange) -> CyclesView:
+    """Continue the limit cycles along the path (:func:`~brakesqueal.nonlinear.models.squeal_branch`).
+
+    Raises
+    ------
+    ParameterError
+        No Hopf point with a cycle prediction on the path.
+    """
+    from ..analysis.maps import Axis
+    from ..nonlinear.models import squeal_branch
+
+    br: Any = squeal_branch(space, Axis(along, rng.low, rng.high, 2, rng.log))
+    s = br.summary
+    rows = list(s.table) if s is not None else []
+    p = np.array([float(r["p"]) for r in rows])
+    amp = np.array([float(r["tilt_amplitude"]) if r.get("tilt_amplitude") is not None else math.nan for r in rows])
+    stable = np.array([bool(r.get("stable")) for r in rows], dtype=bool)
+    loss = br.contact_loss
+    if s is None:
+        text = f"limit cycles along {along}: no summary"
+    else:
+        rng_txt = (f"squeal for {along} in [{s.squeal_range[0]:.6g}, {s.squeal_range[1]:.6g}]"
+                   if s.squeal_range else "no squeal range")
+        text = (f"limit cycles from the Hopf point at {along} = {s.onset:.6g} ({s.criticality}): {rng_txt}; "
+                + (f"a pad loses contact at {along} = {loss:.6g}" if loss is not None else "the pads stay in contact"))
+    return CyclesView(p, amp, stable, None if loss is None else float(loss), text)

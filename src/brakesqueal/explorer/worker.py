@@ -77,8 +77,11 @@ class LatestWorker:
         """Cancel the running job and drop the pending one."""
         with self._cv:
             self._cancel = True
+            dropped, had = self._pending, self._has_pending
             self._has_pending = False
             self._pending = None
+        if had:  # a job that never started is reported as cancelled too
+            self._schedule(partial(self._deliver, dropped, None, Cancelled("cancelled")))
 
     def stop(self) -> None:
         """End the thread after the running job (the session is gone)."""
