@@ -1,0 +1,85 @@
+"""critical-speed at the magnitude bound (1e±100): every certain verdict agrees with exact arithmetic (issue 11).
+
+The characteristic polynomial ``det(M s^2 + D s + K)`` of the paper's closed
+form (eqs. 51-54, derived with SymPy here, independently of the compiled
+kernels) is evaluated in exact rationals at points between and beyond the
+reported crossings; Routh-Hurwitz for the quartic gives the verdict.  A
+route that claimed certainty it does not have (overflow in products of
+1e100-sized terms) would disagree here.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import sympy as sp
+
+from brakesqueal.analysis.crossings import critical_speeds
+from brakesqueal.model.parameters import ParameterSpace
+
+BASE = {"mu1": "0.6", "mu2": "0.4", "k_ip": "1e8", "h": "0.02", "r": "0.13", "k_t": "1.88e7", "d_t": "0.1",
+        "k1": "6e6", "k2": "6e6", "d1": "5", "d2": "5", "Phi": "0.32", "N0": "3000", "R_disk": "0.15"}
+
+
+@pytest.fixture(scope="module")
+def charpoly():
+    """The quartic's coefficients as functions of the paper-fig3 parameters (exact, SymPy)."""
+    names = ("Theta Phi k_t d_t k1 k2 d1 d2 k_ip1 k_ip2 mu1 mu2 h10 h20 r N0 Omega s").split()
+    S = dict(zip(names, sp.symbols(names)))
+    Theta, Phi, k_t, d_t, k1, k2, d1, d2, kp1, kp2, mu1, mu2, h10, h20, r, N0, Om, s = (S[n] for n in names)
+    # the paper's eqs. (51)-(54) for q_m0 = 0 (eq. 49 holds in paper-fig3), as printed by `brakesqueal derive`
+    M = sp.Matrix([[Theta, 0], [0, Theta]])
+    D = sp.Matrix([
+        [(N0*Om*d1*h10*kp2*mu1**2*r + N0*Om*d2*h20*kp1*mu2**2*r + N0*h10**2*kp1*kp2*mu1 + N0*h20**2*kp1*kp2*mu2
+          + Om*d1*kp1*kp2*r**3 + Om*d2*kp1*kp2*r**3 + Om*d_t*kp1*kp2*r)/(Om*kp1*kp2*r), Om*Phi],
+        [(N0*d1*kp2*mu1*r + N0*d2*kp1*mu2*r - Om*Phi*kp1*kp2 - d1*h10*kp1*kp2*mu1*r - d2*h20*kp1*kp2*mu2*r)
+         / (kp1*kp2), d_t]])
+    K = sp.Matrix([
+        [(N0*h10*k1*kp2*mu1**2 + N0*h10*kp1*kp2 + N0*h20*k2*kp1*mu2**2 + N0*h20*kp1*kp2 + k1*kp1*kp2*r**2
+          + k2*kp1*kp2*r**2 + kp1*kp2*k_t)/(kp1*kp2),
+         N0*(-N0*h10*kp2*mu1**3 - N0*h10*kp2*mu1 - N0*h20*kp1*mu2**3 - N0*h20*kp1*mu2 + h10**2*kp1*kp2*mu1
+             + h20**2*kp1*kp2*mu2)/(kp1*kp2*r)],
+        [r*(N0*k1*kp2*mu1 + N0*k2*kp1*mu2 - N0*kp1*kp2*mu1 - N0*kp1*kp2*mu2 - h10*k1*kp1*kp2*mu1
+            - h20*k2*kp1*kp2*mu2)/(kp1*kp2),
+         (-N0**2*kp1*mu2**2 - N0**2*kp1 - N0**2*kp2*mu1**2 - N0**2*kp2 + N0*h10*kp1*kp2*mu1**2 + N0*h10*kp1*kp2
+          + N0*h20*kp1*kp2*mu2**2 + N0*h20*kp1*kp2 + kp1*kp2*k_t)/(kp1*kp2)]])
+    return S, (M, D, K)
+
+
+def _exact_verdict(charpoly, values: dict[str, str], omega: float) -> str:
+    S, (M, D, K) = charpoly
+    v = {k: sp.Rational(x) for k, x in values.items()}
+    kip = v.pop("k_ip")
+    h, Rd = v.pop("h"), v.pop("R_disk")
+    v.update(k_ip1=kip, k_ip2=kip, h10=h*v["mu2"]/(v["mu1"] + v["mu2"]), h20=h*v["mu1"]/(v["mu1"] + v["mu2"]))
+    v["Theta"] = v["Phi"]/2 + v["Phi"]/(2*Rd**2)*(v["h10"] - v["h20"])**2
+    v["Omega"] = sp.Rational(repr(omega))
+    sub = {S[k]: x for k, x in v.items()}
+    s = S["s"]
+    c = sp.Poly(sp.expand((M.subs(sub)*s**2 + D.subs(sub)*s + K.subs(sub)).det()), s).all_coeffs()  # exact
+    if c[0] < 0:
+        c = [-x for x in c]
+    a4, a3, a2, a1, a0 = c
+    h3 = a3*a2*a1 - a4*a1**2 - a3**2*a0
+    return "stable" if all(x > 0 for x in c) and h3 > 0 else "unstable"
+
+
+@pytest.mark.parametrize("name,value", [("k_ip", "1e100"), ("k_t", "1e100"), ("N0", "1e100"), ("Phi", "1e100"),
+                                        ("d1", "1e100"), ("Phi", "1e-100"), ("N0", "1e-100"), ("k_ip", "1e-100")])
+def test_critical_speeds_at_the_magnitude_bound_agree_with_exact_hurwitz(charpoly, name, value):
+    values = {**BASE, name: value}
+    space = ParameterSpace.from_preset("paper-fig3", {name: float(value)})
+    r = critical_speeds(space, 1.0, 1e5)
+    d = r.to_dict()
+    assert set(d) >= {"stable_at_start", "crossings"}, d
+    roots = [c["value"] if isinstance(c, dict) else c[0] for c in d.get("crossings", [])]
+    certain = d.get("exhaustive", True) and not d.get("undecided_ranges")
+    edges = [1.0, *roots, 1e5]
+    probes = [math.sqrt(a * b) for a, b in zip(edges[:-1], edges[1:])]  # one point inside every interval
+    expected = "stable" if d["stable_at_start"] else "unstable"
+    for k, omega in enumerate(probes):
+        if certain:
+            assert _exact_verdict(charpoly, values, omega) == expected, (name, value, omega, d)
+        if k < len(roots):
+            expected = "unstable" if expected == "stable" else "stable"
