@@ -136,3 +136,14 @@ def test_the_guard_restores_the_handler_and_wakeup_fd():
         assert signal.getsignal(signal.SIGINT) is not signal.default_int_handler
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
     assert signal.set_wakeup_fd(before) == before
+
+
+def test_main_called_with_arguments_never_ends_its_callers_process(tmp_path):
+    """Only the program (``main()`` from the entry point) may end the process; ``main(argv)`` returns 130."""
+    code = ("import os, signal, sys, time\nimport brakesqueal.cli as c\n"
+            "from numba.core.compiler_lock import global_compiler_lock\n"
+            "def app(*a, **k):\n    with global_compiler_lock:\n        os.kill(os.getpid(), signal.SIGINT)\n"
+            "        time.sleep(1.5)\n    from brakesqueal.interrupts import check_interrupt\n    check_interrupt()\n"
+            "c.app = app\nprint('returned', c.main(['list']))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0 and out.stdout.strip() == "returned 130", (out.stdout, out.stderr)

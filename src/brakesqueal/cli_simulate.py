@@ -120,10 +120,10 @@ def _simulate_cmd(
         init["perturbation"] = _floats(q0, "--q0")
     _check_outputs(out, plot, wav)
     from .model.options import resolve_space
-    from .interrupts import EXIT_AFTER_S, interrupt_guard
+    from .interrupts import interrupt_guard
 
     p = resolve_space(model, preset, params, list(set_ or [])).resolve({})
-    with interrupt_guard(exit_after=EXIT_AFTER_S):
+    with interrupt_guard():  # nested in the program's guard (brakesqueal.cli.main), which ends a stuck run
         tr = _run(p, t_end, method, rtol, atol, events, sample_rate, progress, no_cache, init)
         if wav and tr.t.size < 2:
             raise ParameterError("the trajectory has fewer than two samples; nothing to write to --wav")

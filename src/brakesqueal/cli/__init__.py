@@ -292,10 +292,12 @@ def main(argv: list[str] | None = None) -> int:
         args = ["--help"]
     from ..interrupts import EXIT_AFTER_S, EXIT_STATUS, exit_now, interrupt_guard
 
+    program = argv is None
     try:
-        # Ctrl-C within a second: a command that does not unwind in EXIT_AFTER_S is ended (not a sweep: its
-        # Dask workers must be shut down); the program itself then skips the interpreter's slow teardown
-        with interrupt_guard(exit_after=None if args[:1] == ["sweep"] else EXIT_AFTER_S):
+        # Ctrl-C within a second: the program (never a caller of main(argv) in its own process) ends a command
+        # that does not unwind in EXIT_AFTER_S (not a sweep: its Dask workers must be shut down), and then skips
+        # the interpreter's slow teardown
+        with interrupt_guard(exit_after=EXIT_AFTER_S if program and args[:1] != ["sweep"] else None):
             rv = app(args=args, prog_name="brakesqueal", standalone_mode=False)
     except BrakesquealError as exc:
         print(f"brakesqueal: error: {exc}", file=sys.stderr)
@@ -312,7 +314,7 @@ def main(argv: list[str] | None = None) -> int:
         rv = EXIT_STATUS
     if rv == EXIT_STATUS:
         print("brakesqueal: interrupted", file=sys.stderr)
-        if argv is None:
+        if program:
             exit_now(EXIT_STATUS)  # the program: outputs are complete or removed; no slow teardown
         return EXIT_STATUS
     return rv if isinstance(rv, int) else 0
