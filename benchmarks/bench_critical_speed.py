@@ -67,5 +67,8 @@ def run(n: int = 100000) -> list[BenchResult]:
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--n", type=int, default=100000)
-    emit(run(ap.parse_args().n))
+    ap.add_argument("--n", type=int, default=100000, help="points of the batch, in [1, 10^8]")
+    n = ap.parse_args().n
+    if not 1 <= n <= 10**8:
+        ap.error(f"--n must be in [1, 10^8]; got {n}")
+    emit(run(n))
