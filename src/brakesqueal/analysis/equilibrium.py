@@ -269,7 +269,8 @@ def _continuation(sysm: _System, F0s: np.ndarray, tol: np.ndarray | None = None)
                 raise NoSilentMotionError(
                     f"the silent motion connected to the trivial one leaves the range of the kinematics "
                     f"(|q1|, |q2| < {MAX_TILT} rad) at {100 * max(s, 0.0):.3g} % of the asymmetry: "
-                    "no silent motion with these parameters")
+                    "no silent motion on the branch connected to the trivial one (a silent motion on another branch "
+                    "is not excluded)")
             ok = False
         if not ok:
             h /= 2
@@ -281,7 +282,8 @@ def _continuation(sysm: _System, F0s: np.ndarray, tol: np.ndarray | None = None)
         if t_new[-1] < 0 and sc < 1.0:
             raise NoSilentMotionError(
                 f"the silent motion connected to the trivial one turns back at {100 * sc:.4g} % of the "
-                "asymmetry (a fold): no silent motion exists with these parameters")
+                "asymmetry (a fold): no silent motion on this branch (a silent motion on another branch, e.g. one "
+                "reached by continuation in a parameter, is not excluded)")
         if sc >= 1.0:
             # land exactly on s = 1 from the bracketing points; if Newton fails there, approach in smaller steps
             frac = (1.0 - s) / (sc - s) if sc > s else 1.0

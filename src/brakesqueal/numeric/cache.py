@@ -66,6 +66,7 @@ GENERATOR_MODULES: tuple[str, ...] = (
     "codegen/*.py",  # the unified code generator and compiled models
     "model/components.py",  # components: their equations and parameter order
     "model/friction.py",  # friction laws: their formulas enter the equations
+    "model/expressions.py",  # ties as SymPy enter cached kernels (the characteristic polynomial of a space)
     "numeric/*.py",  # code generation (CSE), this cache, the compiled 2-DOF model
     "builder/components.py",  # built-model components (their equations and parameter order)
     "analysis/kernels.py",  # stability kernel generators
