@@ -169,7 +169,8 @@ def _try_exit() -> bool:
             _remove(p)
         # never flush Python's buffered streams here: the main thread may hold their locks
         with contextlib.suppress(OSError):
-            os.write(2, b"brakesqueal: interrupted\n")
+            # on a terminal: end a progress bar's line and show the cursor it hid
+            os.write(2, (b"\n\x1b[?25h" if os.isatty(2) else b"") + b"brakesqueal: interrupted\n")
         os._exit(EXIT_STATUS)
     return False  # pragma: no cover - os._exit does not return
 
