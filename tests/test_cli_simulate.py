@@ -73,3 +73,29 @@ def test_solver_failure_writes_partial(tmp_path, capsys, monkeypatch):
     assert exc.value.code == 1
     assert json.loads(capsys.readouterr().out)["status"] == "failed"
     assert nc.stat().st_size > 0
+
+
+def test_simulate_unilateral_contact_matches_library(capsys):
+    """``--contact unilateral`` continues through lift-off; its duty cycles are the library's run's, and the
+    pads were really lifted (bilateral contact refuses this start: a pad is out of contact)."""
+    import numpy as np
+
+    from brakesqueal.model.options import resolve_space
+    from brakesqueal.simulation import simulate, simulation_model
+
+    args = ["simulate", "--preset", "paper-fig3", "--set", "Omega=60", "--t-end", "0.01", "--q0", "3e-2,0",
+            "--events", "continue", "--format", "json", "--no-progress"]  # fmt: skip
+    assert main([*args, "--contact", "unilateral"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["contact"] == "unilateral" and data["status"] == "finished"
+    p = resolve_space(None, "paper-fig3", None, ["Omega=60"]).resolve({})
+    tr = simulate(simulation_model(p.model), p, 0.01, contact="unilateral", events="continue",
+                  perturbation=[3e-2, 0.0])
+    duty = np.asarray(tr.duty_cycle)
+    assert np.all(duty < 0.9)  # both pads spend a real part of the run lifted off
+    assert [data["duty_cycle"][k] for k in tr.pads] == pytest.approx(duty, rel=1e-12)
+    assert main(["simulate", "--preset", "paper-fig3", "--set", "Omega=60", "--t-end", "0.01", "--q0", "3e-2,0",
+                 "--format", "json", "--no-progress"]) == 2  # fmt: skip
+    assert "out of contact at the initial state" in capsys.readouterr().err
+    assert main(["simulate", "--contact", "sideways"]) == 2
+    assert "--contact" in capsys.readouterr().err

@@ -86,6 +86,10 @@ def _simulate_cmd(
     events: Annotated[
         str, typer.Option("--events", help="stop | continue | off (contact loss, sliding reversal).")
     ] = "stop",
+    contact: Annotated[
+        str, typer.Option("--contact", help="bilateral (pads stay pressed) | unilateral (F_n = max(0, .): pads lift "
+                                            "off and come back; DOP853-jit only).")
+    ] = "bilateral",
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Output samples per second [Hz].")] = 44100.0,
     out: Annotated[Optional[str], typer.Option("--out", help="Write the trajectory to this NetCDF file.")] = None,
     plot: Annotated[Optional[str], typer.Option("--plot", help="Write the plot (time history, phase, spectrum).")] = (
@@ -111,6 +115,8 @@ def _simulate_cmd(
         raise ParameterError(f"The option '--format' must be text or json; got {fmt!r}")
     if not (math.isfinite(t_end) and t_end > 0):
         raise ParameterError(f"The option '--t-end' must be a positive number of seconds; got {t_end!r}")
+    if contact not in ("bilateral", "unilateral"):
+        raise ParameterError(f"The option '--contact' must be bilateral or unilateral; got {contact!r}")
     if q0 is not None and x0 is not None:
         raise ParameterError("give either --q0 (deviation from the silent motion) or --x0 (absolute state), not both")
     init: dict[str, Any] = {}
@@ -124,13 +130,17 @@ def _simulate_cmd(
 
     p = resolve_space(model, preset, params, list(set_ or [])).resolve({})
     with interrupt_guard():  # nested in the program's guard (brakesqueal.cli.main), which ends a stuck run
-        tr = _run(p, t_end, method, rtol, atol, events, sample_rate, progress, no_cache, init)
+        tr = _run(p, t_end, method, rtol, atol, events, sample_rate, progress, no_cache, {**init, "contact": contact})
         if wav and tr.t.size < 2:
             raise ParameterError("the trajectory has fewer than two samples; nothing to write to --wav")
         _write(tr, out, plot, wav)
     summary = tr.summary
     data = {**summary.to_dict(), "model": tr.model, "message": tr.message, "start": tr.start,
             "t_end_reached": float(tr.t[-1]) if tr.t.size else 0.0, "wall_s": tr.stats.get("wall_s")}  # fmt: skip
+    if contact == "unilateral":
+        data["contact"] = contact
+        duty = tr.duty_cycle
+        data["duty_cycle"] = None if duty is None else {str(k): float(v) for k, v in zip(tr.pads, duty)}
     if fmt == "json":
         sys.stdout.write(json.dumps(data, indent=2) + "\n")
     else:
