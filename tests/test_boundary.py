@@ -118,6 +118,13 @@ def test_map_stores_boundary_and_plots_it(tmp_path):
     assert any("Re" in a.get_ylabel() and "[1/s]" in a.get_ylabel() for a in fig.axes[1:])
     with pytest.raises(ParameterError, match="color"):
         plot_map_file(str(path), color="nope")
+    # the CSV has one row per grid point: the boundary (its own dimension) is not multiplied into it
+    import pandas as pd
+
+    m.to_csv(str(tmp_path / "m.csv"))
+    df = pd.read_csv(tmp_path / "m.csv")
+    assert len(df) == 40 * 30 and not any(c.startswith("boundary") for c in df.columns)
+    assert df["stable"].sum() == int(mem.data["stable"].sum())
 
 
 def test_failed_points_are_in_the_legend(tmp_path):

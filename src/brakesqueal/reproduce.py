@@ -30,16 +30,6 @@ def _noop(frac: float) -> None:
     pass
 
 
-def _grid_csv(ds: Any, dims: tuple[str, ...], path: Path) -> None:
-    """Long-format CSV of the variables on the map's grid (one row per grid point; the boundary is in the NetCDF).
-
-    ``Dataset.to_dataframe`` of the whole map would form the product of the
-    grid with the stored boundary's own dimension (gigabytes).
-    """
-    names = [v for v in ds.data_vars if set(ds[v].dims) == set(dims)]
-    ds[names].to_dataframe().reset_index().to_csv(str(path), index=False)
-
-
 def reproduce_fig2(out: str | Path, *, n_kip: int = 301, n_mu: int = 241, mu_line: float = FIG2_MU,
                    progress: Callable[[float], None] = _noop) -> dict[str, Any]:
     """Write ``fig2.png``, ``fig2.nc``, ``fig2.csv``, ``fig2.json`` to ``out``; returns the summary."""
@@ -78,7 +68,7 @@ def reproduce_fig2(out: str | Path, *, n_kip: int = 301, n_mu: int = 241, mu_lin
     with write_set(out, what="--out") as tmp:  # all four files replace the previous ones, or none does
         save(fig, str(tmp / "fig2.png"))
         m.to_netcdf(str(tmp / "fig2.nc"))
-        _grid_csv(m.data, tuple(m.dims), tmp / "fig2.csv")
+        m.to_csv(str(tmp / "fig2.csv"))
         (tmp / "fig2.json").write_text(json.dumps(summary, indent=2) + "\n")
     progress(1.0)
     return summary

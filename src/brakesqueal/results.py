@@ -236,8 +236,15 @@ class StabilityMap:
         ds.to_netcdf(path, engine="scipy")
 
     def to_csv(self, path: str) -> None:
-        """Write a long-format CSV (one row per grid point)."""
-        self.data.to_dataframe().reset_index().to_csv(path, index=False)
+        """Write a long-format CSV of the variables on the grid (one row per grid point).
+
+        The refined boundary (its own dimension) stays in the NetCDF file:
+        ``Dataset.to_dataframe`` of the whole map would form the product of the
+        grid with it (gigabytes for a large map).
+        """
+        ds = self.data
+        names = [v for v in ds.data_vars if set(ds[v].dims) == set(self.dims)]
+        ds[names].to_dataframe().reset_index().to_csv(path, index=False)
 
     def boundary(self) -> list[np.ndarray]:
         """Stability boundary as polylines ``(n, 2)`` in (inner, outer) coordinates.
