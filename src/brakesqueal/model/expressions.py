@@ -20,6 +20,7 @@ raise the same error, naming the values of the names the expression used.
 from __future__ import annotations
 
 import ast
+import functools
 import math
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -162,15 +163,29 @@ def _check(node: ast.AST, what: str, expr: str, found: set[str]) -> None:
         raise _reject(what, expr, _kind(node))
 
 
-def _checked_tree(expr: str, what: str) -> tuple[ast.expr, set[str]]:
+def _parse_and_check(expr: object, what: str) -> tuple[ast.expr, frozenset[str]]:
     """Parse and whitelist-check ``expr``; return the tree and its free names."""
     tree = _parse(expr, what)
     found: set[str] = set()
+    assert isinstance(expr, str)  # _parse rejects anything else
     try:
         _check(tree, what, expr, found)
     except RecursionError:
         raise ParameterError(f"{what} = {_one_line(expr)} is nested too deeply") from None
-    return tree, found
+    return tree, frozenset(found)
+
+
+# Parsed and checked trees by (expression, label): ``Preset.resolve`` evaluates the same ties at every
+# point of a path. Only successes are cached (an exception is never stored by ``lru_cache``), so
+# every error is built afresh with the same message; the trees are never mutated by the evaluators.
+_cached_tree = functools.lru_cache(maxsize=4096)(_parse_and_check)
+
+
+def _checked_tree(expr: str, what: str) -> tuple[ast.expr, frozenset[str]]:
+    """Parse and whitelist-check ``expr`` (cached); return the tree and its free names."""
+    if isinstance(expr, str) and isinstance(what, str):
+        return _cached_tree(expr, what)
+    return _parse_and_check(expr, what)
 
 
 def names_in(expr: str, *, what: str = "expression") -> set[str]:
@@ -193,7 +208,7 @@ def names_in(expr: str, *, what: str = "expression") -> set[str]:
     ParameterError
         If ``expr`` cannot be parsed or uses a construct outside the whitelist.
     """
-    return _checked_tree(expr, what)[1]
+    return set(_checked_tree(expr, what)[1])
 
 
 def _binary(op: ast.operator, left: float, right: float) -> float:
@@ -264,7 +279,7 @@ def _compute(node: ast.AST, names: Mapping[str, float]) -> float:
 
 
 
-def _tree_over(expr: str, names: Mapping[str, Any], what: str) -> tuple[ast.expr, set[str]]:
+def _tree_over(expr: str, names: Mapping[str, Any], what: str) -> tuple[ast.expr, frozenset[str]]:
     """The checked tree of ``expr`` and the names it uses, which must all be keys of ``names``."""
     tree, used = _checked_tree(expr, what)
     unknown = sorted(used - set(names))
