@@ -521,6 +521,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
                     flow: Any = None, tol: float = 1e-10, n_samples: int = 64, max_newton: int = 7,
                     max_angle: float = 0.3, start_amplitude: float = 0.02, direction: int = 1,
                     max_period: float | None = None, detect: Iterable[str] = ("LPC", "PD", "NS", "BPC", "GR"),
+                    p_scale: float | None = None,
                     ) -> CycleBranch:  # fmt: skip
     r"""Continue a branch of periodic orbits from a Hopf point (or an orbit) in the parameter ``p``.
 
@@ -564,6 +565,13 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
         Stop when the period exceeds this (default 50 times the initial period).
     detect : iterable of str
         Special points to detect, a subset of ``("LPC", "PD", "NS", "BPC", "GR")``.
+    p_scale : float, optional
+        The parameter distance that sets the scales (default: the width of
+        ``p_range``): ``p`` is scaled by it in the arclength and, from a Hopf
+        point, the amplitude scale is the predicted amplitude at that distance
+        from ``p0`` (at most the end of the range).  Passing the distance of
+        an expected event (e.g. the predicted contact loss) makes the steps
+        independent of the requested range.
 
     Returns
     -------
@@ -607,6 +615,10 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
         raise ParameterError(f"The option 'ds' must be in [ds_min, ds_max] = [{ds_min}, {ds_max}]; got {ds!r}")
     m = int(n_segments)
     width = hi - lo
+    if p_scale is not None:
+        if not (isinstance(p_scale, (int, float, np.floating)) and math.isfinite(p_scale) and p_scale > 0):
+            raise ParameterError(f"The option 'p_scale' must be a positive finite number; got {p_scale!r}")
+        width = float(p_scale)
     hopf = start if isinstance(start, HopfResult) else None
     points: list[_Point] = []
     special: list[tuple[str, int, str]] = []  # (kind, point index, description)
@@ -623,6 +635,8 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
         if reach <= 0:
             raise ParameterError(f"the cycles exist for {hopf.parameter_name} {'>' if hopf.side > 0 else '<'} "
                                  f"{hopf.p0:.12g}, outside p_range = {p_range!r}")  # fmt: skip
+        if p_scale is not None:
+            reach = min(reach, float(p_scale))
         acoef = hopf.amplitude_coefficients
         xs = acoef * math.sqrt(reach)
         xs = np.maximum(xs, 1e-4 * float(np.max(xs)))

@@ -301,6 +301,124 @@ def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = 
 
 
 
+def _periodic_min(values: np.ndarray) -> np.ndarray:
+    """Smallest value over one period of uniform samples (axis 0), refined by a parabola through the
+    smallest sample and its two periodic neighbours (error ~ (2 pi / N)^4 of the amplitude instead of
+    (2 pi / N)^2 for the smallest sample)."""
+    v = np.asarray(values, dtype=float)
+    n = v.shape[0]
+    k = np.argmin(v, axis=0)
+    cols = np.arange(v.shape[1])
+    y0, ym, yp = v[k, cols], v[(k - 1) % n, cols], v[(k + 1) % n, cols]
+    curv = ym - 2 * y0 + yp
+    with np.errstate(divide="ignore", invalid="ignore"):
+        fine = y0 - (yp - ym) ** 2 / (8 * curv)
+    return np.where(curv > 0, np.minimum(fine, y0), y0)
+
+
+def _contact_indicators(sim: Any, params: Any, samples: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per pad, the smallest normal force [N] and the smallest sliding margin over one period of samples.
+
+    The sliding margin is the sliding velocity's component along the silent motion's sliding velocity (it
+    is negative where a pad's sliding reverses)."""
+    st = sim.silent(params)
+    cq = np.array([sim.contact_at(params, y, st) for y in samples])  # (phase, pad, 7)
+    npad = cq.shape[1]
+    slide = np.einsum("spk,pk->sp", cq[:, :, 1:4], st.vr0.reshape(npad, 3))
+    return _periodic_min(cq[:, :, 0]), _periodic_min(slide)
+
+
+def predicted_contact_loss(space: Any, name: str, hopf: Any) -> float | None:
+    r"""Where the Hopf point's small-amplitude prediction says a pad first loses contact.
+
+    On the cycle $x = x_0 + 2 r\,\mathrm{Re}(q e^{i\theta}) + O(r^2)$ the smallest normal force falls
+    linearly in $r \propto \sqrt{|p - p_0|}$, so $F_{\min} \approx F_0 - k\sqrt{|p - p_0|}$; $k$ is taken
+    from :meth:`~.hopf.HopfResult.cycle_guess` at two tiny offsets (Richardson: the $O(r^2)$ terms cancel)
+    and the prediction is $p_0 \pm (F_0/k)^2$.  Only the leading order: a scale for the continuation and
+    an independent estimate of the located contact loss, not the located value.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    name : str
+        The path parameter.
+    hopf : HopfResult
+        The Hopf point (``side`` must be nonzero).
+
+    Returns
+    -------
+    float or None
+        The predicted parameter value, ``None`` if the normal force does not fall on the cycle to first order.
+    """
+    if hopf is None or not hopf.side:
+        return None
+    system = model_system(space, name)
+    sim = system.simulation_model  # type: ignore[attr-defined]
+    p0 = float(hopf.p0)
+    d = 1e-9 * max(1.0, abs(p0))
+    drops = []
+    F0 = None
+    for dd in (d, 4 * d):
+        p = p0 + hopf.side * dd
+        params = space.resolve({name: p})
+        st = sim.silent(params)
+        g = hopf.cycle_guess(p, n_segments=64)
+        xe = hopf.x0 + hopf.dx0_dp * (p - p0)
+        f0 = sim.contact_at(params, xe, st)[:, 0]
+        F = np.array([sim.contact_at(params, y, st)[:, 0] for y in g.x])
+        drops.append(f0 - _periodic_min(F))
+        F0 = f0 if F0 is None else F0
+    k_sqrt_d = 2 * drops[0] - 0.5 * drops[1]  # k sqrt(d), the O(d) term removed
+    assert F0 is not None
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dist = np.where((k_sqrt_d > 0) & (F0 > 0), d * (F0 / k_sqrt_d) ** 2, np.inf)
+    best = float(np.min(dist))
+    return p0 + hopf.side * best if math.isfinite(best) else None
+
+
+def _refine_event(system: Any, indicator: Any, pa: float, ga: float, guess_a: tuple[np.ndarray, float],
+                  pb: float, gb: float, guess_b: tuple[np.ndarray, float], *, ptol: float) -> float:
+    """Zero of ``indicator(orbit)`` in ``p`` between two branch points (Illinois method on ``p``; each
+    evaluation a periodic orbit shot at fixed ``p`` from the nearer known orbit).  Returns the located ``p``
+    (the linear interpolation of the bracket if a shooting fails)."""
+    from .periodic import ShootingError, find_periodic_orbit
+
+    lo, glo, ylo = pa, ga, guess_a
+    hi, ghi, yhi = pb, gb, guess_b
+    side = 0
+    best = lo + (hi - lo) * glo / (glo - ghi)
+    for _ in range(40):
+        p = best
+        if not (min(lo, hi) < p < max(lo, hi)):
+            p = 0.5 * (lo + hi)
+        w = (p - lo) / (hi - lo)
+        x_guess = (1 - w) * ylo[0] + w * yhi[0]
+        T_guess = (1 - w) * ylo[1] + w * yhi[1]
+        try:
+            o = find_periodic_orbit(system, x_guess, period=T_guess, p=p, tol=1e-10, n_samples=256)
+        except ShootingError:
+            return best
+        g = float(indicator(o, p))
+        best = p
+        if g == 0 or abs(hi - lo) <= ptol:
+            break
+        if (g > 0) == (glo > 0):
+            lo, glo, ylo = p, g, (o.x[0], o.period)
+            if side == 1:
+                ghi /= 2
+            side = 1
+        else:
+            hi, ghi, yhi = p, g, (o.x[0], o.period)
+            if side == -1:
+                glo /= 2
+            side = -1
+        best = lo + (hi - lo) * glo / (glo - ghi)
+        if abs(best - p) <= ptol:
+            break
+    return float(best)
+
+
 def _duty_cycle(orbit: Any, mode0: int, npad: int) -> np.ndarray:
     """Fraction of the period each pad is pressed, from the orbit's switching events (mode bit j = pad j lifted)."""
     T = float(orbit.period)
@@ -482,7 +600,8 @@ class SquealBranch:
 
 
 def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: bool = True,
-                  tol: float = 1e-8, contact: str = "bilateral") -> SquealBranch:
+                  tol: float = 1e-8, contact: str = "bilateral", ds: float | None = None,
+                  ds_max: float = 0.05) -> SquealBranch:
     """Continue the limit cycles from the first Hopf point on a path and find where a pad loses contact.
 
     Parameters
@@ -504,6 +623,19 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
         piecewise flow of :func:`model_piecewise_system`, so the branch goes
         on through lift-off and re-contact (the contact loss is a ``GR``
         point of the branch).
+    ds, ds_max : float, optional
+        Initial and largest step of :func:`~.continuation.continue_cycles` (scaled arclength).  The
+        parameter scale is four times the distance from the onset to the contact loss predicted by the
+        Hopf point (:func:`predicted_contact_loss`), not the width of the range, so the steps near the
+        onset do not depend on the requested range.
+
+    Notes
+    -----
+    The contact loss (first zero of the smallest normal force over a period) and, on a bilateral
+    branch, the end of validity (first zero of the smallest sliding margin) are located between the two
+    branch points that bracket them by the Illinois method on the parameter, each evaluation a periodic
+    orbit shot at that parameter with 256 samples and the minimum over the period refined by a parabola:
+    the located values do not depend on the steps or the range (to about ``1e-8`` relative).
 
     Returns
     -------
@@ -528,14 +660,18 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
         raise ParameterError(f"no Hopf point with a limit-cycle prediction for {axis.name} in "
                              f"({axis.start:g}, {axis.stop:g}); see brakesqueal hopf")
     hp = pts[0]
+    h = hp.hopf
+    predicted = predicted_contact_loss(space, axis.name, h)
+    p_scale = 4 * abs(predicted - h.p0) if predicted is not None else None
+    opts: dict[str, Any] = {"max_points": max_points, "tol": tol, "p_scale": p_scale, "ds_max": ds_max,
+                            "ds": min(0.02, ds_max) if ds is None else ds}
+    system = model_system(space, axis.name, use_cache=use_cache)
+    sim = system.simulation_model  # type: ignore[attr-defined]
     if contact == "unilateral":
         pw = model_piecewise_system(space, axis.name, use_cache=use_cache)
-        sim = pw.simulation_model  # type: ignore[attr-defined]
-        br = continue_cycles(pw, hp.hopf, (axis.start, axis.stop), max_points=max_points, tol=tol)
+        br = continue_cycles(pw, h, (axis.start, axis.stop), **opts)
     else:
-        system = model_system(space, axis.name, use_cache=use_cache)
-        sim = system.simulation_model  # type: ignore[attr-defined]
-        br = continue_cycles(system, hp.hopf, (axis.start, axis.stop), max_points=max_points, tol=tol)
+        br = continue_cycles(system, h, (axis.start, axis.stop), **opts)
     ds = br.data
     p = ds["p"].values
     orbits = ds["orbit"].values
@@ -544,29 +680,47 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
     fmax = np.full((p.size, npad), np.nan)
     duty = np.full((p.size, npad), np.nan)
     reversal = np.zeros(p.size, dtype=bool)
+    margin = np.full(p.size, np.nan)
     for i in range(p.size):
         params = space.resolve({axis.name: float(p[i])})
         st = sim.silent(params)
         cq = np.array([sim.contact_at(params, y, st) for y in orbits[i]])  # (phase, pad, 7)
         F = cq[:, :, 0]
-        fmin[i] = F.min(axis=0)
+        fmin[i] = _periodic_min(F)
         pressed = F > 0
         fmax[i] = np.where(pressed, F, 0.0).max(axis=0)
         vr0 = st.vr0.reshape(npad, 3)
         slide = np.einsum("spk,pk->sp", cq[:, :, 1:4], vr0)
         reversal[i] = bool(np.any((slide <= 0) & pressed))
+        margin[i] = float(_periodic_min(slide).min())
         if contact == "unilateral" and i < len(br.orbits) and br.orbits[i].events:
             o = br.orbits[i]
             duty[i] = _duty_cycle(o, int(o.sample_modes[0]) if o.sample_modes.size else 0, npad)
         elif np.all(fmin[i] > 0):
             duty[i] = 1.0
     worst = fmin.min(axis=1)
-    loss = None
-    bad = np.flatnonzero(~(worst > 0))
-    if bad.size and bad[0] > 0:
+
+    def guess(i: int) -> tuple[np.ndarray, float]:
+        if i == 0:  # the Hopf row: the predicted cycle just past the onset
+            g = h.cycle_guess(float(p[0]) + h.side * 1e-6 * abs(float(p[1]) - float(p[0])))
+            return g.x[0], g.period
+        return br.orbits[i].x[0], float(br.orbits[i].period)
+
+    def located(values: np.ndarray, which: int) -> float | None:
+        bad = np.flatnonzero(~(values > 0))
+        if not (bad.size and bad[0] > 0):
+            return None
         i = int(bad[0])
-        a, b = worst[i - 1], worst[i]
-        loss = float(p[i - 1] + (p[i] - p[i - 1]) * a / (a - b)) if a != b else float(p[i])
+
+        def indicator(o: Any, q: float) -> float:
+            return float(_contact_indicators(sim, space.resolve({axis.name: q}), o.samples)[which].min())
+
+        ptol = 1e-9 * max(1.0, abs(float(p[i])))
+        return _refine_event(system, indicator, float(p[i - 1]), float(values[i - 1]), guess(i - 1),
+                             float(p[i]), float(values[i]), guess(i), ptol=ptol)
+
+    loss = located(worst, 0)  # the grazing orbit is a bilateral orbit: shot with the smooth system
+    end = located(margin, 1) if contact == "bilateral" else None
     import xarray as xr
 
     pad_c = {"pad": list(sim.pads)}
@@ -588,6 +742,8 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
                                     attrs={"long_name": "every pad pressed over the whole period (bilateral "
                                                         "equations valid)"})
     ds.attrs["contact_loss"] = np.nan if loss is None else loss
+    ds.attrs["contact_loss_predicted"] = np.nan if predicted is None else predicted
+    ds.attrs["validity_end"] = np.nan if end is None else end
     ds.attrs["contact"] = contact
     out = SquealBranch(hp, br, loss, tuple(sim.pads), contact)
     summ = squeal_summary(out)
@@ -620,6 +776,11 @@ def squeal_summary(branch: SquealBranch) -> SquealSummary:
     h = branch.hopf.hopf
     onset = float(h.p0) if h is not None else float(branch.hopf.value)
     rng = (float(p[ok].min()), float(p[ok].max())) if ok.any() else None
+    loss = branch.contact_loss
+    if rng is not None and branch.contact == "bilateral" and loss is not None:
+        last = int(np.flatnonzero(ok)[-1])
+        if last + 1 < p.size and stable[last + 1] and not valid[last + 1] and min(p[last], p[last + 1]) <= loss:
+            rng = (min(rng[0], loss), max(rng[1], loss))  # stable up to the located contact loss
     folds = [float(v) for k, v in zip(ds["special_kind"].values, ds["special_p"].values) if str(k) == "LPC"]
     hyst = branch.branch.hysteresis_range
     if hyst is None and folds and h is not None and h.side:
@@ -628,7 +789,9 @@ def squeal_summary(branch: SquealBranch) -> SquealSummary:
             f = max(beyond, key=lambda v: abs(v - onset))  # the farthest fold bounds the coexistence range
             hyst = (min(f, onset), max(f, onset))
     rev = ds["sliding_reversal"].values.astype(bool)
-    validity_end = float(p[np.flatnonzero(rev)[0]]) if rev.any() else None
+    located_end = float(ds.attrs.get("validity_end", np.nan))
+    validity_end = located_end if math.isfinite(located_end) else (float(p[np.flatnonzero(rev)[0]])
+                                                                    if rev.any() else None)
     tab = []
     for i in range(p.size):
         tab.append({"p": float(p[i]), "frequency_hz": float(ds["frequency"].values[i]),
