@@ -46,7 +46,7 @@ def run(size: int = 2000) -> list[BenchResult]:
     Q = np.ascontiguousarray(A.transpose(1, 2, 0).reshape(-1, 5))
     t_base = best_time(lambda: roots_summary(Q), repeat=3)
     base = Q.shape[0] / t_base
-    _, _, found = kernel_eigen(kern, C, t, lam_e)  # agreement with LAPACK: tests/test_map_speed.py
+    _, _, found = kernel_eigen(kern, C, t, lam_e)  # agreement with LAPACK: tests/analysis/test_map_speed.py
     small = (Axis("k_ip", 1e5, 1e10, 1000, True), Axis("mu", 0.05, 1.0, 1000))
     stability_map(space, *small)
     t_map = best_time(lambda: stability_map(space, *small), repeat=3)

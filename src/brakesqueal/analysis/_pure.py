@@ -9,7 +9,7 @@ code costs far more than running the same functions in the interpreter.
 IEEE double precision either way (the kernels use no ``fastmath``); where
 Python raises instead of producing ``inf``/``nan`` (numba's
 ``error_model="numpy"``) the call is repeated by the compiled kernel, so the
-result never depends on the route (tests/test_map_speed.py compares both on
+result never depends on the route (tests/analysis/test_map_speed.py compares both on
 random input, bit for bit).
 """
 

@@ -44,7 +44,7 @@ report a silent motion the per-point route does not have (measured: the
 paper's model with ``general`` values, ``mu1 = 1.68``, soft ``k_t``: for
 ``k_t`` below about 1.1e4 the homotopy folds, while Newton warm-started along
 ``k_t`` from the stiffer neighbour converges to admissible tilts all the way
-down to ``k_t = 1``; ``tests/test_silent_batch.py``).  The start from the
+down to ``k_t = 1``; ``tests/analysis/test_silent_batch.py``).  The start from the
 trivial state costs a few iterations more (:attr:`SilentMotions.iterations
 <brakesqueal.analysis.equilibrium.SilentMotions.iterations>`)
 and keeps every point's result independent of the grid.

@@ -27,7 +27,7 @@ Generated modules
 Adding a code generator
     A module whose source influences generated code or cached text must be
     matched by a pattern of :data:`GENERATOR_MODULES` (paths relative to the
-    package, :meth:`pathlib.Path.glob` patterns).  ``tests/test_cache_faults.py``
+    package, :meth:`pathlib.Path.glob` patterns).  ``tests/numeric/test_cache_faults.py``
     checks that every module that calls a code generator or the cache, and
     every package module those import, is listed (or explicitly exempted
     there); when code moves into a new module or package (say ``codegen/``),

@@ -407,7 +407,7 @@ def test_interrupt_while_writing_keeps_the_existing_file(tmp_path, capsys, monke
 
 # ----------------------------------------------------------------------------- Ctrl-C in a real process
 def _cli_env() -> dict[str, str]:
-    src = str(Path(__file__).resolve().parent.parent / "src")
+    src = str(Path(__file__).resolve().parents[2] / "src")
     return {**os.environ, "PYTHONPATH": src + os.pathsep + os.environ.get("PYTHONPATH", "")}
 
 

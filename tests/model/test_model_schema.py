@@ -83,7 +83,7 @@ def test_small_valid_files(validator: Any) -> None:
         assert len(spec_from_dict(d).pads) == len(d["pads"])
 
 
-DOC = pathlib.Path(__file__).resolve().parents[1] / "docs" / "model-format.md"
+DOC = pathlib.Path(__file__).resolve().parents[2] / "docs" / "model-format.md"
 
 
 @pytest.mark.skipif(not DOC.exists(), reason="documentation not available")

@@ -20,7 +20,7 @@ from brakesqueal.analysis.maps import Axis, stability_map, write_map
 from brakesqueal.model.parameters import ParameterSpace
 from brakesqueal.status import PointStatus
 
-SRC = os.path.join(os.path.dirname(__file__), os.pardir, "src")
+SRC = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "src")
 
 
 def _state_eigenvalues(space, names, a, b):

@@ -137,7 +137,7 @@ def test_negative_thickness_sum_is_rejected(tmp_path, cache):
 
 
 def test_bench_derive_script_prints_one_json_array_with_the_required_keys(cache):
-    script = Path(__file__).resolve().parent.parent / "benchmarks" / "bench_derive.py"
+    script = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_derive.py"
     res = subprocess.run([sys.executable, str(script), "--no-baseline"], capture_output=True, text=True,
                          env={**os.environ, "BRAKESQUEAL_CACHE_DIR": str(cache)}, timeout=600)
     assert res.returncode == 0, res.stderr
