@@ -287,24 +287,43 @@ def bench_nonlinear(*, points: int = 200, brute_points: int = 10) -> list[BenchR
     ]  # fmt: skip
 
 
-def bench_paper_model(*, points: int = 40, brute_points: int = 3) -> list[BenchResult]:
+def _branch_diff(old: Any, new: Any, n_pts: int) -> float:
+    """Largest relative difference of period, amplitudes and Floquet multipliers over the first ``n_pts`` points."""
+    out = 0.0
+    for key in ("p", "period", "amplitude", "floquet_re", "floquet_im"):
+        a, b = old[key].values[:n_pts], new[key].values[:n_pts]
+        top = max(float(np.nanmax(np.abs(a))), 1e-300)
+        out = max(out, float(np.nanmax(np.abs(a - b))) / top)
+    return out
+
+
+def bench_paper_model(*, points: int = 200, old_points: int = 20, brute_points: int = 3,
+                      ds_max: float = 0.005) -> list[BenchResult]:  # fmt: skip
     """The paper's model (Fig. 3 set, mu = 0.5, rigid pads): l1 at the Hopf point and a limit-cycle branch.
 
     ``l1`` warm against the issue's target of 50 ms (ratio target / measured).  The branch
-    (:func:`~brakesqueal.nonlinear.continue_cycles` on :func:`~brakesqueal.nonlinear.models.model_system`,
-    ScipyFlow with the exact Jacobian) is timed for ``points`` points and scaled to 200; the baseline is brute
-    force: one long compiled simulation (``simulate``, from the default start along the leading mode) per
-    parameter value until ``10 / sigma`` (``sigma`` the linear growth rate there, capped at 20 s of simulated
-    time), at the ``brute_points`` stable branch points farthest from onset (the fastest transients; nearer the
-    onset brute force is slower still), scaled to 200 points.  The amplitude it reaches is compared with the
-    branch's (a large difference means the baseline had not converged: it is then a lower bound).
+    (:func:`~brakesqueal.nonlinear.continue_cycles` on :func:`~brakesqueal.nonlinear.models.model_system`
+    over ``Omega`` in [30, 40] with steps up to ``ds_max``) is timed for ``points`` points with the compiled flow
+    and the model's generated exact Jacobian (:func:`~brakesqueal.nonlinear.compiled.model_flow`).  Baselines in
+    the same process: (1) the previous route, ScipyFlow with the Python exact Jacobian
+    (:func:`~brakesqueal.simulation.state_jacobian`), for ``old_points`` points of the same branch scaled to
+    ``points`` (and the largest relative difference between the two branches there); (2) brute force: one long
+    compiled simulation (``simulate``, from the default start along the leading mode) per parameter value until
+    ``10 / sigma`` (``sigma`` the linear growth rate there, capped at 20 s of simulated time), at the
+    ``brute_points`` stable branch points farthest from onset (the fastest transients; nearer the onset brute
+    force is slower still), scaled to ``points``.  The amplitude it reaches is compared with the branch's (a
+    large difference means the baseline had not converged: it is then a lower bound).
 
     Parameters
     ----------
     points : int
-        Points of the timed branch.
+        Points of the timed branch (compiled flow).
+    old_points : int
+        Points of the same branch by the previous route (ScipyFlow, Python Jacobian).
     brute_points : int
-        Parameter values simulated by the baseline.
+        Parameter values simulated by the brute-force baseline.
+    ds_max : float
+        Largest continuation step (scaled arclength; small enough that ``points`` points fit in the range).
 
     Returns
     -------
@@ -315,6 +334,7 @@ def bench_paper_model(*, points: int = 40, brute_points: int = 3) -> list[BenchR
     from brakesqueal.analysis.maps import Axis
     from brakesqueal.model import ParameterSpace
     from brakesqueal.nonlinear import continue_cycles, first_lyapunov
+    from brakesqueal.nonlinear.compiled import model_flow
     from brakesqueal.nonlinear.models import hopf_points, model_system
     from brakesqueal.simulation import simulate
 
@@ -325,12 +345,21 @@ def bench_paper_model(*, points: int = 40, brute_points: int = 3) -> list[BenchR
     y0 = sim.silent(space.resolve({"Omega": hp.value})).y
     first_lyapunov(system, y0, hp.value, refine=False)
     t_l1 = best_time(lambda: first_lyapunov(system, y0, hp.value, refine=False), repeat=5)
+    flow = model_flow(space, "Omega", system=system)
+    flow(y0 + 1e-6 * np.abs(y0).max(), 1e-3, hp.value)  # load the compiled kernels
+    kw: dict[str, Any] = {"tol": 1e-8, "ds_max": ds_max}
+    continue_cycles(system, hp.hopf, (30.0, 40.0), max_points=3, flow=flow, **kw)  # warm (imports, first calls)
     t0 = time.perf_counter()
-    br = continue_cycles(system, hp.hopf, (30.0, 40.0), max_points=points, tol=1e-8)
+    br = continue_cycles(system, hp.hopf, (30.0, 40.0), max_points=points, flow=flow, **kw)
     t_br = time.perf_counter() - t0
     d = br.data
     n_pts = int(d.sizes["point"])
-    t_200 = t_br * 200 / n_pts
+    t0 = time.perf_counter()
+    br_old = continue_cycles(system, hp.hopf, (30.0, 40.0), max_points=old_points, **kw)
+    t_old = time.perf_counter() - t0
+    n_old = int(br_old.data.sizes["point"])
+    t_old_scaled = t_old * n_pts / n_old
+    diff = _branch_diff(br_old.data, d, min(n_old, n_pts))
     ok = np.flatnonzero(d["stable"].values & (d["label"].values == ""))
     idx = ok[-brute_points:]  # the stable points farthest from onset: the fastest brute-force transients
     t0 = time.perf_counter()
@@ -348,16 +377,23 @@ def bench_paper_model(*, points: int = 40, brute_points: int = 3) -> list[BenchR
         a_br = 0.5 * float(np.ptp(d["orbit"].values[i][:, 0]))
         diffs.append(abs(a_sim / a_br - 1))
     t_bf = time.perf_counter() - t0
-    t_bf_200 = t_bf * 200 / idx.size
+    t_bf_scaled = t_bf * n_pts / max(idx.size, 1)
     return [
         BenchResult(
-            f"paper model: cycle branch, {n_pts} points scaled to 200 (ScipyFlow, exact Jacobian)", t_200, "s",
-            t_bf_200, t_bf_200 / t_200,
+            f"paper model: {n_pts}-point cycle branch, compiled flow (generated exact Jacobian)", t_br, "s",
+            t_old_scaled, t_old_scaled / t_br,
+            {"baseline": f"ScipyFlow with the Python exact Jacobian, {n_old} points scaled to {n_pts}",
+             "measured_points": n_pts, "old_route_s": round(t_old, 3), "old_route_points": n_old,
+             "same_branch_max_rel_diff": diff, "target_s": 20.0, "status": br.status,
+             "p_end": float(d["p"].values[-1])},
+        ),
+        BenchResult(
+            f"paper model: {n_pts}-point cycle branch against brute force", t_br, "s", t_bf_scaled,
+            t_bf_scaled / t_br,
             {"baseline": f"brute force: one long compiled simulation per parameter value (10/sigma, at most 20 s "
-                         f"simulated; {sim_s:.3g} s simulated for {idx.size} values) scaled to 200",
-             "measured_points": n_pts, "measured_s": round(t_br, 3), "brute_force_s": round(t_bf, 3),
-             "brute_force_vs_branch_half_peak_to_peak_max_rel_diff": float(max(diffs)) if diffs else None,
-             "target_s": 20.0, "status": br.status},
+                         f"simulated; {sim_s:.3g} s simulated for {idx.size} values) scaled to {n_pts}",
+             "brute_force_s": round(t_bf, 3),
+             "brute_force_vs_branch_half_peak_to_peak_max_rel_diff": float(max(diffs)) if diffs else None},
         ),
         BenchResult(
             "paper model: first_lyapunov at the Fig. 3 Hopf point (warm, FD B, C of the exact Jacobian)", t_l1, "s",
@@ -370,7 +406,12 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--points", type=int, default=200, help="points of the continued branch")
     ap.add_argument("--brute-points", type=int, default=10, help="parameter values simulated by the baseline")
-    ap.add_argument("--paper-points", type=int, default=40, help="points of the paper-model branch (scaled to 200)")
+    ap.add_argument("--paper-points", type=int, default=200, help="points of the paper-model branch (compiled flow)")
+    ap.add_argument("--paper-old-points", type=int, default=20,
+                    help="points of the same branch by the previous route (ScipyFlow, Python Jacobian), scaled")
     a = ap.parse_args()
+    for opt, v in (("--paper-points", a.paper_points), ("--paper-old-points", a.paper_old_points)):
+        if not 2 <= v <= 10_000:
+            ap.error(f"{opt} must be in [2, 10000]; got {v}")
     emit(bench_nonlinear(points=a.points, brute_points=a.brute_points)
-         + bench_paper_model(points=a.paper_points))
+         + bench_paper_model(points=a.paper_points, old_points=a.paper_old_points))

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -34,7 +34,7 @@ from ._dop853 import F_SIGNATURE, JAC_SIGNATURE, dop853
 from .flow import FlowError, FlowResult
 from .system import SmoothSystem
 
-__all__ = ["CompiledFlow", "compiled_system", "F_SIGNATURE", "JAC_SIGNATURE"]
+__all__ = ["CompiledFlow", "compiled_system", "model_flow", "F_SIGNATURE", "JAC_SIGNATURE"]
 
 
 def compiled_system(f: Any, jac: Any, dfdp: Any, n: int, theta: Any = (), **kwargs: Any) -> SmoothSystem:
@@ -99,6 +99,9 @@ class CompiledFlow:
         Absolute tolerance of the state (default ``1e-3 rtol scale``).
     max_steps : int
         Maximum number of steps per call.
+    theta_of : callable, optional
+        ``theta_of(p) -> ndarray``: the kernels' ``theta`` at the parameter ``p`` (instead of the fixed
+        ``theta``; e.g. :func:`model_flow`, where ``theta`` holds the whole parameter vector at ``p``).
     """
 
     system: SmoothSystem
@@ -107,6 +110,7 @@ class CompiledFlow:
     rtol: float = 1e-11
     atol: Any = None
     max_steps: int = 1_000_000
+    theta_of: Callable[[float], np.ndarray] | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.system, SmoothSystem):
@@ -174,7 +178,8 @@ class CompiledFlow:
         ts = T * np.arange(n_samples) / n_samples if n_samples else np.empty(0)
         S = np.empty((n_samples, n))
         f, jac, dfdp = self.kernels  # type: ignore[misc]
-        status, nfev, _h = self._kernel(f, jac, dfdp, y, float(p), self.theta, float(T), float(self.rtol), atol,
+        theta = self.theta if self.theta_of is None else self.theta_of(float(p))
+        status, nfev, _h = self._kernel(f, jac, dfdp, y, float(p), theta, float(T), float(self.rtol), atol,
                                         bool(sensitivities), ts, S, 0.0, int(self.max_steps))  # fmt: skip
         if status != 0:
             what = {-1: "step size too small", -2: "too many steps", -3: "non-finite state"}.get(int(status), "failure")
@@ -187,3 +192,64 @@ class CompiledFlow:
             x_samples=S if n_samples else None, events=[], modes=[], mode_end=0, nfev=int(nfev),
             monodromy_method="variational" if sensitivities else "none",
         )  # fmt: skip
+
+
+def model_flow(space: Any, name: str, *, system: SmoothSystem | None = None, use_cache: bool = True,
+               rtol: float = 1e-11) -> CompiledFlow:
+    """The compiled flow of a brake model with its exact, generated Jacobian (variational equations in numba).
+
+    The vector field, its Jacobian and its parameter derivative are the model's generated kernels
+    (:meth:`SimulationModel.variational_kernels <brakesqueal.simulation.SimulationModel.variational_kernels>`):
+    the same ``f`` and ``f_y`` as :func:`~.models.model_system` (whose Jacobian is the Python
+    :func:`~brakesqueal.simulation.state_jacobian`), compiled, so shooting and continuation on a brake model
+    integrate the monodromy matrix without calling Python.  ``f_p`` is exact too (the generated
+    ``d(R, G)/dp`` times the derivative of the parameter vector along ``name``, which is a fourth-order
+    central difference of ``space.resolve``: exact up to rounding for untied or linearly tied parameters).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    name : str
+        The continuation parameter (settable in ``space``).
+    system : SmoothSystem, optional
+        The system the flow belongs to (default :func:`~.models.model_system` ``(space, name)``).
+    use_cache : bool
+        Use the on-disk code cache.
+    rtol : float
+        Relative tolerance of the integrator.
+
+    Returns
+    -------
+    CompiledFlow
+        Bilateral contact (every pad pressed); for unilateral contact use the piecewise system's ScipyFlow.
+    """
+    from ..simulation import simulation_model
+    from .models import model_system
+
+    if system is None:
+        system = model_system(space, name, use_cache=use_cache)
+    params0 = space.resolve({})
+    sim = simulation_model(params0.model, use_cache=use_cache)
+    mod = sim.variational_kernels()
+    cache: dict[float, np.ndarray] = {}
+
+    def theta_of(p: float) -> np.ndarray:
+        th = cache.get(p)
+        if th is None:
+            if len(cache) > 16:
+                cache.clear()
+            params = space.resolve({name: p})
+            h = 1e-3 * max(abs(p), 1e-300)
+            v = [sim.parameter_vector(space.resolve({name: p + k * h})) for k in (-2, -1, 1, 2)]
+            with np.errstate(invalid="ignore"):
+                dp = (8 * (v[2] - v[1]) - (v[3] - v[0])) / (12 * h)
+            same = (v[0] == v[1]) & (v[1] == v[2]) & (v[2] == v[3])
+            dp = np.where(same, 0.0, dp)
+            if not np.all(np.isfinite(dp)):
+                raise ParameterError(f"the model parameters are not differentiable along {name!r} at {p:.12g}")
+            th = cache[p] = sim.variational_theta(params, dp)
+        return th
+
+    return CompiledFlow(system, kernels=(mod.nl_f, mod.nl_jac, mod.nl_dfdp), theta=np.empty(0), rtol=rtol,
+                        theta_of=theta_of)

@@ -338,6 +338,9 @@ def _make_flow(system: Any, flow: Any) -> Any:
         return flow
     if not isinstance(system, (SmoothSystem, PiecewiseSystem)):
         raise ParameterError(f"'system' must be a SmoothSystem or PiecewiseSystem; got {type(system).__name__}")
+    default = getattr(system, "default_flow", None)  # e.g. a brake model's compiled flow (compiled.model_flow)
+    if callable(default):
+        return default()
     return ScipyFlow(system)
 
 

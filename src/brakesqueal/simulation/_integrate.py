@@ -325,6 +325,49 @@ class SimulationModel:
 
         return f, jac
 
+    def variational_kernels(self) -> ModuleType:
+        """The model's compiled vector field with its exact Jacobian (generated, numba; loaded on first use).
+
+        Functions ``nl_f(y, s, theta, out)``, ``nl_jac(y, s, theta, out)`` and ``nl_dfdp(y, s, theta, out)``
+        with the signatures of :data:`brakesqueal.nonlinear.compiled.F_SIGNATURE` /
+        ``JAC_SIGNATURE``: ``f(y)`` (the integrator's right-hand side, bilateral contact), its exact
+        Jacobian ``f_y`` (implicit differentiation of the generated ``d(R, G)/dx``, the same as
+        :func:`state_jacobian`) and ``f_p dp/ds``; ``theta`` from :meth:`variational_theta`.
+        """
+        from ._kernels import load_variational
+
+        mod = self.__dict__.get("_variational")
+        if mod is None:
+            mod = load_variational(self.spec, self.use_cache)
+            object.__setattr__(self, "_variational", mod)
+        return mod
+
+    def variational_theta(self, params: Any, dp: Sequence[float] | None = None,
+                          silent: SilentState | None = None) -> np.ndarray:
+        """The ``theta`` vector of :meth:`variational_kernels` at ``params``.
+
+        Parameters
+        ----------
+        params : Parameters
+            The parameters.
+        dp : sequence of float, optional
+            Derivative of :meth:`parameter_vector` along the continuation parameter ``s``
+            (``nl_dfdp`` returns ``f_p dp/ds``); default zeros.
+        silent : SilentState, optional
+            The silent motion (its pad unknowns start the pads' Newton iterations; default computed).
+
+        Returns
+        -------
+        ndarray
+            ``(p, dp/ds, ztol, l, dl)``; the kernels update ``l``, ``dl`` in place (warm start).
+        """
+        st = silent or self.silent(params)
+        p = self.parameter_vector(params)
+        d = np.zeros(p.size) if dp is None else np.asarray(dp, dtype=float)
+        if d.shape != p.shape:
+            raise ParameterError(f"'dp' must have one entry per parameter ({p.size}); got {d.size}")
+        return np.ascontiguousarray(np.concatenate([p, d, st.ztol, st.l, st.dl]), dtype=float)
+
     def rhs(self, params: Any, silent: SilentState | None = None) -> Callable[[float, np.ndarray], np.ndarray]:
         """``f(t, y)`` for SciPy (the pad unknowns are solved on the way, warm-started)."""
         st = silent or self.silent(params)
