@@ -15,6 +15,9 @@ import numpy as np
 import pytest
 
 from brakesqueal.model import ParameterSpace
+from brakesqueal.model.components import Disk, FrictionLaw, ModelSpec, Pad
+from brakesqueal.model.library import paper_parameters_full
+from brakesqueal.model.parameters import Parameters
 from brakesqueal.simulation import simulation_model
 
 CASES = [
@@ -30,10 +33,7 @@ def _states(st, rng, k=3):
     return scale, [st.y + 1e-3 * rng.standard_normal(st.y.size) * scale for _ in range(k)]
 
 
-@pytest.mark.parametrize("preset, overrides, _name", CASES)
-def test_compiled_jacobian_is_exact(preset, overrides, _name):
-    space = ParameterSpace.from_preset(preset, overrides)
-    params = space.resolve({})
+def _check_jacobian(params, what):
     sim = simulation_model(params.model)
     st = sim.silent(params)
     f, jac = sim.vector_field(params, st)
@@ -50,14 +50,34 @@ def test_compiled_jacobian_is_exact(preset, overrides, _name):
         mod.nl_jac(y, 0.0, th, Jc)
         Jp = jac(y)
         big = np.max(np.abs(Jp))
-        assert np.max(np.abs(Jc - Jp)) <= 1e-10 * big, (preset, np.max(np.abs(Jc - Jp)) / big)
+        assert np.max(np.abs(Jc - Jp)) <= 1e-10 * big, (what, np.max(np.abs(Jc - Jp)) / big)
         cols = []
         for i in range(ny):
             e = np.zeros(ny)
             e[i] = 1e-6 * scale[i]
             cols.append((8 * (f(y + e) - f(y - e)) - (f(y + 2 * e) - f(y - 2 * e))) / (12 * e[i]))
         fd = np.column_stack(cols)
-        assert np.max(np.abs(Jc - fd)) <= 1e-7 * big, (preset, np.max(np.abs(Jc - fd)) / big)
+        assert np.max(np.abs(Jc - fd)) <= 1e-7 * big, (what, np.max(np.abs(Jc - fd)) / big)
+        wrong = Jc.copy()
+        wrong[ny - 1, 0] += 1e-5 * big  # negative control: the comparison sees an error of this size
+        assert np.max(np.abs(wrong - fd)) > 1e-7 * big
+    return sim
+
+
+@pytest.mark.parametrize("preset, overrides, _name", CASES)
+def test_compiled_jacobian_is_exact(preset, overrides, _name):
+    _check_jacobian(ParameterSpace.from_preset(preset, overrides).resolve({}), preset)
+
+
+def test_compiled_jacobian_with_a_dynamic_pad():
+    """A coulomb pad (quasi-static) and a falling-friction pad (its deformation a state) at a tilted silent motion."""
+    pads = tuple(Pad(n, face, radius="r", k=f"k{n}", d=f"d{n}", preload="N0", k_ip=f"k_ip{n}",
+                     friction=FrictionLaw(law, f"mu{n}", slope="s2" if law == "linear" else None))
+                 for n, face, law in (("1", "upper", "coulomb"), ("2", "lower", "linear")))  # fmt: skip
+    par = {**paper_parameters_full(), "k_ip1": 1e4, "k_ip2": 1e4, "s2": 0.05}
+    params = Parameters(ModelSpec("mixed-pads-variational", Disk(), pads, parameters=par), {**par, "h10": 0.012})
+    sim = _check_jacobian(params, "mixed pads")
+    assert sim.pad_kinds == ("quasi-static", "dynamic") and len(sim.state_names) == 5
 
 
 @pytest.mark.parametrize("preset, overrides, name", [c for c in CASES if c[2]])
