@@ -64,6 +64,18 @@ def _label(space: Any, name: str) -> str:
     return f"{name} [{unit}]" if unit else name
 
 
+#: Milliseconds Panel waits before it handles a change sent by the browser (its default is 50 ms, a third of
+#: the slider's latency budget); the explorer's own lanes drop stale values, so no debounce is needed.
+WIDGET_DEBOUNCE_MS = 1
+
+
+def _undebounce(*widgets: Any) -> None:
+    """Handle the browser's changes of ``widgets`` at once (Panel's ``_debounce`` class attribute, per widget)."""
+    for w in widgets:
+        if hasattr(w, "_debounce"):
+            w._debounce = WIDGET_DEBOUNCE_MS
+
+
 class Explorer:
     """One session of the explorer.
 
@@ -101,6 +113,7 @@ class Explorer:
         self._cs_key: Any = None
         self._hopf_key: Any = None
         self._building = False
+        self._sync_shown: ViewState | None = None
         self.ranges: dict[str, SliderRange] = {n: slider_range(self.space, n) for n in self.space.settable()}
         self._map_logs = (self.ranges[state.x].log, self.ranges[state.y].log)
         self._map_axes = (state.x, state.y)
@@ -128,9 +141,18 @@ class Explorer:
             fn()
             return
         try:
-            doc.add_next_tick_callback(fn)
+            doc.add_next_tick_callback(partial(self._held, fn))
         except Exception:  # the session is gone
             self.stop()
+
+    def _held(self, fn: Any) -> None:
+        """Run ``fn`` on the event loop with the document held: all its changes go out as one patch message,
+        which the browser applies (and lays out) once."""
+        from panel.io.document import hold
+        from panel.io.state import set_curdoc
+
+        with set_curdoc(self.doc), hold(self.doc):
+            fn()
 
     def stop(self) -> None:
         """End the session's worker threads."""
@@ -216,6 +238,7 @@ class Explorer:
                                        css_classes=[f"bs-input-{name}"])
             slider.param.watch(lambda e, n=name: self._on_slider(n, e.new), "value")
             box.param.watch(lambda e, n=name: self._on_text(n, e.new), "value")
+            _undebounce(slider, box)
             self.sliders[name], self.inputs[name] = slider, box
             rows.append(pn.Row(slider, box, sizing_mode="stretch_width"))
         fixed = []
@@ -225,6 +248,7 @@ class Explorer:
             box = pn.widgets.TextInput(name=_label(space, name), value=_fmt_value(space.value(name)), width=150,
                                        css_classes=[f"bs-input-{name}"])
             box.param.watch(lambda e, n=name: self._on_text(n, e.new), "value")
+            _undebounce(box)
             self.inputs[name] = box
             fixed.append(box)
         self.params_box.objects = rows
@@ -394,6 +418,10 @@ class Explorer:
     def _on_slider(self, name: str, position: float) -> None:
         if self._building:
             return
+        with self.pn.io.hold():
+            self._slider_moved(name, position)
+
+    def _slider_moved(self, name: str, position: float) -> None:
         value = self.ranges[name].from_slider(position)
         text = _fmt_value(value)
         self._building = True
@@ -516,16 +544,45 @@ class Explorer:
         self.info_lane.cancel()
 
     def _submit(self) -> None:
-        """The eigenvalues first; the map lane follows each delivered locus (so it never delays the first view)."""
-        self.locus_lane.submit(self.state)
+        """The eigenvalues first; the map lane follows each delivered locus (so it never delays the first view).
+
+        When the root locus is kept (only the path parameter moved) and the lane is idle, the current
+        eigenvalues (one linearization, well under a millisecond) are computed and shown at once, without
+        the round trip through the lane's thread.
+        """
+        state = self.state
+        lane = self.locus_lane
+        if self.doc is not None and not lane.busy and not lane.superseded:
+            try:
+                result = self._reused_locus(state)
+            except BrakesquealError:
+                result = None  # the lane reports the error
+            if result is not None:
+                self._sync_shown = state
+                self._show_locus(state, result, None)
+                return
+        self._sync_shown = None
+        lane.submit(state)
+
+    def _locus_key(self, space: Any, state: ViewState) -> tuple[Any, SliderRange]:
+        rng = slider_range(space, state.along) if state.along not in self.ranges else self.ranges[state.along]
+        defs = {k: str(v) for k, v in space.definitions().items() if k != state.along}
+        return (state.model, state.preset, state.along, rng, tuple(sorted(defs.items()))), rng
+
+    def _reused_locus(self, state: ViewState) -> tuple[Any, LocusView, bool] | None:
+        """The locus of ``state`` if its path is the one kept, else None."""
+        space = self.origin.space_of(state)
+        key, rng = self._locus_key(space, state)
+        tracks = self._tracks
+        if tracks is None or key != self._tracks_key:
+            return None
+        return space, locus_view(space, state.along, rng, tracks=tracks), True
 
     # ------------------------------------------------------------------------------------------ lanes
     def _compute_locus(self, state: ViewState, check: Any) -> tuple[Any, LocusView, bool]:
         """The current eigenvalues, then the modes along the path (reused while only ``along`` itself moves)."""
         space = self.origin.space_of(state)
-        rng = slider_range(space, state.along) if state.along not in self.ranges else self.ranges[state.along]
-        defs = {k: str(v) for k, v in space.definitions().items() if k != state.along}
-        key = (state.model, state.preset, state.along, rng, tuple(sorted(defs.items())))
+        key, rng = self._locus_key(space, state)
         if key == self._tracks_key:
             return space, locus_view(space, state.along, rng, tracks=self._tracks), True
         now = locus_view(space, state.along, rng, path=False)
@@ -547,6 +604,8 @@ class Explorer:
                 "style='display:none'></div>")
 
     def _show_locus(self, state: ViewState, result: Any, error: BaseException | None) -> None:
+        if self._sync_shown is self.state and state is not self.state:
+            return  # a lane's result for an older state, after the current one was shown at once
         self.map_lane.submit(self.state)  # the other lanes follow the eigenvalues (latest request only)
         self.info_lane.submit(self.state)
         if error is not None:
@@ -645,11 +704,13 @@ class Explorer:
         if error is not None:
             self._cs_key = self._hopf_key = None
             self.hopf_text.object = f"<b>Hopf:</b> {html.escape(str(error))}"
-        else:
+        else:  # an unchanged text is not sent again
+            if "cs" in out and self.cs_text.object != (cs := html.escape(out["cs"])):
+                self.cs_text.object = cs
             if "cs" in out:
-                self.cs_text.object = html.escape(out["cs"])
                 self.shown["cs"] = out["cs"]
-            self.hopf_text.object = html.escape(out["hopf"])
+            if self.hopf_text.object != (hopf := html.escape(out["hopf"])):
+                self.hopf_text.object = hopf
             self.shown["hopf"] = out["hopf"]
         self.shown["info_state"] = state.to_query()
         self._mark()
@@ -674,6 +735,8 @@ class Explorer:
         if "map" in out:
             mv: MapView = out["map"]
             self._draw_map(state, mv)
+        elif "map_error" not in out:
+            return  # the map did not change: nothing to send
         self._mark()
 
     def _draw_map(self, state: ViewState, mv: MapView) -> None:
