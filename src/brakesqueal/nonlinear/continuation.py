@@ -477,23 +477,29 @@ def _at_parameter(eng: _Engine, a: _Point, b: _Point, bound: float) -> _Point | 
                        1e-13)  # fmt: skip
 
 
-def _bisect_events(eng: _Engine, a: _Point, ds: float, ev_a: tuple[str, ...]) -> _Point | None:
-    """Bisection on ``s`` for the change of the switching events (grazing)."""
-    lo, hi = 0.0, ds
-    yhat0 = a.y / eng.sv
+def _bisect_events(eng: _Engine, a: _Point, b: _Point, ev_a: tuple[str, ...]) -> _Point | None:
+    """Bisection for the change of the switching events (grazing) between the branch points ``a`` and ``b``.
+
+    Each trial is predicted at the midpoint of the current bracket and corrected on the hyperplane through
+    it normal to the bracket's chord (relaxed Newton: the shooting map is only C^1 at grazing), so the
+    predictor stays close to the branch however long the step was; stops when the bracket is below
+    ``1e-10`` in scaled arclength.  Returns the located point on the far side (events changed).
+    """
+    lo, hi = a.y, b.y
     best = None
-    for _ in range(30):
-        s = 0.5 * (lo + hi)
+    for _ in range(60):
+        chord = (hi - lo) / eng.sv
+        length = float(np.linalg.norm(chord))
+        if length <= 1e-10:
+            break
         try:
-            pt = eng.point((yhat0 + s * a.tangent) * eng.sv, a.tangent, a.y, samples=False, relaxed=True)
+            pt = eng.point(0.5 * (lo + hi), chord / length, a.y, samples=False, relaxed=True, t_orient=a.tangent)
         except _NoConvergence:
             break
         if pt.events == ev_a:
-            lo = s
+            lo = pt.y
         else:
-            hi, best = s, pt
-        if hi - lo <= 1e-8 * ds:
-            break
+            hi, best = pt.y, pt
     return best
 
 
@@ -521,7 +527,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
                     flow: Any = None, tol: float = 1e-10, n_samples: int = 64, max_newton: int = 7,
                     max_angle: float = 0.3, start_amplitude: float = 0.02, direction: int = 1,
                     max_period: float | None = None, detect: Iterable[str] = ("LPC", "PD", "NS", "BPC", "GR"),
-                    p_scale: float | None = None,
+                    p_scale: float | None = None, ds_event: float | None = None,
                     ) -> CycleBranch:  # fmt: skip
     r"""Continue a branch of periodic orbits from a Hopf point (or an orbit) in the parameter ``p``.
 
@@ -572,6 +578,9 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
         from ``p0`` (at most the end of the range).  Passing the distance of
         an expected event (e.g. the predicted contact loss) makes the steps
         independent of the requested range.
+    ds_event : float, optional
+        Largest step across an event (a sign change of a test function or a change of the switching
+        events): a longer step that crosses one is halved and redone (default ``ds_max / 10``).
 
     Returns
     -------
@@ -613,6 +622,9 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
     ds = min(0.02, ds_max) if ds is None else float(ds)
     if not (ds_min <= ds <= ds_max):
         raise ParameterError(f"The option 'ds' must be in [ds_min, ds_max] = [{ds_min}, {ds_max}]; got {ds!r}")
+    ds_event = ds_max / 10 if ds_event is None else float(ds_event)
+    if not (ds_event > 0):
+        raise ParameterError(f"The option 'ds_event' must be positive; got {ds_event!r}")
     m = int(n_segments)
     width = hi - lo
     if p_scale is not None:
@@ -715,9 +727,17 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
                 status, message = "step_underflow", f"step below ds_min = {ds_min:g} ({exc})"
                 break
             continue
+        # an event between a and b (a test function changes sign, the switching events change): cut the
+        # step back until the bracket is short, so that the event is located from a nearby point whatever
+        # the step that reached it
+        lpc = "LPC" in detect and a.label != "H" and a.tests.get("LPC", 0) * b.tests["LPC"] < 0
+        event = a.label != "H" and (lpc or ("GR" in detect and a.events != b.events) or any(
+            k in detect and a.tests.get(k, 0) * b.tests[k] < 0 for k in ("PD", "NS", "BPC")))
+        if event and ds_cur > ds_event and ds_cur / 2 >= ds_min:
+            ds_cur /= 2
+            continue
         # special points between a and b (test functions), sorted by arclength
         found: list[tuple[float, _Point, str, str]] = []
-        lpc = "LPC" in detect and a.label != "H" and a.tests.get("LPC", 0) * b.tests["LPC"] < 0
         if lpc:
             pt = _locate(eng, a, ds_cur, lambda q: q.tests["LPC"], b.tests["LPC"], a.tests["LPC"], 1e-12)
             if pt is not None:
@@ -735,7 +755,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
             if desc is not None:
                 found.append((_s_of(eng, a, pt), pt, kind, desc))
         if "GR" in detect and a.label != "H" and a.events != b.events:
-            pt = _bisect_events(eng, a, ds_cur, a.events)
+            pt = _bisect_events(eng, a, b, a.events)
             if pt is not None:
                 found.append((_s_of(eng, a, pt), pt, "GR",
                               f"switching events change from {list(a.events)} to {list(b.events)}"))  # fmt: skip

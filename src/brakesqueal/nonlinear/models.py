@@ -625,7 +625,7 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
         point of the branch).
     ds, ds_max : float, optional
         Initial and largest step of :func:`~.continuation.continue_cycles` (scaled arclength).  The
-        parameter scale is four times the distance from the onset to the contact loss predicted by the
+        parameter scale is twenty times the distance from the onset to the contact loss predicted by the
         Hopf point (:func:`predicted_contact_loss`), not the width of the range, so the steps near the
         onset do not depend on the requested range.
 
@@ -662,7 +662,7 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
     hp = pts[0]
     h = hp.hopf
     predicted = predicted_contact_loss(space, axis.name, h)
-    p_scale = 4 * abs(predicted - h.p0) if predicted is not None else None
+    p_scale = 20 * abs(predicted - h.p0) if predicted is not None else None
     opts: dict[str, Any] = {"max_points": max_points, "tol": tol, "p_scale": p_scale, "ds_max": ds_max,
                             "ds": min(0.02, ds_max) if ds is None else ds}
     system = model_system(space, axis.name, use_cache=use_cache)
