@@ -16,6 +16,7 @@ import html
 import json
 import logging
 import math
+import time
 from dataclasses import replace
 from functools import partial
 from typing import Any
@@ -51,6 +52,8 @@ log = logging.getLogger(__name__)
 
 #: Milliseconds the state must rest before it is written to the URL.
 URL_DELAY_MS = 400
+#: Milliseconds the state must rest before the critical speeds and the Hopf point are recomputed.
+INFO_REST_MS = 150
 _LOG_FORMAT = "return Number((10 ** tick).toPrecision(3)).toExponential();"
 _MAP_PALETTE = ["#f3a5a5", "#a9cdf5", "#c8c8c8"]  # unstable, stable, no verdict
 
@@ -114,6 +117,8 @@ class Explorer:
         self._hopf_key: Any = None
         self._building = False
         self._sync_shown: ViewState | None = None
+        self._info_pending = False
+        self._info_due = 0.0
         self.ranges: dict[str, SliderRange] = {n: slider_range(self.space, n) for n in self.space.settable()}
         self._map_logs = (self.ranges[state.x].log, self.ranges[state.y].log)
         self._map_axes = (state.x, state.y)
@@ -564,6 +569,35 @@ class Explorer:
         self._sync_shown = None
         lane.submit(state)
 
+    def _submit_info(self) -> None:
+        """Compute the critical speeds and the Hopf point once the state has rested for :data:`INFO_REST_MS`.
+
+        Critical speeds take about 10 ms of the interpreter per point; computed on every step of a moving
+        slider they would hold up the event loop that sends the next root locus.
+        """
+        if self.doc is None:
+            self.info_lane.submit(self.state)
+            return
+        self._info_due = time.monotonic() + INFO_REST_MS / 1000
+        if self._info_pending:
+            return
+        self._info_pending = True
+        try:
+            self.doc.add_timeout_callback(self._flush_info, INFO_REST_MS)
+        except Exception:  # the session is gone
+            self._info_pending = False
+
+    def _flush_info(self) -> None:
+        wait = self._info_due - time.monotonic()
+        if wait > 0.001:  # moved again since: wait for the rest
+            try:
+                self.doc.add_timeout_callback(self._flush_info, int(1000 * wait) + 1)
+            except Exception:  # the session is gone
+                self._info_pending = False
+            return
+        self._info_pending = False
+        self.info_lane.submit(self.state)
+
     def _locus_key(self, space: Any, state: ViewState) -> tuple[Any, SliderRange]:
         rng = slider_range(space, state.along) if state.along not in self.ranges else self.ranges[state.along]
         defs = {k: str(v) for k, v in space.definitions().items() if k != state.along}
@@ -607,7 +641,7 @@ class Explorer:
         if self._sync_shown is self.state and state is not self.state:
             return  # a lane's result for an older state, after the current one was shown at once
         self.map_lane.submit(self.state)  # the other lanes follow the eigenvalues (latest request only)
-        self.info_lane.submit(self.state)
+        self._submit_info()
         if error is not None:
             self.leading_text.object = f"<b>leading eigenvalue:</b> {html.escape(str(error))}"
             self.shown["locus"] = {"state": state.to_query(), "error": str(error)}
