@@ -423,10 +423,6 @@ class Explorer:
     def _on_slider(self, name: str, position: float) -> None:
         if self._building:
             return
-        with self.pn.io.hold():
-            self._slider_moved(name, position)
-
-    def _slider_moved(self, name: str, position: float) -> None:
         value = self.ranges[name].from_slider(position)
         text = _fmt_value(value)
         self._building = True

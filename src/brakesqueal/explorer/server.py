@@ -43,19 +43,10 @@ def _configure_offline() -> None:
 
 
 def _warm(origin: Any) -> None:
-    """Import and load what the first page builds and computes, while the server starts.
-
-    A throwaway page is built (no session: its lanes compute at once and
-    are stopped), so the first browser tab finds Panel's and Bokeh's model
-    classes imported and initialised and the library's kernels compiled.
-    """
-    from .app import Explorer
+    """Import and load what the first page computes while the browser loads the page's scripts."""
     from .state import locus_view, slider_range
 
     try:
-        ex = Explorer(origin, {})
-        ex.stop()
-        ex.page.get_root()
         state = origin.initial_state()
         space = origin.space_of(state)
         locus_view(space, state.along, slider_range(space, state.along))
