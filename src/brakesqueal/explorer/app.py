@@ -145,19 +145,12 @@ class Explorer:
         if doc is None:  # no server (tests of the object): run now
             fn()
             return
+        # Not held (pn.io.hold): a callback that a worker thread adds while the document is held can be
+        # dropped when the hold is released, and the lane's result would never be shown.
         try:
-            doc.add_next_tick_callback(partial(self._held, fn))
+            doc.add_next_tick_callback(fn)
         except Exception:  # the session is gone
             self.stop()
-
-    def _held(self, fn: Any) -> None:
-        """Run ``fn`` on the event loop with the document held: all its changes go out as one patch message,
-        which the browser applies (and lays out) once."""
-        from panel.io.document import hold
-        from panel.io.state import set_curdoc
-
-        with set_curdoc(self.doc), hold(self.doc):
-            fn()
 
     def stop(self) -> None:
         """End the session's worker threads."""
