@@ -94,6 +94,10 @@ def model_system(space: Any, name: str, *, use_cache: bool = True) -> SmoothSyst
     system = SmoothSystem(f=f, jac=jac, n=len(sim.state_names), state_names=tuple(sim.state_names),
                           parameter_name=name)
     object.__setattr__(system, "simulation_model", sim)
+    # shooting and continuation integrate with the compiled flow and the generated exact Jacobian
+    from .compiled import model_flow
+
+    object.__setattr__(system, "default_flow", lambda: model_flow(space, name, system=system, use_cache=use_cache))
     return system
 
 
