@@ -333,7 +333,7 @@ def bench_paper_model(*, points: int = 200, old_points: int = 20, brute_points: 
 
     from brakesqueal.analysis.maps import Axis
     from brakesqueal.model import ParameterSpace
-    from brakesqueal.nonlinear import continue_cycles, first_lyapunov
+    from brakesqueal.nonlinear import ScipyFlow, continue_cycles, first_lyapunov
     from brakesqueal.nonlinear.compiled import model_flow
     from brakesqueal.nonlinear.models import hopf_points, model_system
     from brakesqueal.simulation import simulate
@@ -355,7 +355,7 @@ def bench_paper_model(*, points: int = 200, old_points: int = 20, brute_points: 
     d = br.data
     n_pts = int(d.sizes["point"])
     t0 = time.perf_counter()
-    br_old = continue_cycles(system, hp.hopf, (30.0, 40.0), max_points=old_points, **kw)
+    br_old = continue_cycles(system, hp.hopf, (30.0, 40.0), max_points=old_points, flow=ScipyFlow(system), **kw)
     t_old = time.perf_counter() - t0
     n_old = int(br_old.data.sizes["point"])
     t_old_scaled = t_old * n_pts / n_old
