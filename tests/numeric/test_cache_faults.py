@@ -422,6 +422,8 @@ EXEMPT = {
     "plotting.py": "figures of results (nonlinear/continuation.py's branch plot): generates no cached code",
     "model/parameters.py": "parameter values and presets: never enter generated code",
     "model/roles.py": "ranges and units of parameters: validation only",
+    "simulation/__init__.py": "the simulation's public names (nonlinear/compiled.py's model_flow loads a model through "
+                              "it at run time); the generated source comes from simulation/_kernels.py (listed)",
     "nonlinear/models.py": "brake models as systems of the nonlinear machinery: runs the simulation's generated "
                            "kernels and the crossings, generates no code",
 }  # fmt: skip
