@@ -218,7 +218,7 @@ def _register_plugins() -> None:
     """Add the command groups that live in their own modules."""
     import importlib
 
-    for name in (".stability", ".modes", ".sweep", ".cache", "..cli_simulate", "..cli_export", ".explore"):
+    for name in (".stability", ".modes", ".sweep", ".cache", ".simulate", ".export", ".explore"):
         mod = importlib.import_module(name, __package__)
         mod.register(app)
 

@@ -79,9 +79,9 @@ def _export_cmd(
     ] = None,
 ) -> None:
     """Write any model's equations (nonlinear or closed-form linear) as C, Octave, Julia, Python or LaTeX."""
-    from .export import TARGETS, check_name, export_code
-    from .model.options import resolve_space
-    from .outputs import atomic_write, check_output
+    from ..export import TARGETS, check_name, export_code
+    from ..model.options import resolve_space
+    from ..outputs import atomic_write, check_output
 
     suffix = TARGETS[to.value]
     path = None if out == "-" else check_output(out, what="--out", suffixes=(suffix,))

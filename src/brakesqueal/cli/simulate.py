@@ -12,7 +12,7 @@ from typing import Annotated, Any, Optional
 
 import typer
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 __all__ = ["register"]
 
@@ -40,7 +40,7 @@ def _check_outputs(out: str | None, plot: str | None, wav: str | None) -> None:
     """Every output path is checked before anything is computed (one line, exit status 2)."""
     from pathlib import Path
 
-    from .outputs import check_output
+    from ..outputs import check_output
 
     given = {opt: path for opt, path in (("--out", out), ("--plot", plot), ("--wav", wav)) if path}
     if out:
@@ -125,8 +125,8 @@ def _simulate_cmd(
     elif q0 is not None:
         init["perturbation"] = _floats(q0, "--q0")
     _check_outputs(out, plot, wav)
-    from .model.options import resolve_space
-    from .interrupts import interrupt_guard
+    from ..model.options import resolve_space
+    from ..interrupts import interrupt_guard
 
     p = resolve_space(model, preset, params, list(set_ or [])).resolve({})
     with interrupt_guard():  # nested in the program's guard (brakesqueal.cli.main), which ends a stuck run
@@ -156,12 +156,12 @@ def _simulate_cmd(
 
 def _run(p: Any, t_end: float, method: str, rtol: float, atol: Any, events: str, sample_rate: float,
          progress: bool, no_cache: bool, init: dict[str, Any]) -> Any:
-    from .simulation import simulate, simulation_model
-    from .interrupts import check_interrupt
+    from ..simulation import simulate, simulation_model
+    from ..interrupts import check_interrupt
 
     sim = simulation_model(p.model, use_cache=not no_cache)
     check_interrupt()
-    from .cli._progress import progress as _progress
+    from ._progress import progress as _progress
 
     with _progress("simulate", None if progress else False) as cb:
         return simulate(
@@ -172,13 +172,13 @@ def _run(p: Any, t_end: float, method: str, rtol: float, atol: Any, events: str,
 
 def _write(tr: Any, out: str | None, plot: str | None, wav: str | None) -> None:
     """Write the outputs atomically (each OSError: one line naming the option)."""
-    from .interrupts import check_interrupt
+    from ..interrupts import check_interrupt
 
     if out:
         tr.to_netcdf(out, what="--out")
         check_interrupt()
     if plot:
-        from .outputs import write_with
+        from ..outputs import write_with
 
         fig = tr.plot()  # an Agg figure of its own, never managed by pyplot
         write_with(plot, lambda tmp: fig.savefig(tmp, dpi=300), what="--plot")
