@@ -1,9 +1,11 @@
 """Result objects of the stability analysis: conversion to xarray, files, ``.plot()``.
 
 ``.plot()`` returns the matplotlib figure (Agg backend, never ``plt.show()``).
-NetCDF files are written with xarray's ``scipy`` engine (NetCDF3, no extra
-dependency); booleans are stored as ``int8`` with ``flag_values`` /
-``flag_meanings`` and restored by :func:`open_map`.
+NetCDF files are NetCDF3 (64-bit offset, no extra dependency), written with
+xarray's ``scipy`` engine or, for maps computed chunk by chunk, by
+:class:`MapFile` (same variables and attributes, bounded memory); booleans are
+stored as ``int8`` with ``flag_values`` / ``flag_meanings`` and restored by
+:func:`open_map`.
 """
 
 from __future__ import annotations
@@ -17,7 +19,8 @@ import numpy as np
 
 from .labels import unit
 
-__all__ = ["StabilityMap", "CrossingResult", "CriticalSpeedResult", "open_map", "MapFile", "plot_map_file"]
+__all__ = ["StabilityMap", "CrossingResult", "CriticalSpeedResult", "open_map", "MapFile", "plot_map_file",
+           "NC3_MAX_VAR_BYTES"]
 
 def _status_attrs() -> dict[str, Any]:
     from .status import STATUS_MEANINGS, PointStatus
@@ -66,15 +69,110 @@ def boundary_of(ds_or_vars: Any, names: tuple[str, str]) -> tuple[np.ndarray, np
     return a, b
 
 
-class MapFile:
-    """A stability map's NetCDF3 file whose variables are filled in place, row block by row block.
+#: NetCDF3 type codes (classic format specification) of the numpy types a map file stores.
+_NC_TYPE = {"i1": 1, "S1": 2, "i2": 3, "i4": 4, "f4": 5, "f8": 6}
+#: Default fill bytes of the NetCDF3 types (padding of a variable without ``_FillValue``).
+_NC_FILL = {1: b"\x81", 2: b"\x00", 3: b"\x80\x01", 4: b"\x80\x00\x00\x01", 5: b"\x7c\xf0\x00\x00",
+            6: b"\x47\x9e\x00\x00\x00\x00\x00\x00"}
+#: Largest size [bytes] of one variable of a NetCDF3 64-bit-offset file (its ``vsize`` is a 32-bit count).
+NC3_MAX_VAR_BYTES = 2**32 - 4
 
-    The file has the layout :meth:`StabilityMap.to_netcdf` writes and is read
-    back by :func:`open_map`.  It is a :func:`scipy.io.netcdf_file` whose
-    variables' arrays (attributes ``stable``, ``status``, ``max_real``,
-    ``frequency``) are the map's result arrays, so no second copy of the map
-    (an xarray Dataset, a converted copy per variable) is built; the data
-    are written when the file is closed.
+
+def _nc_int(n: int) -> bytes:
+    return int(n).to_bytes(4, "big", signed=True)
+
+
+def _nc_name(name: str) -> bytes:
+    b = name.encode("utf-8")
+    return _nc_int(len(b)) + b + b"\x00" * (-len(b) % 4)
+
+
+def _nc_att_values(value: Any) -> tuple[int, bytes]:
+    """NetCDF3 type and encoded values of an attribute (the types :func:`scipy.io.netcdf_file` gives them)."""
+    if isinstance(value, (str, bytes)):
+        data = value.encode("utf-8") if isinstance(value, str) else value
+        return 2, _nc_int(len(data)) + data + b"\x00" * (-len(data) % 4)
+    if hasattr(value, "dtype"):
+        a = np.asarray(value)
+    elif isinstance(value, int):
+        a = np.asarray(value, dtype=np.int32)
+    else:
+        a = np.asarray(value, dtype=np.float32)
+    a = np.atleast_1d(a)
+    key = f"{a.dtype.kind}{a.dtype.itemsize}"
+    if key not in _NC_TYPE:
+        raise TypeError(f"attribute of type {a.dtype} cannot be stored in NetCDF3")
+    data = a.astype(a.dtype.newbyteorder(">")).tobytes()
+    return _NC_TYPE[key], _nc_int(a.size) + data + b"\x00" * (-len(data) % 4)
+
+
+def _nc_atts(attrs: dict[str, Any]) -> bytes:
+    if not attrs:
+        return b"\x00" * 8
+    out = [b"\x00\x00\x00\x0c", _nc_int(len(attrs))]
+    for k, v in attrs.items():
+        t, data = _nc_att_values(v)
+        out += [_nc_name(k), _nc_int(t), data]
+    return b"".join(out)
+
+
+@dataclass
+class _NcVar:
+    """One fixed-size variable of a NetCDF3 file: its metadata and where its data start (``begin``)."""
+
+    name: str
+    dims: tuple[str, ...]
+    dtype: np.dtype  # big-endian, as stored
+    attrs: dict[str, Any]
+    size: int
+    begin: int = 0
+
+    @property
+    def nbytes(self) -> int:
+        return self.size * self.dtype.itemsize
+
+    @property
+    def vsize(self) -> int:
+        return self.nbytes + (-self.nbytes % 4)
+
+    def padding(self) -> bytes:
+        """The bytes after the data up to a multiple of 4 (the fill value, as :func:`scipy.io.netcdf_file`)."""
+        fill = self.attrs.get("_FillValue")
+        code = _NC_TYPE[f"{self.dtype.kind}{self.dtype.itemsize}"]
+        enc = np.asarray(fill, dtype=self.dtype).tobytes() if fill is not None else _NC_FILL[code]
+        return enc * ((self.vsize - self.nbytes) // len(enc))
+
+
+def _nc3_header(dims: list[tuple[str, int]], attrs: dict[str, Any], variables: list[_NcVar]) -> bytes:
+    """The header of a NetCDF3 64-bit-offset file (``CDF\\x02``) without record variables."""
+    names = [d for d, _ in dims]
+    out = [b"CDF\x02", _nc_int(0)]
+    out += [b"\x00\x00\x00\x0a", _nc_int(len(dims))] if dims else [b"\x00" * 8]
+    out += [_nc_name(d) + _nc_int(n) for d, n in dims]
+    out.append(_nc_atts(attrs))
+    out += [b"\x00\x00\x00\x0b", _nc_int(len(variables))] if variables else [b"\x00" * 8]
+    for v in variables:
+        out += [_nc_name(v.name), _nc_int(len(v.dims)), *(_nc_int(names.index(d)) for d in v.dims), _nc_atts(v.attrs),
+                _nc_int(_NC_TYPE[f"{v.dtype.kind}{v.dtype.itemsize}"]),
+                _nc_int(min(v.vsize, 2**32 - 1)), int(v.begin).to_bytes(8, "big", signed=True)]
+    return b"".join(out)
+
+
+class MapFile:
+    """A stability map's NetCDF3 file written row block by row block (memory bounded for any map size).
+
+    The file has the layout :meth:`StabilityMap.to_netcdf` writes (NetCDF3
+    64-bit offset, the variables, types and attributes of
+    :func:`scipy.io.netcdf_file`) and is read back by :func:`open_map` or
+    :func:`xarray.open_dataset`.  The variables' sizes are known from the axes,
+    so each one's place in the file is fixed when the file is created: every
+    block of rows (:meth:`write_rows`) is written to its place at once and
+    nothing of the map is held; the header (which names the route, known at
+    the end, and the boundary's length) is written by :meth:`close`.  When a
+    boundary may follow (``boundary=True``), room for its dimension and two
+    variables is kept in front of the data; a map without a boundary then has
+    zero bytes between its header and its first variable (allowed by the
+    format: every variable's data start at its recorded offset).
 
     Parameters
     ----------
@@ -88,59 +186,127 @@ class MapFile:
         Whether ``max_real`` and ``frequency`` are stored.
     float_dtype : numpy dtype
         Type of ``max_real`` and ``frequency`` (float32 or float64).
+    method : str
+        The route (global attribute ``method``; :meth:`close` may give
+        another name of at most the same length).
+    boundary : bool
+        Keep room in the header for :meth:`write_boundary` (default ``True``).
+
+    Raises
+    ------
+    ParameterError
+        If a variable would exceed :data:`NC3_MAX_VAR_BYTES` (the format's limit).
     """
 
     def __init__(self, path: str, space: Any, outer: Any, inner: Any, *, eigen: bool,
-                 float_dtype: Any = np.float64) -> None:
-        from scipy.io import netcdf_file
+                 float_dtype: Any = np.float64, method: str = "", boundary: bool = True) -> None:
+        from .errors import ParameterError
 
-        self.space = space
-        self._f = netcdf_file(path, "w", version=2, maskandscale=False)
-        ft = np.dtype(float_dtype)
+        self.space, self.outer, self.inner = space, outer, inner
+        ft = np.dtype(float_dtype).newbyteorder(">")
+        n = outer.num * inner.num
+        size = ft.itemsize if eigen else 1
+        if n * size > NC3_MAX_VAR_BYTES:
+            raise ParameterError(f"the map has {n:.4g} points: a NetCDF3 variable holds at most "
+                                 f"{NC3_MAX_VAR_BYTES // size:.4g} values of {size} byte(s) (4 GiB); use fewer "
+                                 "points or a sweep (brakesqueal sweep)")
         dims = (outer.name, inner.name)
-        for ax in (outer, inner):
-            self._f.createDimension(ax.name, ax.num)
-            v = self._f.createVariable(ax.name, "d", (ax.name,))
-            v[:] = ax.values()
-            self._attrs(v, {**_coord_attrs(ax, space), "_FillValue": np.float64(np.nan)})
-        self.max_real = self.frequency = None
+        self._dims = [(ax.name, int(ax.num)) for ax in (outer, inner)]
+        self._vars = [_NcVar(ax.name, (ax.name,), np.dtype(">f8"),
+                             {**_coord_attrs(ax, space), "_FillValue": np.float64(np.nan)}, int(ax.num))
+                      for ax in (outer, inner)]
+        grid = [("stable", np.dtype("i1"), {**_VAR_ATTRS["stable"], **_STABLE_FLAGS}),
+                ("status", np.dtype("i1"), _status_attrs())]
         if eigen:
-            self.max_real = self._var("max_real", ft, dims, {**_VAR_ATTRS["max_real"], "_FillValue": ft.type(np.nan)})
-        self.stable = self._var("stable", np.int8, dims, {**_VAR_ATTRS["stable"], **_STABLE_FLAGS})
-        if eigen:
-            self.frequency = self._var("frequency", ft, dims,
-                                       {**_VAR_ATTRS["frequency"], "_FillValue": ft.type(np.nan)})
-        self.status = self._var("status", np.int8, dims, _status_attrs())
+            grid.insert(0, ("max_real", ft, {**_VAR_ATTRS["max_real"], "_FillValue": ft.type(np.nan)}))
+            grid.insert(2, ("frequency", ft, {**_VAR_ATTRS["frequency"], "_FillValue": ft.type(np.nan)}))
+        self._vars += [_NcVar(name, dims, dt, attrs, n) for name, dt, attrs in grid]
+        self._grid = {v.name: v for v in self._vars[2:]}
+        self.eigen = eigen
+        # the header's length depends on the names and attributes, not on the lengths and offsets in it
+        self._bnames = [f"boundary_{ax.name}" for ax in (outer, inner)]
+        self.method = method
+        self._room = len(self._header(method, self._boundary_vars(1) if boundary else None))
+        offset = self._room
+        for v in self._vars:
+            v.begin = offset
+            offset += v.vsize
+        self._end = offset
+        self._fp = open(path, "wb")
+        try:
+            for v in self._vars[:2]:
+                self._put(v, 0, np.asarray(self.outer.values() if v.name == outer.name else inner.values()))
+        except BaseException:
+            self._fp.close()
+            raise
+        self._boundary: list[_NcVar] = []
 
-    @staticmethod
-    def _attrs(v: Any, attrs: dict[str, Any]) -> None:
-        for k, a in attrs.items():
-            setattr(v, k, a)
+    def _boundary_vars(self, n: int) -> list[_NcVar]:
+        return [_NcVar(name, (BOUNDARY_DIM,), np.dtype(">f8"),
+                       {**_boundary_attrs(ax.name, self.space), "_FillValue": np.float64(np.nan)}, n)
+                for name, ax in zip(self._bnames, (self.outer, self.inner))]
 
-    def _var(self, name: str, dtype: Any, dims: tuple[str, str], attrs: dict[str, Any]) -> np.ndarray:
-        v = self._f.createVariable(name, np.dtype(dtype), dims)
-        self._attrs(v, attrs)
-        return v.data  # type: ignore[no-any-return]
+    def _header(self, method: str, boundary: list[_NcVar] | None) -> bytes:
+        dims = self._dims + ([(BOUNDARY_DIM, boundary[0].size)] if boundary else [])
+        return _nc3_header(dims, _map_attrs(self.space, method), self._vars + (boundary or []))
+
+    def _put(self, v: _NcVar, start: int, values: np.ndarray) -> None:
+        """Write ``values`` (flattened) at element ``start`` of variable ``v``."""
+        a = np.ascontiguousarray(values, dtype=v.dtype)
+        self._fp.seek(v.begin + start * v.dtype.itemsize)
+        self._fp.write(a.data)
+
+    def write_rows(self, r0: int, r1: int, stable: np.ndarray, status: np.ndarray,
+                   max_real: np.ndarray | None = None, frequency: np.ndarray | None = None) -> None:
+        """Write outer rows ``r0:r1`` of the map (arrays of shape ``(r1 - r0, inner.num)``).
+
+        ``max_real`` and ``frequency`` are required when the file stores them
+        (``eigen``) and ignored otherwise.
+        """
+        start = r0 * self.inner.num
+        cells = {"stable": stable, "status": status}
+        if self.eigen:
+            if max_real is None or frequency is None:
+                raise ValueError("this map file stores max_real and frequency: give both")
+            cells.update(max_real=max_real, frequency=frequency)
+        for name, values in cells.items():
+            if np.shape(values) != (r1 - r0, self.inner.num):
+                raise ValueError(f"{name}: expected shape {(r1 - r0, self.inner.num)}, got {np.shape(values)}")
+            self._put(self._grid[name], start, values)
 
     def write_boundary(self, b: Any) -> None:
         """Add the refined stability boundary (:class:`~brakesqueal.analysis.boundary.Boundary`) before closing."""
         n = int(b.coords[0].size)
         if n == 0:
             return
-        self._f.createDimension(BOUNDARY_DIM, n)
-        for name, values in zip(b.names, b.coords):
-            v = self._f.createVariable(f"boundary_{name}", "d", (BOUNDARY_DIM,))
-            v[:] = values
-            self._attrs(v, {**_boundary_attrs(name, self.space), "_FillValue": np.float64(np.nan)})
+        if self._room < len(self._header("", self._boundary_vars(n))):
+            raise RuntimeError("MapFile: no room for a boundary (created with boundary=False)")
+        self._boundary = self._boundary_vars(n)
+        offset = self._end
+        for v, values in zip(self._boundary, b.coords):
+            v.begin = offset
+            offset += v.vsize
+            self._put(v, 0, np.asarray(values, dtype=float))
 
-    def close(self, method: str) -> None:
-        """Set the global attributes (``method`` names the route), write the file and close it."""
-        self._attrs(self._f, _map_attrs(self.space, method))
-        self._f.close()
+    def close(self, method: str | None = None) -> None:
+        """Write the header (global attribute ``method`` names the route, default the one given at creation)
+        and the padding, and close the file."""
+        try:
+            header = self._header(self.method if method is None else method, self._boundary or None)
+            if len(header) > self._room:
+                raise ValueError(f"MapFile: the header ({len(header)} bytes) does not fit before the data "
+                                 f"({self._room} bytes): the route's name is longer than the one given at creation")
+            for v in self._vars + self._boundary:
+                self._fp.seek(v.begin + v.nbytes)
+                self._fp.write(v.padding())
+            self._fp.seek(0)
+            self._fp.write(header + b"\x00" * (self._room - len(header)))
+        finally:
+            self._fp.close()
 
     def abort(self) -> None:
         """Close without meaningful content (the caller removes the file)."""
-        self._f.fp.close()
+        self._fp.close()
 
 
 @dataclass

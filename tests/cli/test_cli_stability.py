@@ -67,7 +67,7 @@ def test_map_writes_netcdf_and_plot(tmp_path, capsys):
     (["map", "--x", "N0=1:2:3", "--y", "mu=0.1:1:10"], "tied"),
     (["crossings", "--along", "k_ip=5:1"], "reversed"),
     (["critical-speed", "--range", "0:10"], "positive"),
-    (["map", "--x", "k_ip=1e5:1e10:100000:log", "--y", "mu=0.1:1:100000", "--force"], "GiB of memory"),
+    (["map", "--x", "k_ip=1e5:1e10:100000:log", "--y", "mu=0.1:1:100000", "--force"], "at most 4 GiB"),
     (["map", "--x", "k_ip=1e5:1e10:10:log", "--y", "mu=0.1:1:10", "--plot", "m.xyz"], "--plot"),
     (["crossings", "--along", "k_ip=1e5:1e10:log", "--plot", "no/such/dir/c.png"], "does not exist"),
     (["map", "--model", "belt", "--preset", "paper-fig2", "--x", "slope=0:1:3", "--y", "m=1:2:3"], "paper-fig2"),

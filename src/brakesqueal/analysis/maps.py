@@ -21,10 +21,15 @@ Points where the silent motion does not exist, a pad loses contact or does not
 slide, the parameters are invalid or the verdict cannot be decided are flagged
 in ``status`` (:class:`~brakesqueal.status.PointStatus`) and never marked
 stable.  No verdict depends on where an axis starts or on its sign.  Memory is
-bounded: the results of a map are held in memory, so maps whose results
-would need more than :data:`MAX_MAP_BYTES` to compute and write are refused
-(use a sweep, which writes chunks to a store); the temporary memory per chunk is
-bounded by ``chunk_points``.
+bounded: the points are computed in blocks of rows (``chunk_points`` bounds the
+temporary memory per block); :func:`write_map` (the ``map`` command) writes
+each block to its place in the NetCDF file at once and holds nothing else of
+the map but, for maps of at most :data:`BOUNDARY_MAX_POINTS` points, the
+verdicts and status codes the stability boundary is located from (2 bytes per
+point), so its memory does not grow with the map beyond that (measured:
+0.2 GB peak RSS for 1e8 points); :func:`stability_map` returns the whole map
+in memory, so maps whose results would need more than :data:`MAX_MAP_BYTES`
+are refused there.
 """
 
 from __future__ import annotations
@@ -52,7 +57,8 @@ __all__ = ["Axis", "parse_axis", "stability_map", "write_map", "MapSummary", "cl
 STATUS = {int(s): s.meaning for s in PointStatus}
 #: Maps larger than this need ``force=True`` (``--force``).
 MAX_POINTS = 10**9
-#: Largest memory [bytes] computing and writing one map may take (:func:`map_bytes`); use a sweep beyond.
+#: Largest memory [bytes] :func:`stability_map` may take for one map (:func:`map_bytes`); use :func:`write_map`
+#: (bounded memory) beyond.
 MAX_MAP_BYTES = 4 * 2**30
 #: Largest map [points] whose stability boundary is located and stored.
 BOUNDARY_MAX_POINTS = 16 * 10**6
@@ -150,7 +156,7 @@ def parse_axis(text: str, *, with_num: bool = True) -> Axis:
 
 
 def map_bytes(points: int, eigen: bool) -> int:
-    """Estimated peak memory [bytes] of computing a map and writing it to NetCDF.
+    """Estimated peak memory [bytes] of computing a map in memory and writing it to NetCDF.
 
     Parameters
     ----------
@@ -167,15 +173,17 @@ def map_bytes(points: int, eigen: bool) -> int:
         writer holds a converted copy of every variable until the file is
         closed) plus 256 MiB for the chunk buffers and the interpreter: a bound
         for :func:`stability_map` followed by ``to_netcdf``.  :func:`write_map`
-        (the ``map`` command) holds the result arrays once plus one variable's
-        copy while writing: measured 1.5 GiB peak RSS for a 1e8-point map with
-        ``max_real`` and ``frequency`` (float32).
+        (the ``map`` command) does not hold the result arrays: its memory is
+        bounded whatever the map's size (measured 0.2 GB peak RSS for a
+        1e8-point map with ``max_real`` and ``frequency``; at most 2 bytes per
+        point more for maps of at most :data:`BOUNDARY_MAX_POINTS` points, plus
+        the boundary's location).
     """
     per = 2 + (2 * (4 if points > _FLOAT32_ABOVE else 8) if eigen else 0)
     return 2 * per * points + 2**28
 
 
-def _check_axes(space: object, axes: list[Axis], force: bool, eigen: bool) -> None:
+def _check_axes(space: object, axes: list[Axis], force: bool, eigen: bool, in_memory: bool = True) -> None:
     for ax in axes:
         space.check_axis(ax.name)  # type: ignore[attr-defined]
     if len(axes) == 2 and axes[0].name == axes[1].name:
@@ -183,6 +191,17 @@ def _check_axes(space: object, axes: list[Axis], force: bool, eigen: bool) -> No
     n = math.prod(ax.num for ax in axes)
     if n > MAX_POINTS and not force:
         raise ParameterError(f"the map has {n:.3g} points (> {MAX_POINTS:.0e}); pass --force to compute it anyway")
+    if not in_memory:
+        from ..results import NC3_MAX_VAR_BYTES
+
+        size = (4 if n > _FLOAT32_ABOVE else 8) if eigen else 1
+        if n * size > NC3_MAX_VAR_BYTES:
+            hint = "; --no-eigen stores 1 byte per point" if eigen else ""
+            raise ParameterError(f"the map has {n:.3g} points: a variable of its NetCDF3 file would take "
+                                 f"{n * size / 2**30:.3g} GiB, the format holds at most 4 GiB per variable "
+                                 f"({NC3_MAX_VAR_BYTES // size:.4g} points{hint}); use fewer points or a sweep "
+                                 "(brakesqueal sweep)")
+        return
     need = map_bytes(n, eigen)
     if need > MAX_MAP_BYTES:
         hint = "; --no-eigen needs a fifth of it" if eigen else ""
@@ -236,8 +255,8 @@ class _Plan:
     charpoly: CharpolyTable | None = None
 
 
-def _plan(space: object, x: Axis, y: Axis, force: bool, eigen: bool) -> _Plan:
-    _check_axes(space, [x, y], force, eigen)
+def _plan(space: object, x: Axis, y: Axis, force: bool, eigen: bool, in_memory: bool = True) -> _Plan:
+    _check_axes(space, [x, y], force, eigen, in_memory)
     space.resolve({})  # type: ignore[attr-defined]
     closed = closed_form_route(space, (x.name, y.name))
     kern = map_kernel(space, x.name, y.name) if closed else None  # type: ignore[arg-type]
@@ -464,12 +483,18 @@ class MapSummary:
 def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False, eigen: bool = True,
               chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None,
               boundary: bool = True) -> MapSummary:
-    """Compute a stability map and write it to a NetCDF3 file without holding it as an xarray Dataset.
+    """Compute a stability map and write it to a NetCDF3 file block by block (memory bounded for any size).
 
-    Same results and file as ``stability_map(...).to_netcdf(path)`` (read
-    back with :func:`brakesqueal.results.open_map`), with less time and memory:
-    the result arrays are the file's variables (:class:`brakesqueal.results.MapFile`),
-    filled chunk by chunk, and neither xarray nor a copy of the map is needed.
+    Same results and file content as ``stability_map(...).to_netcdf(path)``
+    (read back with :func:`brakesqueal.results.open_map` or
+    :func:`xarray.open_dataset`), with less time and memory: each block of
+    ``chunk_points`` points (whole outer rows) is written to its place in the
+    file (:class:`brakesqueal.results.MapFile`) as soon as it is computed;
+    neither xarray nor the map's arrays are held (only ``stable`` and
+    ``status`` of maps with at most :data:`BOUNDARY_MAX_POINTS` points, for the
+    stability boundary).  There is no memory limit (:data:`MAX_MAP_BYTES`
+    applies to :func:`stability_map`); a variable of the file holds at most
+    4 GiB (:data:`~brakesqueal.results.NC3_MAX_VAR_BYTES`).
 
     Parameters
     ----------
@@ -489,31 +514,37 @@ def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False
     Raises
     ------
     ParameterError
-        As :func:`stability_map`.
+        As :func:`stability_map` (but no memory limit), or a variable of more
+        than 4 GiB.
     """
     from ..results import MapFile
 
-    plan = _plan(space, x, y, force, eigen)
-    n_o = plan.outer.num
-    f = MapFile(path, space, plan.outer, plan.inner, eigen=eigen, float_dtype=plan.ftype)
+    plan = _plan(space, x, y, force, eigen, in_memory=False)
+    n_o, n_i = plan.outer.num, plan.inner.num
+    # the boundary needs the verdicts and status codes of the whole grid (2 bytes per point, at most
+    # BOUNDARY_MAX_POINTS points); nothing else of the map is held: each block of rows goes to the file at once
+    keep = boundary and n_o * n_i <= BOUNDARY_MAX_POINTS
+    stable = np.zeros((n_o, n_i), dtype=bool) if keep else None
+    status = np.zeros((n_o, n_i), dtype=np.int8) if keep else None
+    f = MapFile(path, space, plan.outer, plan.inner, eigen=eigen, float_dtype=plan.ftype, method=plan.method,
+                boundary=keep)
     n_stable = 0
     try:
         for r0, r1, st, ss, mr, fr in _rows(space, plan, eigen, chunk_points):
-            f.stable[r0:r1] = st
-            f.status[r0:r1] = ss
+            f.write_rows(r0, r1, st, ss, mr, fr)
             n_stable += int(np.count_nonzero(st))
-            if f.max_real is not None and f.frequency is not None:
-                f.max_real[r0:r1] = mr
-                f.frequency[r0:r1] = fr
+            if stable is not None and status is not None:
+                stable[r0:r1] = st
+                status[r0:r1] = ss
             if progress is not None:
                 progress(r1 / n_o)
-        if boundary:
-            b = _boundary(space, plan, np.asarray(f.stable, dtype=bool), np.asarray(f.status))
+        if stable is not None and status is not None:
+            b = _boundary(space, plan, stable, status)
             if b is not None:
                 f.write_boundary(b)
     except BaseException:
         f.abort()
         raise
-    f.close(plan.method)
-    n = n_o * plan.inner.num
+    f.close()
+    n = n_o * n_i
     return MapSummary(n, n_stable / n, plan.method, plan.outer, plan.inner)
