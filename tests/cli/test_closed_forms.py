@@ -67,6 +67,11 @@ def test_fingerprint_follows_every_source(tmp_path, monkeypatch):
         seen.add(closed_forms.fingerprint(data.SOURCES))
         p.write_bytes(original)
     assert len(seen) == 1 + 2 * len(data.SOURCES)
+    crlf = tmp_path / data.SOURCES[0]
+    original = crlf.read_bytes()
+    crlf.write_bytes(original.replace(b"\n", b"\r\n"))  # a CRLF checkout of the same source
+    assert closed_forms.fingerprint(data.SOURCES) == data.FINGERPRINT
+    crlf.write_bytes(original)
     assert closed_forms.shipped_text("general", "text") is not None
     monkeypatch.setattr(closed_forms, "_EXTERNAL", (("sympy", "__init__.py"), ("symengine", "_version.py")))
     assert closed_forms.shipped_text("general", "text") is None

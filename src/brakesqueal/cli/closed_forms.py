@@ -48,12 +48,13 @@ def fingerprint(sources: tuple[str, ...]) -> str:
     Returns
     -------
     str
-        64 hex digits; a missing file hashes as ``missing`` (so it differs from any content).
+        64 hex digits; a missing file hashes as ``missing`` (so it differs from any content), line
+        endings are normalised to ``\\n``.
     """
     h = hashlib.sha256()
     for rel in sources:
         try:
-            data = (_PKG / rel).read_bytes()
+            data = (_PKG / rel).read_bytes().replace(b"\r\n", b"\n")  # a CRLF checkout is the same source
         except OSError:
             data = b"missing"
         h.update(f"{rel}\0{len(data)}\0".encode())
