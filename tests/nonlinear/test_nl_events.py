@@ -34,7 +34,7 @@ def test_contact_loss_does_not_depend_on_range_or_steps(branches):
     losses = np.array([b.contact_loss for b in runs], dtype=float)
     assert np.all(np.isfinite(losses))
     assert np.ptp(losses) < 1e-6, losses  # rad/s (measured spread 3e-9)
-    onset = runs[0].hopf.hopf.p0
+    onset = runs[0].hopf.branch_start.p0  # the branch continues the simulated (quasi-static pad) equations
     for k, b in enumerate(runs):
         assert b.summary.onset == onset
         # stable squeal from the onset up to the located contact loss, whatever the range (was (35.74, 35.74))
@@ -68,3 +68,6 @@ def test_contact_loss_against_shooting_and_hopf_prediction(branches):
     # the leading-order prediction from the Hopf point is within 2 % of the distance to the onset (measured 0.9 %)
     pred = ds.attrs["contact_loss_predicted"]
     assert abs(pred - loss) < 0.02 * (loss - onset)
+    # the same leading order from the implicit equations' normal form (nonlinear.implicit; an independent
+    # implementation: generated contact functions along X(i omega0, phi), pads' rates kept, k_ip = 1e8)
+    assert abs(b.hopf.contact_loss - loss) < 0.05 * (loss - onset)

@@ -427,6 +427,8 @@ EXEMPT = {
                               "it at run time); the generated source comes from simulation/_kernels.py (listed)",
     "nonlinear/models.py": "brake models as systems of the nonlinear machinery: runs the simulation's generated "
                            "kernels and the crossings, generates no code",
+    "nonlinear/implicit.py": "Hopf normal form of the implicit model equations: evaluates the compiled residual "
+                             "Jacobians and the linearization, generates no code",
 }  # fmt: skip
 
 

@@ -165,9 +165,15 @@ def _hopf_text(points: list) -> str:  # type: ignore[type-arg]
         if h.side:
             lines.append(f"      cycles for {hp.parameter} {'>' if h.side > 0 else '<'} {h.p0:.12g}; first-harmonic "
                          f"amplitudes A_j ~ a_j sqrt(|{hp.parameter} - p0|), a_j = {amp}")
+        for what, at, tilt in (("a pad lifts off", hp.contact_loss, hp.tilt_at_contact_loss),
+                               ("a pad's sliding reverses (end of validity)", hp.sliding_reversal,
+                                hp.tilt_at_sliding_reversal)):
+            if at is not None:
+                lines.append(f"      predicted (leading order): {what} at {hp.parameter} = {at:.8g}"
+                             + (f", tilt amplitude {tilt:.3g} rad" if tilt is not None else ""))
         lines += [f"      warning: {w}" for w in h.warnings]
-    notes = {hp.message for hp in points if hp.hopf is not None and hp.message}
-    lines += [f"  note: {n}" for n in notes]
+        if hp.message:
+            lines.append(f"      note: {hp.message}")
     return "\n".join(lines) + "\n"
 
 
@@ -234,9 +240,11 @@ def cycles(
     if fmt == OutFormat.json:
         sys.stdout.write(json.dumps(d, indent=2, default=float) + "\n")
         return
-    h = b.hopf.hopf
+    h = b.hopf.branch_start
+    assert h is not None
     lines = [f"Hopf point {axis.name} = {h.p0:.12g}: {h.criticality} (l1 = {h.l1:.6g} ± {h.l1_error:.2g}), "
-             f"{h.frequency0_hz:.6g} Hz",
+             f"{h.frequency0_hz:.6g} Hz" + (" in the simulated equations (quasi-static pads)"
+                                            if b.hopf.simulated is not None else ""),
              f"{d['points']} branch points ({d['status']}: {d['message']})"]
     if b.contact_loss is not None and b.contact == "bilateral":
         amp = ", ".join(f"{k}: {v:.4g}" for k, v in list(d["amplitude_at_last_contact_point"].items())[:2])

@@ -43,7 +43,7 @@ import scipy.linalg as sla
 from ..errors import BrakesquealError, ParameterError
 from .system import EPS, H_FIRST, H_SECOND, SmoothSystem
 
-__all__ = ["HopfResult", "CycleGuess", "first_lyapunov"]
+__all__ = ["HopfResult", "CycleGuess", "first_lyapunov", "hopf_result"]
 
 
 @dataclass(frozen=True)
@@ -511,28 +511,46 @@ def first_lyapunov(system: SmoothSystem, x0: Any, p0: float, *, refine: bool = T
     err_round = 10 * EPS * (kap + _eig_condition(A, w0, q, pv)) * terms
     err_off = abs(lam_k.real) / max(abs(lam_k), 1e-300) * terms
     c1_err = fd_err + err_round + err_off
+    return hopf_result(x, p, lam, lam_k, q, pv, c1, c1_err, dl, xp, h20, h11,
+                       multilinear="exact" if exact else "finite-difference", refined=refined,
+                       state_names=tuple(system.state_names or ()), parameter_name=system.parameter_name,
+                       warnings=warnings)
+
+
+def hopf_result(x0: np.ndarray, p0: float, eigenvalues: np.ndarray, eigenvalue: complex, q: np.ndarray,
+                pv: np.ndarray, c1: complex, c1_error: float, dlambda_dp: complex, dx0_dp: np.ndarray,
+                h20: np.ndarray, h11: np.ndarray, *, multilinear: str, refined: bool, state_names: tuple[str, ...],
+                parameter_name: str, warnings: list[str]) -> HopfResult:  # fmt: skip
+    """The :class:`HopfResult` of a normal form: criticality, side, amplitude coefficients, frequency slope.
+
+    Shared by :func:`first_lyapunov` and :func:`brakesqueal.nonlinear.implicit.exact_lyapunov`: ``l1 =
+    Re c1 / omega0`` is ``"supercritical"`` below ``-10 l1_error``, ``"subcritical"`` above ``10 l1_error``,
+    else ``"degenerate"``; the cycles exist for ``sign(p - p0) = -sign(Re c1 mu')`` with first-harmonic
+    amplitudes ``a_j sqrt(|p - p0|)``, ``a_j = 2 |q_j| sqrt(|mu' / Re c1|)`` (module docstring).
+    """
+    w0 = eigenvalue.imag
     l1 = c1.real / w0
-    l1_err = c1_err / w0
+    l1_err = c1_error / w0
     if l1 < -10 * l1_err:
         crit = "supercritical"
     elif l1 > 10 * l1_err:
         crit = "subcritical"
     else:
         crit = "degenerate"
-    mu1 = dl.real
-    transversal = abs(mu1) > 1e-10 * max(abs(dl), 1e-300) and abs(mu1) > 0
+    warnings = list(warnings)
+    mu1 = dlambda_dp.real
+    transversal = abs(mu1) > 1e-10 * max(abs(dlambda_dp), 1e-300) and abs(mu1) > 0
     if not transversal:
         warnings.append("dRe(lambda)/dp ~ 0: the Hopf point is not transversal; no amplitude prediction")
     if crit != "degenerate" and transversal:
         side = int(-np.sign(c1.real) * np.sign(mu1))
         acoef = 2 * np.abs(q) * math.sqrt(abs(mu1 / c1.real))
-        fslope = dl.imag - mu1 * c1.imag / c1.real
+        fslope = dlambda_dp.imag - mu1 * c1.imag / c1.real
     else:
-        side, acoef, fslope = 0, np.zeros(x.size), dl.imag
+        side, acoef, fslope = 0, np.zeros(x0.size), dlambda_dp.imag
     return HopfResult(
-        x0=x, p0=p, eigenvalue=lam_k, omega0=w0, q=q, p=pv, c1=c1, l1=l1, l1_error=l1_err, criticality=crit,
-        dlambda_dp=dl, dRe_lambda_dp=mu1, dx0_dp=xp, h20=h20, h11=h11, side=side, amplitude_coefficients=acoef,
-        frequency_slope=float(fslope), multilinear="exact" if exact else "finite-difference", refined=refined,
-        state_names=tuple(system.state_names or ()), parameter_name=system.parameter_name, eigenvalues=lam,
-        warnings=tuple(warnings),
+        x0=x0, p0=p0, eigenvalue=eigenvalue, omega0=w0, q=q, p=pv, c1=c1, l1=l1, l1_error=l1_err,
+        criticality=crit, dlambda_dp=dlambda_dp, dRe_lambda_dp=mu1, dx0_dp=dx0_dp, h20=h20, h11=h11, side=side,
+        amplitude_coefficients=acoef, frequency_slope=float(fslope), multilinear=multilinear, refined=refined,
+        state_names=state_names, parameter_name=parameter_name, eigenvalues=eigenvalues, warnings=tuple(warnings),
     )  # fmt: skip

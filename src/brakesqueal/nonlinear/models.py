@@ -218,11 +218,23 @@ class HopfPoint:
     direction : str
         ``"destabilizing"`` or ``"stabilizing"`` with increasing parameter.
     hopf : HopfResult or None
-        The normal form (``None`` when it could not be computed; see ``message``).
+        The normal form of the model's equations with the pads' true tangential dynamics
+        (:func:`~.implicit.exact_lyapunov`; ``None`` when it could not be computed, see ``message``).
     pad_treatment : dict
-        Every pad deformation's treatment (``"quasi-static"`` or ``"dynamic"``).
+        Every pad deformation's treatment in the *simulated* equations (``"quasi-static"`` or
+        ``"dynamic"``): those of :attr:`simulated`, of the simulation and of limit-cycle branches.
     message : str
         Why ``hopf`` is missing, or a note on the pad treatment.
+    simulated : HopfResult or None
+        The normal form of the simulated equations (:func:`model_system`) when they differ from the
+        exact ones (massless Coulomb pads with a finite ``k_ip`` are quasi-static there): the start of
+        limit-cycle branches.  ``None`` when the simulated equations are exact.
+    contact_loss, sliding_reversal : float or None
+        Leading-order predictions from ``hopf`` of where a pad first lifts off and where a pad's
+        sliding velocity (its rate included) first reverses on the cycle (the end of the model's
+        validity); ``None`` when not predicted.
+    tilt_at_contact_loss, tilt_at_sliding_reversal : float or None
+        The predicted largest tilt amplitude [rad] there.
     """
 
     parameter: str
@@ -231,6 +243,16 @@ class HopfPoint:
     hopf: HopfResult | None
     pad_treatment: dict[str, str]
     message: str = ""
+    simulated: HopfResult | None = None
+    contact_loss: float | None = None
+    sliding_reversal: float | None = None
+    tilt_at_contact_loss: float | None = None
+    tilt_at_sliding_reversal: float | None = None
+
+    @property
+    def branch_start(self) -> HopfResult | None:
+        """The normal form in the simulated equations' state (where limit-cycle branches start)."""
+        return self.simulated if self.simulated is not None else self.hopf
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready summary: l1 and its error, criticality, frequency, side and amplitude coefficients."""
@@ -240,19 +262,41 @@ class HopfPoint:
         if h is None:
             d["hopf"] = None
             return d
-        names = tuple(h.state_names or ())
-        d["hopf"] = {
-            "p0": h.p0, "omega0": h.omega0, "frequency_hz": h.frequency0_hz, "l1": h.l1,
-            "l1_error": h.l1_error, "criticality": h.criticality, "c1": [h.c1.real, h.c1.imag],
-            "dRe_lambda_dp": h.dRe_lambda_dp, "side": h.side,
-            "cycles_exist_for": ("p > p0" if h.side > 0 else "p < p0") if h.side else None,
-            "amplitude_coefficients": dict(zip(names, map(float, h.amplitude_coefficients))),
-            "frequency_slope": h.frequency_slope, "multilinear": h.multilinear,
-            "conventions": "state (Q, dQ/dt, L_dynamic) in SI units; <q,q> = 1, <p,q> = 1; l1 = Re(c1)/omega0 "
-                           "(Kuznetsov; MatCont); A_j ~ a_j sqrt(|p - p0|)",
-            "warnings": list(h.warnings),
-        }
+        d["hopf"] = _hopf_dict(h)
+        d["hopf"]["pad_dynamics"] = "exact (tangential rates kept; centre manifold of the implicit equations)"
+        d["predicted"] = {"contact_loss": self.contact_loss, "sliding_reversal": self.sliding_reversal,
+                          "tilt_at_contact_loss": self.tilt_at_contact_loss,
+                          "tilt_at_sliding_reversal": self.tilt_at_sliding_reversal}
+        d["hopf_simulated"] = None if self.simulated is None else _hopf_dict(self.simulated)
         return d
+
+
+def _soft_quasi_static(sim: Any, params: Any) -> bool:
+    """Whether a pad the simulation treats quasi-statically has a finite tangential stiffness (not exact)."""
+    kinds = dict(zip(sim.unknown_pads, sim.pad_kinds))
+    for pad in params.model.pads:
+        if kinds.get(pad.name) != "quasi-static":
+            continue
+        k = pad.k_ip
+        value = float(params[k]) if isinstance(k, str) else float(k)
+        if not math.isinf(value):
+            return True
+    return False
+
+
+def _hopf_dict(h: HopfResult) -> dict[str, Any]:
+    names = tuple(h.state_names or ())
+    return {
+        "p0": h.p0, "omega0": h.omega0, "frequency_hz": h.frequency0_hz, "l1": h.l1,
+        "l1_error": h.l1_error, "criticality": h.criticality, "c1": [h.c1.real, h.c1.imag],
+        "dRe_lambda_dp": h.dRe_lambda_dp, "side": h.side,
+        "cycles_exist_for": ("p > p0" if h.side > 0 else "p < p0") if h.side else None,
+        "amplitude_coefficients": dict(zip(names, map(float, h.amplitude_coefficients))),
+        "frequency_slope": h.frequency_slope, "multilinear": h.multilinear,
+        "conventions": "state (" + ", ".join(names) + ") in SI units; <q,q> = 1, <p,q> = 1; l1 = Re(c1)/omega0 "
+                       "(Kuznetsov; MatCont); A_j ~ a_j sqrt(|p - p0|)",
+        "warnings": list(h.warnings),
+    }
 
 
 def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = None) -> list[HopfPoint]:
@@ -273,36 +317,44 @@ def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = 
     Returns
     -------
     list of HopfPoint
-        In increasing parameter order; a crossing where the normal form cannot
-        be computed (a real eigenvalue crossing, a failed refinement) has
-        ``hopf = None`` and a message.
+        In increasing parameter order; ``hopf`` with the pads' true tangential dynamics
+        (:func:`~.implicit.exact_lyapunov`), ``simulated`` for the simulated equations when they
+        differ.  A crossing where the normal form cannot be computed (a real eigenvalue crossing,
+        a failed refinement) has ``hopf = None`` and a message.
     """
     from ..analysis.crossings import crossings
+    from .implicit import exact_lyapunov
 
     r = crossings(space, axis) if result is None else result
     system = model_system(space, axis.name, use_cache=use_cache)
     sim = system.simulation_model  # type: ignore[attr-defined]
     treatment = dict(zip(sim.pad_unknowns, sim.pad_kinds))
-    note = ""
-    params0 = space.resolve({})
-    finite = [pad.k_ip for pad in params0.model.pads if pad.name in sim.unknown_pads]
-    finite = [k for k in finite if not (isinstance(k, (int, float)) and math.isinf(k))
-              and not (isinstance(k, str) and math.isinf(float(params0[k])))]
-    if any(k == "quasi-static" for k in treatment.values()) and finite:
-        note = ("massless Coulomb pads are quasi-static (ldot := 0): exact for the linearization, not beyond first "
-                "order (l1 with a finite k_ip is approximate; give the pads a tangential DOF for their true dynamics)")
     out = []
     for value, direction in r.crossings:  # type: ignore[attr-defined]
         try:
-            params = space.resolve({axis.name: float(value)})
-            y0 = sim.silent(params).y
-            h = first_lyapunov(system, y0, float(value), refine=True)
-            out.append(HopfPoint(axis.name, float(h.p0), direction, h, treatment, note))
+            ex = exact_lyapunov(space, axis.name, float(value), use_cache=use_cache)
         except (BrakesquealError, np.linalg.LinAlgError) as exc:
             out.append(HopfPoint(axis.name, float(value), direction, None, treatment,
                                  f"no Hopf normal form: {exc}"))
+            continue
+        h = ex.hopf
+        simulated, note = None, ""
+        if _soft_quasi_static(sim, space.resolve({axis.name: h.p0})) or \
+                tuple(h.state_names) != tuple(system.state_names or ()):
+            try:
+                y0 = sim.silent(space.resolve({axis.name: h.p0})).y
+                simulated = first_lyapunov(system, y0, h.p0, refine=True, omega=h.omega0)
+                note = (f"the simulation and limit-cycle branches use quasi-static pads (ldot := 0; exact only to "
+                        f"first order): l1 = {simulated.l1:.6g} ({simulated.criticality}) there")
+            except (BrakesquealError, np.linalg.LinAlgError) as exc:
+                note = f"no normal form of the simulated equations (quasi-static pads): {exc}"
+            if simulated is not None and simulated.criticality != h.criticality:
+                note += (f"; the criticality differs from the exact {h.criticality}: the simulated branch "
+                         "does not describe the brake near onset")
+        out.append(HopfPoint(axis.name, float(h.p0), direction, h, treatment, note, simulated,
+                             ex.contact_loss, ex.sliding_reversal, ex.tilt_at_contact_loss,
+                             ex.tilt_at_sliding_reversal))
     return out
-
 
 
 def _periodic_min(values: np.ndarray) -> np.ndarray:
@@ -659,12 +711,14 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
 
     if contact not in ("bilateral", "unilateral"):
         raise ParameterError(f"The option 'contact' must be bilateral or unilateral; got {contact!r}")
-    pts = [hp for hp in hopf_points(space, axis, use_cache=use_cache) if hp.hopf is not None and hp.hopf.side]
+    pts = [hp for hp in hopf_points(space, axis, use_cache=use_cache)
+           if hp.branch_start is not None and hp.branch_start.side]
     if not pts:
         raise ParameterError(f"no Hopf point with a limit-cycle prediction for {axis.name} in "
                              f"({axis.start:g}, {axis.stop:g}); see brakesqueal hopf")
     hp = pts[0]
-    h = hp.hopf
+    h = hp.branch_start
+    assert h is not None
     predicted = predicted_contact_loss(space, axis.name, h)
     p_scale = 20 * abs(predicted - h.p0) if predicted is not None else None
     opts: dict[str, Any] = {"max_points": max_points, "tol": tol, "p_scale": p_scale, "ds_max": ds_max,
@@ -777,7 +831,7 @@ def squeal_summary(branch: SquealBranch) -> SquealSummary:
     stable = ds["stable"].values.astype(bool)
     valid = np.ones(p.size, dtype=bool) if branch.contact == "unilateral" else ds["in_contact"].values.astype(bool)
     ok = stable & valid
-    h = branch.hopf.hopf
+    h = branch.hopf.branch_start  # the normal form of the continued (simulated) equations
     onset = float(h.p0) if h is not None else float(branch.hopf.value)
     rng = (float(p[ok].min()), float(p[ok].max())) if ok.any() else None
     loss = branch.contact_loss

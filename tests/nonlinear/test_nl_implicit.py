@@ -1,0 +1,142 @@
+"""Hopf points with the pads' true tangential dynamics (nonlinear.implicit.exact_lyapunov).
+
+Independent checks:
+* on a model whose pads have a regular first-order dynamics (a rising friction law
+  ``mu(v) = mu1 + |s| v``: the pad's rate is a state of an explicit ODE), the normal form of the implicit
+  equations equals Kuznetsov's formula on that ODE (``first_lyapunov`` of ``model_system``, a different
+  route: the explicit vector field, its generated Jacobian, the pads eliminated by implicit differentiation);
+* as the friction slope tends to 0 that ODE's l1 tends to the Coulomb model's l1 of this module (the pad
+  becomes infinitely fast but keeps its rate), and not to the quasi-static pad's l1;
+* with rigid pads (no pad unknown) both routes describe the same equations and agree;
+* the leading-order contact loss prediction against the located one of the limit-cycle branch.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from brakesqueal.analysis.maps import Axis
+from brakesqueal.cli import main
+from brakesqueal.model import MODELS, ParameterSpace
+from brakesqueal.model.io import model_to_toml
+from brakesqueal.model.options import resolve_space
+from brakesqueal.nonlinear import first_lyapunov
+from brakesqueal.nonlinear.implicit import exact_lyapunov
+from brakesqueal.nonlinear.models import hopf_points, model_system
+
+K_IP = 1e5
+ONSET = 3.3533  # the Coulomb model's Hopf point near 3.35 rad/s at k_ip = 1e5 (refined by the code)
+
+
+@pytest.fixture(scope="module")
+def rising_friction_model(tmp_path_factory):
+    """The paper's model with the linear law ``mu1 - s v`` at both pads (``s < 0``: rising friction)."""
+    text = model_to_toml(resolve_space(None, None, None, []).resolve({}).model)
+    text = text[:text.index("[presets")] if "[presets" in text else text
+    text = text.replace('name = "paper"', 'name = "paper-rising"', 1)
+    for pad in ("mu1", "mu2"):
+        text = text.replace(f'law = "coulomb", mu = "{pad}"', f'law = "linear", mu = "{pad}", slope = "s"')
+    text = text.replace("\nOmega = ", "\ns = -0.001\nOmega = ", 1)
+    path = tmp_path_factory.mktemp("models") / "rising.toml"
+    path.write_text(text)
+    return str(path)
+
+
+def _ode_l1(space, p0, omega):
+    system = model_system(space, "Omega")
+    y0 = system.simulation_model.silent(space.resolve({"Omega": p0})).y
+    return first_lyapunov(system, y0, p0, refine=True, omega=omega)
+
+
+def test_implicit_normal_form_equals_the_ode_route_for_regular_pads(rising_friction_model):
+    space = resolve_space(rising_friction_model, None, None, [f"k_ip1={K_IP}", f"k_ip2={K_IP}", "s=-1e-3"])
+    ex = exact_lyapunov(space, "Omega", 4.19).hopf
+    ode = _ode_l1(space, ex.p0, ex.omega0)
+    assert ex.p0 == pytest.approx(ode.p0, rel=1e-8)  # Re lambda = 0 to ~1e-13 |lambda| in both routes
+    assert ex.omega0 == pytest.approx(ode.omega0, rel=1e-9)
+    assert ex.state_names == ode.state_names  # (q, dq, l1, l2): the pads' deformations are states in both
+    tol = 10 * (ex.l1_error + ode.l1_error) + 1e-5 * abs(ode.l1)
+    assert abs(ex.l1 - ode.l1) <= tol, (ex.l1, ode.l1)
+    assert ex.dlambda_dp == pytest.approx(ode.dlambda_dp, rel=1e-6)
+    np.testing.assert_allclose(ex.amplitude_coefficients, ode.amplitude_coefficients, rtol=1e-4)
+
+
+def test_coulomb_pads_are_the_limit_of_vanishing_friction_slope(rising_friction_model):
+    coulomb = resolve_space(None, None, None, [f"k_ip={K_IP}"])
+    pts = hopf_points(coulomb, Axis("Omega", 1.0, 10.0))
+    assert len(pts) == 1
+    hp = pts[0]
+    exact, quasi = hp.hopf, hp.simulated
+    assert exact is not None and quasi is not None and hp.value == pytest.approx(ONSET, rel=1e-4)
+    errs = []
+    for s in (1e-4, 1e-5):
+        space = resolve_space(rising_friction_model, None, None, [f"k_ip1={K_IP}", f"k_ip2={K_IP}", f"s={-s}"])
+        ode = _ode_l1(space, exact.p0, exact.omega0)
+        errs.append(abs(ode.l1 - exact.l1) / abs(exact.l1))
+    assert errs[1] < 0.3 * errs[0] and errs[1] < 2e-2, errs  # O(s) convergence to the Coulomb pads' l1
+    # the quasi-static pad misses it: here even the sign (issue #14's first design fact)
+    assert abs(quasi.l1 - exact.l1) > 10 * abs(exact.l1) * errs[1]
+    assert exact.criticality == "supercritical"
+
+
+def test_rigid_pads_both_routes_agree():
+    space = ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5, "k_ip": math.inf})
+    hp = hopf_points(space, Axis("Omega", 1.0, 1e3, log=True))[0]
+    assert hp.simulated is None and hp.hopf is not None  # the simulated equations are exact here
+    ode = _ode_l1(space, hp.hopf.p0, hp.hopf.omega0)
+    assert abs(hp.hopf.l1 - ode.l1) <= 10 * (hp.hopf.l1_error + ode.l1_error) + 1e-6 * abs(ode.l1)
+    assert hp.hopf.p0 == pytest.approx(35.601027692919985, rel=1e-10)  # the exact crossing (README, Fig. 3)
+    np.testing.assert_allclose(hp.hopf.amplitude_coefficients, ode.amplitude_coefficients, rtol=1e-4)
+
+
+def test_soft_pads_change_l1_and_the_outputs_say_so(capsys):
+    """k_ip = 1e6: the pads' rate changes l1 by more than an order of magnitude, same sign (issue #14)."""
+    assert main(["hopf", "--set", "k_ip=1e6", "--along", "Omega=10:200", "--format", "json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    (c,) = d["crossings"]
+    h, hs = c["hopf"], c["hopf_simulated"]
+    assert hs is not None and "quasi-static" in c["message"]
+    assert h["l1"] < 0 and hs["l1"] < 0 and abs(h["l1"]) > 10 * abs(hs["l1"])
+    assert h["p0"] == pytest.approx(hs["p0"], rel=1e-9)  # same linearization, same onset
+    pred = c["predicted"]
+    # leading-order predictions on the side where the cycles exist
+    assert pred["sliding_reversal"] > h["p0"] and pred["contact_loss"] > h["p0"]
+    assert 1e-4 < pred["tilt_at_sliding_reversal"] < 1e-2  # "tilt amplitudes of about 1e-3 rad"
+    assert main(["hopf", "--set", "k_ip=1e6", "--along", "Omega=10:200"]) == 0
+    out = capsys.readouterr().out
+    assert "sliding reverses" in out and "quasi-static" in out
+
+
+def test_bad_parameter_is_named():
+    space = resolve_space(None, None, None, [])
+    with pytest.raises(Exception, match="Omgea"):
+        exact_lyapunov(space, "Omgea", 37.0)
+    with pytest.raises(Exception, match="finite"):
+        exact_lyapunov(space, "Omega", math.nan)
+
+
+@pytest.mark.parametrize("name", list(MODELS))
+def test_every_built_in_model_against_the_ode_route(name):
+    """Where the simulated equations are exact (no quasi-static pad with a finite k_ip), both routes agree."""
+    space = ParameterSpace.from_preset(name)
+    axis = Axis("slope", 0.0, 0.02) if name == "belt" else Axis("Omega", 1.0, 1e3, log=True)
+    pts = [hp for hp in hopf_points(space, axis) if hp.hopf is not None]
+    assert pts, name
+    for hp in pts:
+        ex = hp.hopf
+        ode = hp.simulated if hp.simulated is not None else _ode_l1_along(space, axis.name, ex)
+        assert ex.p0 == pytest.approx(ode.p0, rel=1e-8) and ex.omega0 == pytest.approx(ode.omega0, rel=1e-9)
+        if hp.simulated is None:
+            tol = 10 * (ex.l1_error + ode.l1_error) + 1e-4 * abs(ode.l1)
+            assert abs(ex.l1 - ode.l1) <= tol, (name, ex.l1, ode.l1)
+            assert ex.criticality == ode.criticality
+
+
+def _ode_l1_along(space, name, ex):
+    system = model_system(space, name)
+    y0 = system.simulation_model.silent(space.resolve({name: ex.p0})).y
+    return first_lyapunov(system, y0, ex.p0, refine=True, omega=ex.omega0)
