@@ -19,6 +19,7 @@ from brakesqueal.explorer.state import (
     check_t_end,
     format_eigenvalue,
     leading_eigenvalue,
+    locus_lines,
     locus_view,
     slider_range,
 )
@@ -84,6 +85,23 @@ def test_leading_eigenvalue_is_the_state_matrix_one(origin):
     assert lv.tracks.eigenvalues.shape == (10, 2)
     assert leading_eigenvalue([1 - 2j, 1 + 2j, -3]) == 1 + 2j
     assert format_eigenvalue(0.1838688 + 10927.157j) == "0.183869 + 10927.2i"
+
+
+def test_locus_lines_hold_every_mode_between_nans(origin):
+    space = origin.space
+    tr = locus_view(space, "mu", slider_range(space, "mu"), num=7).tracks
+    lines = locus_lines(tr.values, tr.eigenvalues)
+    n, m = tr.eigenvalues.shape
+    assert {k: v.dtype for k, v in lines.items()} == dict.fromkeys(("value", "re", "im", "freq"), np.float64)
+    gaps = np.flatnonzero(np.isnan(lines["re"]))
+    assert list(gaps) == [k * (n + 1) + n for k in range(m - 1)]
+    for k, seg in enumerate(np.split(np.arange(lines["re"].size), gaps)):
+        seg = seg[~np.isin(seg, gaps)]
+        lam = np.array([tr.eigenvalues[i][k] for i in range(n)])  # mode k, point by point
+        assert np.array_equal(lines["re"][seg], lam.real) and np.array_equal(lines["im"][seg], lam.imag)
+        assert np.array_equal(lines["value"][seg], np.asarray(tr.values, dtype=float))
+        assert np.allclose(lines["freq"][seg], [abs(z.imag) / (2 * np.pi) for z in lam], rtol=1e-15)
+    assert all(v.size == 0 for v in locus_lines(np.empty(0), np.empty((0, 0))).values())
 
 
 def test_audio_equals_the_wav_file(tmp_path):

@@ -12,13 +12,15 @@ the page and carries the state they show, for tests and benchmarks.
 
 from __future__ import annotations
 
+import contextlib
 import html
 import json
 import logging
 import math
+import threading
 import time
 from dataclasses import replace
-from functools import partial
+from functools import partial, wraps
 from typing import Any
 
 import numpy as np
@@ -39,6 +41,7 @@ from .state import (
     format_eigenvalue,
     hopf_scan,
     hopf_text,
+    locus_lines,
     locus_view,
     map_view,
     simulation_view,
@@ -52,10 +55,14 @@ log = logging.getLogger(__name__)
 
 #: Milliseconds the state must rest before it is written to the URL.
 URL_DELAY_MS = 400
-#: Milliseconds the state must rest before the critical speeds and the Hopf point are recomputed.
-INFO_REST_MS = 150
+#: Milliseconds the state must rest before the critical speeds and the Hopf point are recomputed (longer than
+#: the steps of a moving slider, so that their work and their update of the page stay off its path).
+INFO_REST_MS = 250
 _LOG_FORMAT = "return Number((10 ** tick).toPrecision(3)).toExponential();"
 _MAP_PALETTE = ["#f3a5a5", "#a9cdf5", "#c8c8c8"]  # unstable, stable, no verdict
+#: Render level of what moves with every slider step (the current point, its markers): Bokeh repaints only
+#: the overlay layer of a plot when only overlay renderers changed, not its axes, grids and lines.
+_MOVING = "overlay"
 
 
 def _fmt_value(v: float) -> str:
@@ -79,6 +86,122 @@ def _undebounce(*widgets: Any) -> None:
             w._debounce = WIDGET_DEBOUNCE_MS
 
 
+def _locus_key(space: Any, state: ViewState, ranges: dict[str, SliderRange]) -> tuple[Any, SliderRange]:
+    """What the root locus along ``state.along`` depends on (everything but the value of ``along``), its range."""
+    rng = ranges[state.along] if state.along in ranges else slider_range(space, state.along)
+    defs = {k: str(v) for k, v in space.definitions().items() if k != state.along}
+    return (state.model, state.preset, state.along, rng, tuple(sorted(defs.items()))), rng
+
+
+def _map_key(space: Any, state: ViewState) -> tuple[Any, ...]:
+    """What the map depends on (everything but the values of its axes)."""
+    defs = {k: str(v) for k, v in space.definitions().items()}
+    return (state.model, state.preset, state.x, state.y, state.nx, state.ny,
+            tuple(sorted((k, v) for k, v in defs.items() if k not in (state.x, state.y))))
+
+
+class _WarmUp:
+    """The root locus of the command line's view, computed while the server starts (:func:`warm_up`).
+
+    The first session waits for it rather than computing it a second time, and puts it into its page.
+    """
+
+    def __init__(self) -> None:
+        self.started = False
+        self.done = threading.Event()
+        self.key: Any = None
+        self.tracks: Any = None
+
+    def tracks_for(self, key: Any, timeout: float = 60.0) -> Any:
+        """The warmed-up modes along the path if ``key`` is the warmed-up view's, else None."""
+        if not self.started:
+            return None
+        self.done.wait(timeout)
+        return self.tracks if self.done.is_set() and key == self.key else None
+
+
+_WARM = _WarmUp()
+
+
+def warm_up(origin: Origin) -> None:
+    """Start computing the command line's first view in a thread (loads the model's compiled code and the
+    plotting modules while the server starts and the browser loads the page's scripts)."""
+    _WARM.started = True
+
+    def run() -> None:
+        try:
+            from bokeh.plotting import figure  # noqa: F401  (the first session's figures)
+
+            state = origin.initial_state()
+            space = origin.space_of(state)
+            key, rng = _locus_key(space, state, {})
+            lv = locus_view(space, state.along, rng)
+            _WARM.key, _WARM.tracks = key, lv.tracks
+        except Exception:  # the page reports the error itself
+            log.debug("warm-up failed", exc_info=True)
+        finally:
+            _WARM.done.set()
+
+    threading.Thread(target=run, name="explorer-warm-up", daemon=True).start()
+
+
+class _AfterRest:
+    """Call ``fn`` with the document locked once :meth:`poke` has not been called for ``delay_ms``.
+
+    The timer runs on the IO loop, not as a document callback: a document callback added while the
+    document is held (:meth:`Explorer._held`) can be lost when the hold is released.
+
+    Parameters
+    ----------
+    doc : bokeh.document.Document
+        The session's document.
+    loop : tornado.ioloop.IOLoop
+        The server's loop.
+    delay_ms : int
+        The rest [ms].
+    fn : callable
+        Called without arguments.
+    """
+
+    def __init__(self, doc: Any, loop: Any, delay_ms: int, fn: Any) -> None:
+        self.doc, self.loop, self.delay, self.fn = doc, loop, delay_ms / 1000, fn
+        self.due = 0.0
+        self.pending = False
+
+    def poke(self) -> None:
+        """(Re)start the rest."""
+        self.due = time.monotonic() + self.delay
+        if not self.pending:
+            self._arm(self.delay)
+
+    def _arm(self, wait: float) -> None:
+        self.pending = True
+        self.loop.call_later(wait + 0.001, self._tick)
+
+    def _tick(self) -> None:
+        try:
+            self.doc.add_next_tick_callback(self._fire)
+        except Exception:  # the session is gone
+            self.pending = False
+
+    def _fire(self) -> None:
+        wait = self.due - time.monotonic()
+        if wait > 0.001:  # poked again since: wait for the rest
+            self._arm(wait)
+            return
+        self.pending = False
+        self.fn()
+
+
+def _batched(method: Any) -> Any:
+    """Run an event handler of :class:`Explorer` in :meth:`Explorer._held` (its changes sent as one message)."""
+    @wraps(method)
+    def run(self: Any, *args: Any, **kwargs: Any) -> Any:
+        with self._held():
+            return method(self, *args, **kwargs)
+    return run
+
+
 class Explorer:
     """One session of the explorer.
 
@@ -97,6 +220,11 @@ class Explorer:
         self.origin = origin
         self.count = 0
         self.doc = pn.state.curdoc
+        self._loop: Any = None
+        if self.doc is not None:
+            from tornado.ioloop import IOLoop
+
+            self._loop = IOLoop.current()
         self.errors: dict[str, str] = {}
         state = origin.initial_state()
         try:
@@ -109,7 +237,8 @@ class Explorer:
         self.space = origin.space_of(state)
         self.shown: dict[str, Any] = {}
         self._map_key: Any = None
-        self._url_pending = False
+        self._url_rest = _AfterRest(self.doc, self._loop, URL_DELAY_MS, lambda: self._write_url_now())
+        self._info_rest = _AfterRest(self.doc, self._loop, INFO_REST_MS, lambda: self.info_lane.submit(self.state))
         self._tracks_key: Any = None
         self._tracks: Any = None
         self._drawn_tracks: Any = None
@@ -117,8 +246,6 @@ class Explorer:
         self._hopf_key: Any = None
         self._building = False
         self._sync_shown: ViewState | None = None
-        self._info_pending = False
-        self._info_due = 0.0
         self.ranges: dict[str, SliderRange] = {n: slider_range(self.space, n) for n in self.space.settable()}
         self._map_logs = (self.ranges[state.x].log, self.ranges[state.y].log)
         self._map_axes = (state.x, state.y)
@@ -135,22 +262,82 @@ class Explorer:
                                      progress=self._sim_progress, name="explorer-sim")
         self.page = self._layout()
         self._refresh_alert()
-        self._submit()
+        # The map and the texts follow the eigenvalues once the page has loaded (their work would otherwise
+        # compete with building and sending the first view); without a server they follow at once.
+        self._loaded = self.doc is None
+        if self.doc is None or not self._first_locus():
+            self._submit()
         if pn.state.curdoc is not None:
-            pn.state.onload(self._write_url_now)
+            pn.state.onload(self._on_load)
+
+    def _first_locus(self) -> bool:
+        """Put the first eigenvalues (and the root locus, when the server's warm-up computed it) into the page
+        itself, so that the first view needs no update after the browser connects.  False if they fail (the
+        locus lane then reports the error)."""
+        state, space = self.state, self.space
+        key, rng = _locus_key(space, state, self.ranges)
+        tracks = _WARM.tracks_for(key)
+        try:
+            lv = locus_view(space, state.along, rng, tracks=tracks, path=False)
+        except BrakesquealError:
+            return False
+        if tracks is not None:
+            self._tracks_key, self._tracks = key, tracks
+            self._sync_shown = state
+            self._show_locus(state, (space, lv, True), None)
+        else:  # the path follows from the lane
+            self._show_locus(state, (space, lv, False), None)
+            self.locus_lane.submit(state)
+        return True
+
+    def _on_load(self) -> None:
+        self._loaded = True
+        self._write_url_now()
+        self._follow()
+
+    def _follow(self) -> None:
+        """The map (when its inputs changed) and the texts follow the eigenvalues (latest request only)."""
+        if not self._loaded:
+            return
+        if self._map_key is None or self._map_key != _map_key(self.space, self.state):
+            self.map_lane.submit(self.state)
+        self._submit_info()
 
     # ------------------------------------------------------------------------------------------ plumbing
     def _schedule(self, fn: Any) -> None:
+        """Run ``fn`` on the document's event loop with the document locked (callable from any thread)."""
         doc = self.doc
         if doc is None:  # no server (tests of the object): run now
             fn()
             return
-        # Not held (pn.io.hold): a callback that a worker thread adds while the document is held can be
-        # dropped when the hold is released, and the lane's result would never be shown.
+        # Through the IO loop (thread-safe), not doc.add_next_tick_callback from the worker thread: the event
+        # loop batches each interaction's changes in a hold (:meth:`_held`), and a callback that another thread
+        # adds while the document is held can be dropped when the hold is released.
+        loop = self._loop
+        if loop is None:
+            self._add_tick(fn)
+        else:
+            loop.add_callback(self._add_tick, fn)
+
+    def _add_tick(self, fn: Any) -> None:
         try:
-            doc.add_next_tick_callback(fn)
+            self.doc.add_next_tick_callback(partial(self._held_call, fn))
         except Exception:  # the session is gone
             self.stop()
+
+    def _held_call(self, fn: Any) -> None:
+        with self._held():
+            fn()
+
+    def _held(self) -> Any:
+        """Collect the document changes of one interaction and send them to the browser in one message.
+
+        Unheld, every changed property is a message of its own, and the browser re-lays out the page and
+        repaints the plots once per message.
+        """
+        if self.doc is None:
+            return contextlib.nullcontext()
+        return self.pn.io.hold(self.doc)
 
     def stop(self) -> None:
         """End the session's worker threads."""
@@ -198,7 +385,8 @@ class Explorer:
                                      sizing_mode="stretch_width")
         self.cycles_text = pn.pane.HTML("Press Cycles to continue the limit cycles from the Hopf point on the path.",
                                         sizing_mode="stretch_width")
-        self.audio = pn.pane.Audio(None, name="squeal", sample_rate=AUDIO_RATE, width=320, css_classes=["bs-audio"])
+        self.dynamics_box = pn.Column()  # the simulation's and cycles' views, built on first use
+        self.fig_hist: Any = None
         self.render = pn.pane.HTML(self._render_html(), width=0, height=0, margin=0)
 
     def _axis_options(self) -> None:
@@ -259,19 +447,19 @@ class Explorer:
         from bokeh.plotting import figure
 
         pn = self.pn
-        self.src_locus = ColumnDataSource({"xs": [], "ys": [], "mode": []})
+        self.src_locus = ColumnDataSource(locus_lines(np.empty(0), np.empty((0, 0))))
         self.src_now = ColumnDataSource({"re": [], "im": []})
         f = figure(height=330, width=420, title="eigenvalues along the path (root locus)",
                    x_axis_label="Re λ [1/s]", y_axis_label="Im λ [1/s]", tools="pan,wheel_zoom,box_zoom,reset")
-        f.multi_line("xs", "ys", source=self.src_locus, line_width=1.5, color="#4c72b0", alpha=0.8)
-        f.scatter("re", "im", source=self.src_now, size=9, color="#d62728", legend_label="current point")
+        f.line("re", "im", source=self.src_locus, line_width=1.5, color="#4c72b0", alpha=0.8)
+        f.scatter("re", "im", source=self.src_now, size=9, color="#d62728", legend_label="current point",
+                  level=_MOVING)
         f.add_layout(Span(location=0, dimension="height", line_color="black", line_dash="dashed", line_width=1))
         f.legend.location = "top_left"
         f.css_classes = ["bs-locus"]
         self.fig_locus = f
-        self.src_modes = ColumnDataSource({"xs": [], "freq": [], "real": []})
-        self.span_f = Span(location=0, dimension="height", line_color="#d62728", line_width=1)
-        self.span_r = Span(location=0, dimension="height", line_color="#d62728", line_width=1)
+        self.span_f = Span(location=0, dimension="height", line_color="#d62728", line_width=1, level=_MOVING)
+        self.span_r = Span(location=0, dimension="height", line_color="#d62728", line_width=1, level=_MOVING)
         self.pane_locus = pn.pane.Bokeh(f, css_classes=['bs-locus'])
         self.pane_modes = pn.pane.Bokeh(self._modes_figure(False))
         self.src_map = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
@@ -279,14 +467,27 @@ class Explorer:
         self.src_point = ColumnDataSource({"x": [], "y": []})
         self.map_mapper = LinearColorMapper(palette=_MAP_PALETTE, low=-0.5, high=2.5)
         self.pane_map = pn.pane.Bokeh(self._map_figure(*self._map_logs), css_classes=['bs-map'])
+
+    def _ensure_dynamics(self) -> None:
+        """Build the views of the simulation and the limit cycles (time history, spectrum, audio, branches).
+
+        Built on the first press of Simulate or Cycles rather than with the page: four empty views fewer to
+        build, send and lay out before the first eigenvalues show.
+        """
+        if self.fig_hist is not None:
+            return
+        from bokeh.models import ColumnDataSource, Span
+        from bokeh.plotting import figure
+
+        pn = self.pn
         self.src_hist = ColumnDataSource({"t": [], "x": []})
         self.src_spec = ColumnDataSource({"f": [], "a": []})
         h = figure(height=220, width=520, title="time history", x_axis_label="t [s]", y_axis_label="deviation",
                    tools="pan,wheel_zoom,box_zoom,reset")
         h.line("t", "x", source=self.src_hist, line_width=0.8)
         self.fig_hist = h
-        s = figure(height=220, width=360, title="spectrum", x_axis_label="frequency [Hz]", y_axis_label="amplitude",
-                   y_axis_type="log", tools="pan,wheel_zoom,box_zoom,reset")
+        s = figure(height=220, width=360, title="spectrum", x_axis_label="frequency [Hz]",
+                   y_axis_label="amplitude", y_axis_type="log", tools="pan,wheel_zoom,box_zoom,reset")
         s.line("f", "a", source=self.src_spec, line_width=0.8)
         self.fig_spec = s
         self.src_cycles = ColumnDataSource({"p": [], "a": [], "color": []})
@@ -300,6 +501,9 @@ class Explorer:
         c.add_layout(self.span_loss)
         c.title.text_font_size = "9pt"
         self.fig_cycles = c
+        self.audio = pn.pane.Audio(None, name="squeal", sample_rate=AUDIO_RATE, width=320,
+                                   css_classes=["bs-audio"])
+        self.dynamics_box.objects = [pn.Row(self.fig_hist, self.fig_spec), pn.Row(self.audio, self.fig_cycles)]
 
     def _modes_figure(self, log: bool) -> Any:
         from bokeh.layouts import column
@@ -310,11 +514,11 @@ class Explorer:
         lab = _label(self.space, name)
         a = figure(height=165, width=420, title="mode coupling", x_axis_type=xt, y_axis_label="f [Hz]",
                    tools="pan,wheel_zoom,box_zoom,reset")
-        a.multi_line("xs", "freq", source=self.src_modes, line_width=1.5, color="#4c72b0")
+        a.line("value", "freq", source=self.src_locus, line_width=1.5, color="#4c72b0")
         a.add_layout(self.span_f)
         b = figure(height=165, width=420, x_axis_type=xt, x_axis_label=lab, y_axis_label="Re λ [1/s]",
                    x_range=a.x_range, tools="pan,wheel_zoom,box_zoom,reset")
-        b.multi_line("xs", "real", source=self.src_modes, line_width=1.5, color="#4c72b0")
+        b.line("value", "re", source=self.src_locus, line_width=1.5, color="#4c72b0")
         b.add_layout(self.span_r)
         return column(a, b)
 
@@ -331,7 +535,7 @@ class Explorer:
         f.image("image", x="x", y="y", dw="dw", dh="dh", source=self.src_map, color_mapper=self.map_mapper)
         f.line("x", "y", source=self.src_boundary, line_color="black", line_width=2, legend_label="boundary")
         f.scatter("x", "y", source=self.src_point, marker="cross", size=16, line_width=3, color="#2ca02c",
-                  legend_label="current point")
+                  legend_label="current point", level=_MOVING)
         f.legend.location = "bottom_right"
         f.title.text_font_size = "9pt"
         if x_log:
@@ -362,7 +566,7 @@ class Explorer:
         texts = pn.Column(self.leading_text, self.cs_text, self.hopf_text, self.map_text, legend, self.sim_text,
                           self.cycles_text, width=460)
         views = pn.Column(pn.Row(self.pane_locus, self.pane_modes), pn.Row(self.pane_map, texts),
-                          pn.Row(self.fig_hist, self.fig_spec), pn.Row(self.audio, self.fig_cycles))
+                          self.dynamics_box)
         return pn.Column(head, self.alert, pn.Row(left, views), self.render, sizing_mode="stretch_width")
 
     # ------------------------------------------------------------------------------------------ state changes
@@ -393,17 +597,7 @@ class Explorer:
         if self.doc is None:
             self._write_url_now()
             return
-        if self._url_pending:
-            return
-        self._url_pending = True
-        try:
-            self.doc.add_timeout_callback(self._flush_url, URL_DELAY_MS)
-        except Exception:  # the session is gone
-            self._url_pending = False
-
-    def _flush_url(self) -> None:
-        self._url_pending = False
-        self._write_url_now()
+        self._url_rest.poke()
 
     def _write_url_now(self) -> None:
         loc = self.pn.state.location
@@ -413,6 +607,7 @@ class Explorer:
             except Exception:  # no browser location (tests of the object)
                 log.debug("no location", exc_info=True)
 
+    @_batched
     def _on_slider(self, name: str, position: float) -> None:
         if self._building:
             return
@@ -425,6 +620,7 @@ class Explorer:
             self._building = False
         self._set_state(self.state.with_values({name: text}), source=name)
 
+    @_batched
     def _on_text(self, name: str, text: str) -> None:
         if self._building:
             return
@@ -451,6 +647,7 @@ class Explorer:
         finally:
             self._building = False
 
+    @_batched
     def _on_tap(self, event: Any) -> None:
         if event.x is None or event.y is None:
             return
@@ -459,6 +656,7 @@ class Explorer:
         y = 10.0 ** event.y if y_log else float(event.y)
         self._move_to({self.state.x: x, self.state.y: y})
 
+    @_batched
     def _on_view(self, event: Any) -> None:
         if self._building:
             return
@@ -484,24 +682,30 @@ class Explorer:
                 self._building = False
             self._rebuild_parameters()
 
+    @_batched
     def _on_model(self, event: Any) -> None:
         if self._building:
             return
         self._reset_to(ViewState(model=event.new, preset="", nx=self.state.nx, ny=self.state.ny,
                                  t_end=self.state.t_end), "model")
 
+    @_batched
     def _on_preset(self, event: Any) -> None:
         if self._building or not event.new:
             return
         self._reset_to(ViewState(model=self.state.model, preset=event.new, nx=self.state.nx, ny=self.state.ny,
                                  t_end=self.state.t_end), "preset")
 
+    @_batched
     def _on_simulate(self, event: Any) -> None:
+        self._ensure_dynamics()
         self.sim_text.object = "simulating …"
         self.sim_progress.value, self.sim_progress.visible = 0, True
         self.sim_lane.submit(self.state)
 
+    @_batched
     def _on_cycles(self, event: Any) -> None:
+        self._ensure_dynamics()
         self.cycles_text.object = "continuing the limit cycles … (Cancel drops the result)"
         self.cycles_lane.submit(self.state)
 
@@ -518,6 +722,7 @@ class Explorer:
             self.cycles_text.object = f"<b>limit cycles:</b> {html.escape(msg)}"
             self.shown["cycles"] = {"state": state.to_query(), "error": msg}
         else:
+            self._ensure_dynamics()
             lifted = np.zeros(cv.p.size, dtype=bool)
             if cv.contact_loss is not None and cv.p.size:  # the branch starts at the Hopf point
                 lifted = np.abs(cv.p - cv.p[0]) > abs(cv.contact_loss - cv.p[0])
@@ -531,6 +736,7 @@ class Explorer:
                                     "contact_loss": cv.contact_loss, "summary": cv.summary}
         self._mark()
 
+    @_batched
     def _on_cancel(self, event: Any) -> None:
         self.cycles_lane.cancel()
         self.sim_lane.cancel()
@@ -567,35 +773,12 @@ class Explorer:
         if self.doc is None:
             self.info_lane.submit(self.state)
             return
-        self._info_due = time.monotonic() + INFO_REST_MS / 1000
-        if self._info_pending:
-            return
-        self._info_pending = True
-        try:
-            self.doc.add_timeout_callback(self._flush_info, INFO_REST_MS)
-        except Exception:  # the session is gone
-            self._info_pending = False
-
-    def _flush_info(self) -> None:
-        wait = self._info_due - time.monotonic()
-        if wait > 0.001:  # moved again since: wait for the rest
-            try:
-                self.doc.add_timeout_callback(self._flush_info, int(1000 * wait) + 1)
-            except Exception:  # the session is gone
-                self._info_pending = False
-            return
-        self._info_pending = False
-        self.info_lane.submit(self.state)
-
-    def _locus_key(self, space: Any, state: ViewState) -> tuple[Any, SliderRange]:
-        rng = slider_range(space, state.along) if state.along not in self.ranges else self.ranges[state.along]
-        defs = {k: str(v) for k, v in space.definitions().items() if k != state.along}
-        return (state.model, state.preset, state.along, rng, tuple(sorted(defs.items()))), rng
+        self._info_rest.poke()
 
     def _reused_locus(self, state: ViewState) -> tuple[Any, LocusView, bool] | None:
         """The locus of ``state`` if its path is the one kept, else None."""
-        space = self.origin.space_of(state)
-        key, rng = self._locus_key(space, state)
+        space = self.space if state is self.state else self.origin.space_of(state)
+        key, rng = _locus_key(space, state, self.ranges)
         tracks = self._tracks
         if tracks is None or key != self._tracks_key:
             return None
@@ -605,7 +788,7 @@ class Explorer:
     def _compute_locus(self, state: ViewState, check: Any) -> tuple[Any, LocusView, bool]:
         """The current eigenvalues, then the modes along the path (reused while only ``along`` itself moves)."""
         space = self.origin.space_of(state)
-        key, rng = self._locus_key(space, state)
+        key, rng = _locus_key(space, state, self.ranges)
         if key == self._tracks_key:
             return space, locus_view(space, state.along, rng, tracks=self._tracks), True
         now = locus_view(space, state.along, rng, path=False)
@@ -629,8 +812,7 @@ class Explorer:
     def _show_locus(self, state: ViewState, result: Any, error: BaseException | None) -> None:
         if self._sync_shown is self.state and state is not self.state:
             return  # a lane's result for an older state, after the current one was shown at once
-        self.map_lane.submit(self.state)  # the other lanes follow the eigenvalues (latest request only)
-        self._submit_info()
+        self._follow()
         if error is not None:
             self.leading_text.object = f"<b>leading eigenvalue:</b> {html.escape(str(error))}"
             self.shown["locus"] = {"state": state.to_query(), "error": str(error)}
@@ -648,26 +830,14 @@ class Explorer:
         tr = lv.tracks
         if tr is not None and tr is not self._drawn_tracks:  # unchanged paths are not sent again
             self._drawn_tracks = tr
-            lam = tr.eigenvalues
-            xs, ys, mode, vx, fr, re_ = [], [], [], [], [], []
-            for k in range(lam.shape[1]):
-                col = lam[:, k]
-                xs.append(col.real.tolist())
-                ys.append(col.imag.tolist())
-                mode.append(k)
-                vx.append(tr.values.tolist())
-                fr.append((np.abs(col.imag) / (2 * math.pi)).tolist())
-                re_.append(col.real.tolist())
-            self.src_locus.data = {"xs": xs, "ys": ys, "mode": mode}
+            self.src_locus.data = locus_lines(tr.values, tr.eigenvalues)  # float64 arrays: binary buffers
             log_now = bool(tr.log)
             if getattr(self, "_modes_key", None) != (state.along, log_now, state.model, state.preset):
                 self._modes_key = (state.along, log_now, state.model, state.preset)
                 self.pane_modes.object = self._modes_figure(log_now)
-            self.src_modes.data = {"xs": vx, "freq": fr, "real": re_}
         if lv.message:  # no path: clear the previous one rather than show it for another point
             self._drawn_tracks = None
-            self.src_locus.data = {"xs": [], "ys": [], "mode": []}
-            self.src_modes.data = {"xs": [], "freq": [], "real": []}
+            self.src_locus.data = locus_lines(np.empty(0), np.empty((0, 0)))
             self.leading_text.object += f"<br><i>{html.escape(lv.message)}</i>"
         x, y = self._map_point(space, state)
         self.src_point.data = {"x": [x], "y": [y]}
@@ -691,9 +861,7 @@ class Explorer:
         space = self.origin.space_of(state)
         ranges = {n: (self.ranges.get(n) or slider_range(space, n)) for n in (state.x, state.y)}
         out: dict[str, Any] = {}
-        defs = {k: str(v) for k, v in space.definitions().items()}
-        map_key = (state.model, state.preset, state.x, state.y, state.nx, state.ny,
-                   tuple(sorted((k, v) for k, v in defs.items() if k not in (state.x, state.y))))
+        map_key = _map_key(space, state)
         if map_key != self._map_key:
             try:
                 out["map"] = map_view(space, state.x, state.y, ranges[state.x], ranges[state.y], state.nx, state.ny,
@@ -801,6 +969,7 @@ class Explorer:
             self.shown["sim"] = {"state": state.to_query(), "error": msg}
             self._mark()
             return
+        self._ensure_dynamics()
         self.src_hist.data = {"t": sv.t, "x": sv.x}
         self.fig_hist.yaxis.axis_label = sv.coordinate
         keep = sv.f > 0

@@ -5,7 +5,6 @@ from __future__ import annotations
 import ipaddress
 import socket
 import sys
-import threading
 from typing import Any
 
 from ..errors import ParameterError
@@ -42,18 +41,6 @@ def _configure_offline() -> None:
     pn.extension(inline=False)  # registers Panel's bundled models; resources are served by this server
 
 
-def _warm(origin: Any) -> None:
-    """Import and load what the first page computes while the browser loads the page's scripts."""
-    from .state import locus_view, slider_range
-
-    try:
-        state = origin.initial_state()
-        space = origin.space_of(state)
-        locus_view(space, state.along, slider_range(space, state.along))
-    except Exception:  # the page shows the error itself
-        pass
-
-
 def make_server(space: Any, *, port: int = DEFAULT_PORT, host: str = "127.0.0.1", show: bool = False) -> Any:
     """A started-on-demand Bokeh server of the explorer (call ``.start()``, ``.io_loop.start()``).
 
@@ -74,7 +61,7 @@ def make_server(space: Any, *, port: int = DEFAULT_PORT, host: str = "127.0.0.1"
     """
     import panel as pn
 
-    from .app import build_page
+    from .app import build_page, warm_up
     from .state import Origin
 
     if not 0 <= port <= 65535:
@@ -87,7 +74,7 @@ def make_server(space: Any, *, port: int = DEFAULT_PORT, host: str = "127.0.0.1"
     origins = [f"{host}:{port}", f"127.0.0.1:{port}", f"localhost:{port}"]
     if not is_loopback(host):
         origins = ["*"]
-    threading.Thread(target=_warm, args=(origin,), name="explorer-warm-up", daemon=True).start()
+    warm_up(origin)
     return pn.serve({"/": lambda: build_page(origin)}, port=port, address=host, show=show, start=False,
                     websocket_origin=origins, title="brakesqueal explorer", verbose=False)
 

@@ -31,7 +31,7 @@ from ..errors import ParameterError
 
 __all__ = ["MAX_MAP_POINTS", "MAX_T_END", "LOCUS_POINTS", "AUDIO_RATE", "SliderRange", "ViewState",
            "slider_range", "format_eigenvalue", "leading_eigenvalue", "MapView", "map_view", "LocusView",
-           "locus_view", "critical_speed_text", "hopf_scan", "hopf_text", "SimulationView",
+           "locus_view", "locus_lines", "critical_speed_text", "hopf_scan", "hopf_text", "SimulationView",
            "simulation_view", "check_map_size", "check_t_end", "Origin", "audio_samples", "default_axes", "CyclesView",
            "cycles_view"]
 
@@ -313,6 +313,39 @@ def locus_view(space: Any, along: str, rng: SliderRange, num: int = LOCUS_POINTS
     except BrakesquealError as exc:
         tracks, message = None, f"root locus along {along}: {exc}"
     return LocusView(lam, leading_eigenvalue(lam), tracks, message)
+
+
+def locus_lines(values: np.ndarray, eigenvalues: np.ndarray) -> dict[str, np.ndarray]:
+    """The modes along a path as one polyline per quantity, the modes separated by NaN.
+
+    One float64 array per quantity (sent to the browser as one binary buffer
+    and drawn as one line that breaks at the NaNs) instead of a list of
+    lists per mode.
+
+    Parameters
+    ----------
+    values : ndarray, shape (n,)
+        The path parameter's values.
+    eigenvalues : ndarray of complex, shape (n, m)
+        Mode ``k`` along the path in column ``k``.
+
+    Returns
+    -------
+    dict
+        ``value``, ``re``, ``im`` and ``freq`` (``|Im λ| / 2π`` [Hz]), each of
+        length ``m (n + 1) - 1``: mode ``k`` at ``[k (n + 1), k (n + 1) + n)``.
+    """
+    lam = np.asarray(eigenvalues, dtype=complex)
+    if lam.ndim != 2 or lam.size == 0:
+        return {k: np.empty(0) for k in ("value", "re", "im", "freq")}
+    n, m = lam.shape
+    v = np.asarray(values, dtype=float).reshape(n, 1)
+
+    def flat(a: np.ndarray) -> np.ndarray:
+        return np.vstack([a, np.full((1, m), np.nan)]).T.ravel()[:-1]
+
+    return {"value": flat(np.repeat(v, m, axis=1)), "re": flat(lam.real), "im": flat(lam.imag),
+            "freq": flat(np.abs(lam.imag) / (2 * math.pi))}
 
 
 # ---------------------------------------------------------------------------------------------- map
