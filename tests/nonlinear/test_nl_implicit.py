@@ -140,3 +140,20 @@ def _ode_l1_along(space, name, ex):
     system = model_system(space, name)
     y0 = system.simulation_model.silent(space.resolve({name: ex.p0})).y
     return first_lyapunov(system, y0, ex.p0, refine=True, omega=ex.omega0)
+
+
+def test_crossings_and_critical_speed_gain_the_hopf_fields(capsys):
+    """`crossings --hopf` and `critical-speed --hopf` give the `hopf` command's fields for every crossing."""
+    assert main(["hopf", "--along", "Omega=1:1e4:log", "--format", "json"]) == 0
+    ref = json.loads(capsys.readouterr().out)["crossings"]
+    assert main(["crossings", "--along", "Omega=1:1e4:log", "--hopf", "--format", "json"]) == 0
+    got = json.loads(capsys.readouterr().out)["crossings"]
+    assert main(["critical-speed", "--range", "1:1e4", "--hopf", "--format", "json"]) == 0
+    crit = json.loads(capsys.readouterr().out)
+    assert len(ref) == len(got) == 2 and len(crit["crossings"]) == 2
+    for a, b, c in zip(ref, got, crit["crossings"]):
+        assert a["hopf"]["criticality"] == b["hopf"]["criticality"] == c["hopf"]["criticality"]
+        assert b["hopf"]["l1"] == pytest.approx(a["hopf"]["l1"], rel=1e-6)
+        assert c["hopf"]["p0"] == pytest.approx(a["hopf"]["p0"], rel=1e-9)
+    assert main(["crossings", "--along", "Omega=1:1e4:log", "--format", "json"]) == 0
+    assert "hopf" not in json.loads(capsys.readouterr().out)["crossings"][0]  # unchanged without --hopf

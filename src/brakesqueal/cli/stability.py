@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 import sys
 from enum import Enum
-from typing import Annotated, Optional
+from typing import Annotated, Any, Optional
 
 import typer
 
@@ -45,10 +45,14 @@ def _write_plot(fig: object, plot: str) -> None:
         fig.savefig(tmp, dpi=300)  # type: ignore[attr-defined]
 
 
+_HopfOpt = Annotated[bool, typer.Option("--hopf", help="Add the Hopf normal form at every crossing (l1, "
+                                         "criticality, predicted amplitude; as the hopf command).")]
+
+
 def crossings(
     along: Annotated[str, typer.Option("--along", help="NAME=START:STOP[:log] path to search.")],
     model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
-    fmt: FormatOpt = OutFormat.text, plot: _PlotOpt = None,
+    fmt: FormatOpt = OutFormat.text, plot: _PlotOpt = None, hopf: _HopfOpt = False,
 ) -> None:
     """Every parameter value on a path where the stability of the silent motion changes (exact where possible)."""
     from ..analysis.crossings import crossings as _crossings
@@ -58,16 +62,33 @@ def crossings(
     axis = parse_axis(along, with_num=False)
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
-    r = _crossings(space_from(model, preset, params, set_), axis)
+    space = space_from(model, preset, params, set_)
+    r = _crossings(space, axis)
     if plot:
         _write_plot(r.plot(), plot)  # type: ignore[attr-defined]
-    sys.stdout.write(json.dumps(r.to_dict(), indent=2) + "\n" if fmt == OutFormat.json else r.text())  # type: ignore[attr-defined]
+    _write_crossings(r, space, axis, fmt, hopf)
+
+
+def _write_crossings(r: Any, space: Any, axis: Any, fmt: OutFormat, hopf: bool) -> None:
+    """Text or JSON of a crossing result; with ``hopf`` every crossing gains its normal form (as ``hopf``)."""
+    if not hopf:
+        sys.stdout.write(json.dumps(r.to_dict(), indent=2) + "\n" if fmt == OutFormat.json else r.text())
+        return
+    from ..nonlinear.models import hopf_points
+
+    pts = hopf_points(space, axis, result=r)
+    if fmt == OutFormat.json:
+        d = r.to_dict()
+        d["crossings"] = [hp.to_dict() for hp in pts]
+        sys.stdout.write(json.dumps(d, indent=2, default=float) + "\n")
+    else:
+        sys.stdout.write(r.text() + _hopf_text(pts))
 
 
 def critical_speed(
     range_: Annotated[str, typer.Option("--range", help="Omega range LO:HI [rad/s].")] = "1:1e5",
     model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
-    fmt: FormatOpt = OutFormat.text, plot: _PlotOpt = None,
+    fmt: FormatOpt = OutFormat.text, plot: _PlotOpt = None, hopf: _HopfOpt = False,
 ) -> None:
     """All onsets and re-stabilisations of squeal along the spin rate Omega, and Omega_crit."""
     from ..analysis.crossings import critical_speeds
@@ -77,10 +98,11 @@ def critical_speed(
     axis = parse_axis(f"Omega={range_}:log", with_num=False)
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
-    r = critical_speeds(space_from(model, preset, params, set_), axis.start, axis.stop)
+    space = space_from(model, preset, params, set_)
+    r = critical_speeds(space, axis.start, axis.stop)
     if plot:
         _write_plot(r.plot(), plot)  # type: ignore[attr-defined]
-    sys.stdout.write(json.dumps(r.to_dict(), indent=2) + "\n" if fmt == OutFormat.json else r.text())  # type: ignore[attr-defined]
+    _write_crossings(r, space, axis, fmt, hopf)
 
 
 def map_(
