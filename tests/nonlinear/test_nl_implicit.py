@@ -157,3 +157,26 @@ def test_crossings_and_critical_speed_gain_the_hopf_fields(capsys):
         assert c["hopf"]["p0"] == pytest.approx(a["hopf"]["p0"], rel=1e-9)
     assert main(["crossings", "--along", "Omega=1:1e4:log", "--format", "json"]) == 0
     assert "hopf" not in json.loads(capsys.readouterr().out)["crossings"][0]  # unchanged without --hopf
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_random_regular_pad_models_against_the_ode_route(rising_friction_model, seed):
+    """Random asymmetric parameter sets with rising friction: the implicit route equals the explicit ODE's."""
+    rng = np.random.default_rng(seed)
+    sets = [f"k_ip1={10 ** rng.uniform(5, 8):.6g}", f"k_ip2={10 ** rng.uniform(5, 8):.6g}",
+            f"mu1={rng.uniform(0.3, 0.7):.4f}", f"mu2={rng.uniform(0.3, 0.7):.4f}",
+            f"s={-(10 ** rng.uniform(-3, -2)):.4g}", f"d1={rng.uniform(1, 10):.3f}", f"k2={rng.uniform(4e6, 8e6):.4g}"]
+    space = resolve_space(rising_friction_model, None, None, sets)
+    every = hopf_points(space, Axis("Omega", 1.0, 1e4, log=True))
+    pts = [hp for hp in every if hp.hopf is not None]
+    assert pts and len(pts) == len(every), [hp.message for hp in every]  # a normal form at every crossing
+    for hp in pts:
+        ex = hp.hopf
+        assert hp.simulated is None  # rate-dependent pads: the simulated equations keep the pads' rates
+        ode = _ode_l1_along(space, "Omega", ex)
+        tol = 10 * (ex.l1_error + ode.l1_error) + 1e-4 * abs(ode.l1)
+        assert abs(ex.l1 - ode.l1) <= tol, (sets, ex.l1, ode.l1)
+        assert ex.dlambda_dp == pytest.approx(ode.dlambda_dp, rel=1e-6)
+        # a_j ~ |Re c1|^(-1/2): the amplitudes agree to half the relative tolerance of l1
+        rtol = 0.5 * tol / abs(ode.l1) + 1e-5
+        np.testing.assert_allclose(ex.amplitude_coefficients, ode.amplitude_coefficients, rtol=rtol)
