@@ -359,6 +359,7 @@ class Explorer:
                                    css_classes=["bs-alert"])
         self.params_box = pn.Column(sizing_mode="stretch_width")
         self.fixed_box = pn.Card(title="fixed parameters", collapsed=True, sizing_mode="stretch_width")
+        self.fixed_box.param.watch(self._on_fixed_card, "collapsed")
         self.along_select = pn.widgets.Select(name="root locus along", width=130)
         self.x_select = pn.widgets.Select(name="map x", width=100)
         self.y_select = pn.widgets.Select(name="map y", width=100)
@@ -427,6 +428,17 @@ class Explorer:
             _undebounce(slider, box)
             self.sliders[name], self.inputs[name] = slider, box
             rows.append(pn.Row(slider, box, sizing_mode="stretch_width"))
+        self.params_box.objects = rows
+        self.fixed_box.objects = []
+        if not self.fixed_box.collapsed:
+            self._build_fixed()
+        self._axis_options()
+
+    def _build_fixed(self) -> None:
+        """Typed inputs for the fixed names (built when their card is first opened: a dozen inputs fewer to
+        build and lay out before the first view)."""
+        pn = self.pn
+        space = self.space
         fixed = []
         for name in space.settable():
             if name in space.preset.free:
@@ -437,9 +449,12 @@ class Explorer:
             _undebounce(box)
             self.inputs[name] = box
             fixed.append(box)
-        self.params_box.objects = rows
         self.fixed_box.objects = [pn.FlexBox(*fixed)]
-        self._axis_options()
+
+    @_batched
+    def _on_fixed_card(self, event: Any) -> None:
+        if not event.new and not self.fixed_box.objects:
+            self._build_fixed()
 
     # ------------------------------------------------------------------------------------------ figures
     def _make_figures(self) -> None:
