@@ -181,7 +181,8 @@ class MapFile:
     space : ParameterSpace
         The map's parameter space.
     outer, inner : Axis
-        The axes (dimension order).
+        The axes (dimension order; :class:`~brakesqueal.analysis.maps.Axis`, their
+        values are written block by block with ``values_range``).
     eigen : bool
         Whether ``max_real`` and ``frequency`` are stored.
     float_dtype : numpy dtype
@@ -234,8 +235,9 @@ class MapFile:
         self._end = offset
         self._fp = open(path, "wb")
         try:
-            for v in self._vars[:2]:
-                self._put(v, 0, np.asarray(self.outer.values() if v.name == outer.name else inner.values()))
+            for v, ax in zip(self._vars[:2], (outer, inner)):
+                for i in range(0, ax.num, 1 << 20):  # a long axis: no array of its length
+                    self._put(v, i, ax.values_range(i, min(ax.num, i + (1 << 20))))
         except BaseException:
             self._fp.close()
             raise
@@ -257,21 +259,29 @@ class MapFile:
         self._fp.write(a.data)
 
     def write_rows(self, r0: int, r1: int, stable: np.ndarray, status: np.ndarray,
-                   max_real: np.ndarray | None = None, frequency: np.ndarray | None = None) -> None:
-        """Write outer rows ``r0:r1`` of the map (arrays of shape ``(r1 - r0, inner.num)``).
+                   max_real: np.ndarray | None = None, frequency: np.ndarray | None = None, *, c0: int = 0) -> None:
+        """Write the block ``[r0:r1, c0:c0 + width]`` of the map: whole outer rows, or a piece of one row.
 
-        ``max_real`` and ``frequency`` are required when the file stores them
-        (``eigen``) and ignored otherwise.
+        The arrays have shape ``(r1 - r0, width)``: ``width = inner.num``
+        (and ``c0 = 0``) for whole rows; a piece of one row (``r1 = r0 + 1``)
+        may start at any ``c0``.  ``max_real`` and ``frequency`` are required
+        when the file stores them (``eigen``) and ignored otherwise.
         """
-        start = r0 * self.inner.num
+        n_i = self.inner.num
+        width = int(np.shape(stable)[-1]) if np.ndim(stable) == 2 else -1
+        whole = c0 == 0 and width == n_i
+        if not (0 <= r0 < r1 <= self.outer.num and (whole or (r1 == r0 + 1 and 0 <= c0 and c0 + width <= n_i))):
+            raise ValueError(f"rows {r0}:{r1}, columns from {c0}, width {width}: not whole rows nor a piece of "
+                             f"one row of the ({self.outer.num}, {n_i}) grid")
+        start = r0 * n_i + c0
         cells = {"stable": stable, "status": status}
         if self.eigen:
             if max_real is None or frequency is None:
                 raise ValueError("this map file stores max_real and frequency: give both")
             cells.update(max_real=max_real, frequency=frequency)
         for name, values in cells.items():
-            if np.shape(values) != (r1 - r0, self.inner.num):
-                raise ValueError(f"{name}: expected shape {(r1 - r0, self.inner.num)}, got {np.shape(values)}")
+            if np.shape(values) != (r1 - r0, width):
+                raise ValueError(f"{name}: expected shape {(r1 - r0, width)}, got {np.shape(values)}")
             self._put(self._grid[name], start, values)
 
     def write_boundary(self, b: Any) -> None:

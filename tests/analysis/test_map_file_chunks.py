@@ -72,9 +72,10 @@ def test_map_file_holds_what_scipy_writes(tmp_path, eigen, ftype, nb):
                              method=method, boundary=b).to_netcdf(str(ref))
     out = tmp_path / "chunks.nc"
     f = MapFile(str(out), space, outer, inner, eigen=eigen, float_dtype=ftype, method=method, boundary=True)
-    for r0, r1 in ((0, 5), (5, 6), (6, 13)):  # blocks of unequal size
-        f.write_rows(r0, r1, stable[r0:r1], status[r0:r1], None if mr is None else mr[r0:r1],
-                     None if fr is None else fr[r0:r1])
+    for r0, r1, c0, c1 in ((6, 13, 0, 7), (0, 5, 0, 7), (5, 6, 3, 7), (5, 6, 0, 3)):  # any order; pieces of a row
+        blk = np.s_[r0:r1, c0:c1]
+        f.write_rows(r0, r1, stable[blk], status[blk], None if mr is None else mr[blk],
+                     None if fr is None else fr[blk], c0=c0)
     if b is not None:
         f.write_boundary(b)
     f.close()
@@ -95,6 +96,10 @@ def test_map_file_checks_its_input(tmp_path):
         f.write_rows(0, 1, z, z)
     with pytest.raises(ValueError, match="expected shape"):
         f.write_rows(0, 1, z, z, z, np.zeros((1, 3)))
+    with pytest.raises(ValueError, match="nor a piece"):
+        f.write_rows(0, 2, np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3)), c0=1)
+    with pytest.raises(ValueError, match="nor a piece"):
+        f.write_rows(0, 1, np.zeros((1, 3)), np.zeros((1, 3)), np.zeros((1, 3)), np.zeros((1, 3)), c0=2)
     f.abort()
     f = MapFile(str(tmp_path / "n.nc"), space, outer, inner, eigen=False, method="m", boundary=False)
     with pytest.raises(RuntimeError, match="no room"):
@@ -130,6 +135,31 @@ def test_chunked_and_unchunked_writes_give_the_same_map(tmp_path, preset, x, y, 
     _tol_equal(a, b, eigen)
     assert s1.stable_fraction == s2.stable_fraction == pytest.approx(float(a["stable"].values.mean()))
     assert s1.method == s2.method == a.attrs["method"]
+
+
+@pytest.mark.parametrize("chunk", [15, 3 * 41 + 5])  # pieces of rows (15, 15, 11), three whole rows
+def test_blocks_of_any_size_give_the_same_map(tmp_path, chunk):
+    space = ParameterSpace.from_preset("paper-fig2")
+    x, y = Axis("k_ip", 1e5, 1e10, 41, log=True), Axis("mu", -0.1, 1.0, 37)
+    one, many = tmp_path / "one.nc", tmp_path / "many.nc"
+    write_map(space, x, y, str(one), chunk_points=10**7)
+    write_map(space, x, y, str(many), chunk_points=chunk)
+    _tol_equal(_read(one), _read(many), True)
+
+
+def test_blocks_cover_the_grid_once_in_file_order():
+    from brakesqueal.analysis.maps import _blocks
+
+    for n_o, n_i, points in ((7, 5, 1), (7, 5, 4), (7, 5, 5), (7, 5, 12), (7, 5, 100), (3, 10, 4), (1, 1, 0)):
+        seen = np.zeros((n_o, n_i), int)
+        last = -1
+        for r0, r1, c0, c1 in _blocks(n_o, n_i, points):
+            assert (r1 - r0) * (c1 - c0) <= max(points, 1)
+            assert (c0, c1) == (0, n_i) or r1 == r0 + 1  # contiguous in the row-major file
+            assert r0 * n_i + c0 == last + 1  # in file order, no gap
+            last = (r1 - 1) * n_i + c1 - 1
+            seen[r0:r1, c0:c1] += 1
+        assert np.all(seen == 1)
 
 
 def _eigen_reference(space, names, a, b):
@@ -191,3 +221,35 @@ def test_a_map_beyond_the_file_format_is_refused_before_computing(tmp_path, monk
     assert not path.exists()
     with pytest.raises(ParameterError, match="--force"):
         write_map(space, x, y, str(path))
+
+
+@pytest.mark.parametrize("values", [
+    np.logspace(5, 10, 1001), np.linspace(-0.2, 1.0, 17), np.linspace(-1.0, 1.0, 11),  # zero on the axis
+    np.zeros(5), np.logspace(5, 300, 40), np.array([1e5, np.inf]),  # the kernel does not apply to the last two
+])
+def test_kernel_exponent_by_blocks_equals_kernel_scaling(values):
+    from brakesqueal.analysis.kernels import kernel_scaling, map_kernel
+    from brakesqueal.analysis.maps import _kernel_exponent
+
+    kern = map_kernel(ParameterSpace.from_preset("paper-fig2"), "k_ip", "mu")
+    assert kern is not None
+    want = kernel_scaling(kern, values)
+    for block in (1, 3, 1 << 20):
+        got = _kernel_exponent(kern, lambda i0, i1: values[i0:i1], values.size, block)
+        assert got == (None if want is None else want[0])
+
+
+@pytest.mark.parametrize("ax", [
+    Axis("k_ip", 1e5, 1e10, 1001, log=True), Axis("mu", -0.2, 1.0, 17), Axis("h", 1e-310, 2e-310, 7),  # subnormal
+    Axis("a", 3.0, 7.0, 2), Axis("b", 1e-300, 1e300, 9999, log=True), Axis("c", 0.1, 0.1 + 2e-16, 5),
+])
+def test_axis_values_range_equals_a_slice_of_values(ax):
+    rng = np.random.default_rng(ax.num)
+    v = ax.values()
+    assert np.array_equal(ax.values_range(0, ax.num), v)
+    for _ in range(40):
+        i0, i1 = sorted(rng.integers(0, ax.num + 1, 2).tolist())
+        w = ax.values_range(i0, i1)
+        assert w.dtype == v.dtype and np.array_equal(w, v[i0:i1]), (i0, i1)
+    with pytest.raises(ValueError, match="outside"):
+        ax.values_range(0, ax.num + 1)

@@ -120,6 +120,41 @@ class Axis:
             return np.logspace(math.log10(self.start), math.log10(self.stop), self.num)
         return np.linspace(self.start, self.stop, self.num)
 
+    def values_range(self, i0: int, i1: int) -> np.ndarray:
+        """The grid points ``i0:i1``, equal to ``values()[i0:i1]`` without forming the whole axis.
+
+        The element-wise arithmetic of :func:`numpy.linspace` / :func:`numpy.logspace`
+        (``start + i * step``, the last point set to ``stop``; ``10**`` that for
+        log axes) on the indices ``i0..i1-1`` only.
+
+        Parameters
+        ----------
+        i0, i1 : int
+            The range of indices, ``0 <= i0 <= i1 <= num``.
+
+        Returns
+        -------
+        ndarray
+            ``i1 - i0`` grid points.
+        """
+        if not 0 <= i0 <= i1 <= self.num:
+            raise ValueError(f"axis '{self.name}': index range {i0}:{i1} outside 0:{self.num}")
+        a, b = (math.log10(self.start), math.log10(self.stop)) if self.log else (self.start, self.stop)
+        start, stop = np.float64(a), np.float64(b)
+        delta = np.subtract(stop, start)
+        div = self.num - 1
+        step = delta / div
+        y = np.arange(i0, i1, dtype=float)
+        if step == 0:  # as numpy.linspace: subnormal steps
+            y /= div
+            y *= delta
+        else:
+            y *= step
+        y += start
+        if i1 == self.num and i1 > i0:
+            y[-1] = stop
+        return np.power(10.0, y) if self.log else y
+
     @property
     def ref(self) -> float:
         """A representative magnitude (geometric mean for log axes), used to scale polynomials."""
@@ -247,8 +282,7 @@ class _Plan:
     kern: object
     outer: Axis
     inner: Axis
-    scaled: tuple[int, np.ndarray] | None
-    seg_T: tuple[np.ndarray, np.ndarray] | None
+    scaled: int | None  # the kernel's inner-axis exponent (kernel_scaling), None: the kernel does not apply
     closed: bool
     method: str
     ftype: type
@@ -262,8 +296,7 @@ def _plan(space: object, x: Axis, y: Axis, force: bool, eigen: bool, in_memory: 
     kern = map_kernel(space, x.name, y.name) if closed else None  # type: ignore[arg-type]
     ax = {x.name: x, y.name: y}
     outer, inner = (ax[kern.outer], ax[kern.inner]) if kern else (y, x)
-    scaled = kernel_scaling(kern, inner.values())
-    seg_T = kernel_segments(scaled[1]) if scaled is not None else None
+    scaled = _kernel_exponent(kern, inner.values_range, inner.num)
     cp = None
     if closed:
         method = ("closed form: certified compiled Hurwitz kernel of the exact quartic + robust per-point route"
@@ -273,16 +306,57 @@ def _plan(space: object, x: Axis, y: Axis, force: bool, eigen: bool, in_memory: 
         cp = charpoly_table(space, outer.name, inner.name)  # type: ignore[arg-type]
         method = CHARPOLY_ROUTE if cp is not None else ROUTES["points"]
     ftype = np.float32 if outer.num * inner.num > _FLOAT32_ABOVE else np.float64
-    return _Plan(kern, outer, inner, scaled, seg_T, closed, method, ftype, cp)
+    return _Plan(kern, outer, inner, scaled, closed, method, ftype, cp)
 
 
-_Rows = tuple[int, int, np.ndarray, np.ndarray, "np.ndarray | None", "np.ndarray | None"]
+def _kernel_exponent(kern: object, values: Callable[[int, int], np.ndarray], n: int, block: int = 1 << 20
+                     ) -> int | None:
+    """The exponent ``e`` of :func:`~.kernels.kernel_scaling` for an inner axis (``None``: the kernel does not apply).
+
+    ``values(i0, i1)`` gives the axis' values ``i0:i1`` of ``n``.  Same result
+    as ``kernel_scaling(kern, all values)[0]``, which depends only on whether
+    every value is finite and on the smallest nonzero and the largest
+    ``|value|``: these are found block by block and passed on, so a long axis
+    needs no array of its length (``t = values / 2^e`` is formed per block).
+    """
+    if kern is None:
+        return None
+    lo, hi, finite = math.inf, 0.0, True
+    for i in range(0, n, block):
+        a = np.abs(values(i, min(n, i + block)))
+        ok = np.isfinite(a)
+        finite = finite and bool(ok.all())
+        pos = a[ok & (a > 0)]
+        if pos.size:
+            lo, hi = min(lo, float(pos.min())), max(hi, float(pos.max()))
+    summary = np.array([lo, hi] if hi > 0 else [0.0]) if finite else np.array([np.nan])
+    scaled = kernel_scaling(kern, summary)  # type: ignore[arg-type]
+    return None if scaled is None else scaled[0]
 
 
-def _rows(space: object, plan: _Plan, eigen: bool, chunk_points: int) -> Iterator[_Rows]:
-    """Yield ``(r0, r1, stable, status, max_real, frequency)`` for blocks of outer rows (bounded memory).
+_Block = tuple[int, int, int, int, np.ndarray, np.ndarray, "np.ndarray | None", "np.ndarray | None"]
 
-    With a kernel, the verdicts are its certified codes and, with ``eigen``,
+
+def _blocks(n_o: int, n_i: int, points: int) -> Iterator[tuple[int, int, int, int]]:
+    """Blocks ``(r0, r1, c0, c1)`` of at most ``max(points, 1)`` points in file order: whole outer rows, or
+    pieces of one row when a row is longer (every block is contiguous in the row-major grid)."""
+    points = max(1, points)
+    if n_i <= points:
+        rows = points // n_i
+        for r0 in range(0, n_o, rows):
+            yield r0, min(n_o, r0 + rows), 0, n_i
+        return
+    for r0 in range(n_o):
+        for c0 in range(0, n_i, points):
+            yield r0, r0 + 1, c0, min(n_i, c0 + points)
+
+
+def _rows(space: object, plan: _Plan, eigen: bool, chunk_points: int) -> Iterator[_Block]:
+    """Yield ``(r0, r1, c0, c1, stable, status, max_real, frequency)`` for blocks of the grid (bounded memory).
+
+    A block is ``[r0:r1, c0:c1]`` of the ``(outer, inner)`` grid with at most
+    ``chunk_points`` points: whole outer rows, or pieces of one row when a row
+    is longer.  With a kernel, the verdicts are its certified codes and, with ``eigen``,
     ``max_real``/``frequency`` are the compiled roots of the same quartic
     (:func:`~.kernels.kernel_eigen`); only points the kernel leaves uncertain,
     whose roots were not found cleanly or whose ``max_real`` contradicts the
@@ -290,29 +364,38 @@ def _rows(space: object, plan: _Plan, eigen: bool, chunk_points: int) -> Iterato
     per-point route, exact arithmetic where needed).
     """
     kern, outer, inner = plan.kern, plan.outer, plan.inner
-    ov, iv = outer.values(), inner.values()
-    n_o, n_i = ov.size, iv.size
+    n_o, n_i = outer.num, inner.num
     # without a compiled kernel points may go one by one: smaller blocks, so progress is reported often
     fast = kern is not None or plan.charpoly is not None
-    rows = max(1, (chunk_points if fast else min(chunk_points, 4096)) // n_i)
-    buf = np.empty((min(rows, n_o), n_i), dtype=np.uint8)
-    for r0 in range(0, n_o, rows):
-        r1 = min(n_o, r0 + rows)
-        arr = space.arrays({outer.name: ov[r0:r1, None], inner.name: iv[None, :]})  # type: ignore[attr-defined]
-        valid = np.broadcast_to(valid_points(space, arr), (r1 - r0, n_i))
+    points = chunk_points if fast else min(chunk_points, 4096)
+    buf = np.empty((min(max(1, points // n_i), n_o), n_i), dtype=np.uint8) if n_i <= max(1, points) else None
+    iv_all = inner.values() if buf is not None else None  # whole rows: the inner values formed once
+    if plan.scaled is not None and iv_all is not None:  # and scaled and segmented once
+        t_all = np.ldexp(iv_all, -plan.scaled)
+        seg_all = kernel_segments(t_all)
+    for r0, r1, c0, c1 in _blocks(n_o, n_i, points):
+        # only this block's values: no array of an axis' length (a map may have very long axes)
+        iv = iv_all if iv_all is not None else inner.values_range(c0, c1)
+        ov = outer.values_range(r0, r1)
+        shape = (r1 - r0, c1 - c0)
+        arr = space.arrays({outer.name: ov[:, None], inner.name: iv[None, :]})  # type: ignore[attr-defined]
+        valid = np.broadcast_to(valid_points(space, arr), shape)
         if plan.charpoly is not None:
-            yield (r0, r1, *_charpoly_rows(space, plan, ov[r0:r1], iv, valid, eigen))
+            yield (r0, r1, c0, c1, *_charpoly_rows(space, plan, ov, iv, valid, eigen))
             continue
-        if kern is None or plan.scaled is None or plan.seg_T is None:
+        if kern is None or plan.scaled is None:
             res = evaluate_arrays(space, arr, eigen=eigen, closed=plan.closed, valid=valid)
-            yield r0, r1, res.stable, res.status, (res.max_real if eigen else None), (res.frequency if eigen else None)
+            yield (r0, r1, c0, c1, res.stable, res.status, (res.max_real if eigen else None),
+                   (res.frequency if eigen else None))
             continue
-        codes = buf[: r1 - r0]
-        C, EC, lam_e = kern.row_tables(ov[r0:r1], plan.scaled[0])  # type: ignore[attr-defined]
-        kern.classify(C, EC, plan.scaled[1], plan.seg_T[0], plan.seg_T[1], codes)  # type: ignore[attr-defined]
+        codes = buf[: r1 - r0] if buf is not None else np.empty(shape, dtype=np.uint8)
+        t = t_all if buf is not None else np.ldexp(iv, -plan.scaled)
+        seg, seg_T = seg_all if buf is not None else kernel_segments(t)
+        C, EC, lam_e = kern.row_tables(ov, plan.scaled)  # type: ignore[attr-defined]
+        kern.classify(C, EC, t, seg, seg_T, codes)  # type: ignore[attr-defined]
         mr = fr = None
         if eigen:
-            mr, fr, found = kernel_eigen(kern, C, plan.scaled[1], lam_e)  # type: ignore[arg-type]
+            mr, fr, found = kernel_eigen(kern, C, t, lam_e)  # type: ignore[arg-type]
             good = valid & found.view(bool) & (((codes == STABLE) & (mr < 0)) | ((codes == UNSTABLE) & (mr >= 0)))
             mr[~valid] = np.nan
             fr[~valid] = np.nan
@@ -322,7 +405,7 @@ def _rows(space: object, plan: _Plan, eigen: bool, chunk_points: int) -> Iterato
         status = np.where(valid, np.int8(PointStatus.OK), np.int8(PointStatus.INVALID))
         redo = np.nonzero(valid & ~good)
         if redo[0].size:
-            sub = space.arrays({outer.name: ov[r0:r1][redo[0]], inner.name: iv[redo[1]]})  # type: ignore[attr-defined]
+            sub = space.arrays({outer.name: ov[redo[0]], inner.name: iv[redo[1]]})  # type: ignore[attr-defined]
             res = evaluate_arrays(space, sub, eigen=eigen, codes=codes[redo], closed=True,
                                   valid=np.ones(redo[0].size, dtype=bool))
             stable[redo] = res.stable
@@ -330,7 +413,7 @@ def _rows(space: object, plan: _Plan, eigen: bool, chunk_points: int) -> Iterato
             if mr is not None and fr is not None:
                 mr[redo] = res.max_real
                 fr[redo] = res.frequency
-        yield r0, r1, stable, status, mr, fr
+        yield r0, r1, c0, c1, stable, status, mr, fr
 
 
 def _charpoly_rows(space: object, plan: _Plan, ov: np.ndarray, iv: np.ndarray, valid: np.ndarray, eigen: bool
@@ -378,7 +461,8 @@ def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen
         Compute ``max_real`` and ``frequency``; ``False`` only classifies
         and leaves both variables out of the result.
     chunk_points : int
-        Points per chunk (bounds the temporary memory).
+        Points per chunk (bounds the temporary memory): whole outer rows, or
+        pieces of one row when a row has more points.
     progress : callable, optional
         Called with the completed fraction after each chunk.
     boundary : bool
@@ -410,14 +494,14 @@ def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen
     status = np.zeros((n_o, n_i), dtype=np.int8)
     max_real = np.full((n_o, n_i), np.nan, dtype=plan.ftype) if eigen else None
     freq = np.full((n_o, n_i), np.nan, dtype=plan.ftype) if eigen else None
-    for r0, r1, st, ss, mr, fr in _rows(space, plan, eigen, chunk_points):
-        stable[r0:r1] = st
-        status[r0:r1] = ss
+    for r0, r1, c0, c1, st, ss, mr, fr in _rows(space, plan, eigen, chunk_points):
+        stable[r0:r1, c0:c1] = st
+        status[r0:r1, c0:c1] = ss
         if max_real is not None and freq is not None:
-            max_real[r0:r1] = mr
-            freq[r0:r1] = fr
+            max_real[r0:r1, c0:c1] = mr
+            freq[r0:r1, c0:c1] = fr
         if progress is not None:
-            progress(r1 / n_o)
+            progress(((r1 - 1) * n_i + c1) / (n_o * n_i))
     b = _boundary(space, plan, stable, status) if boundary else None
     return StabilityMap.from_arrays(space, plan.outer, plan.inner, stable=stable, status=status, max_real=max_real,
                                     frequency=freq, method=plan.method, boundary=b)
@@ -530,14 +614,14 @@ def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False
                 boundary=keep)
     n_stable = 0
     try:
-        for r0, r1, st, ss, mr, fr in _rows(space, plan, eigen, chunk_points):
-            f.write_rows(r0, r1, st, ss, mr, fr)
+        for r0, r1, c0, c1, st, ss, mr, fr in _rows(space, plan, eigen, chunk_points):
+            f.write_rows(r0, r1, st, ss, mr, fr, c0=c0)
             n_stable += int(np.count_nonzero(st))
             if stable is not None and status is not None:
-                stable[r0:r1] = st
-                status[r0:r1] = ss
+                stable[r0:r1, c0:c1] = st
+                status[r0:r1, c0:c1] = ss
             if progress is not None:
-                progress(r1 / n_o)
+                progress(((r1 - 1) * n_i + c1) / (n_o * n_i))
         if stable is not None and status is not None:
             b = _boundary(space, plan, stable, status)
             if b is not None:
