@@ -62,7 +62,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import BrakesquealError, ParameterError
-from .hopf import HopfResult, hopf_result
+from .hopf import HopfResult, _skeel, hopf_result
 from .system import EPS, H_FIRST, H_SECOND, fd_bilinear, fd_trilinear
 
 __all__ = ["PadHopf", "exact_lyapunov"]
@@ -220,7 +220,9 @@ def exact_lyapunov(space: Any, name: str, p0: float, *, omega: float | None = No
     if np.min(np.abs(lams)) <= 1e-12 * abs(lam):
         raise BrakesquealError("a zero eigenvalue at the Hopf point (fold-Hopf): l1 is not defined")
     phi, psi, q, pv = _vectors(pt, w0)
-    c1, c1_err, h20, h11, X1 = _c1(pt, w0, phi, psi)
+    sv = np.linalg.svd(pt.P(1j * w0), compute_uv=False)
+    kvec = float(sv[0] / sv[-2]) if sv.size > 1 else 1.0  # condition of the null vectors phi, psi
+    c1, c1_err, h20, h11, X1 = _c1(pt, w0, phi, psi, kvec)
     # the silent motion's derivative along the path, in the state
     hp = 1e-6 * max(abs(p), 1e-3)
     dy0 = (_Point(space, sim, name, p + hp).y0() - _Point(space, sim, name, p - hp).y0()) / (2 * hp)
@@ -257,8 +259,8 @@ def _vectors(pt: _Point, w0: float) -> tuple[np.ndarray, np.ndarray, np.ndarray,
     return phi, psi, q, pv / np.conj(pq)
 
 
-def _c1(pt: _Point, w0: float, phi: np.ndarray,
-        psi: np.ndarray) -> tuple[complex, float, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+def _c1(pt: _Point, w0: float, phi: np.ndarray, psi: np.ndarray,
+        kvec: float = 1.0) -> tuple[complex, float, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
     """``(c1, error, h20, h11, X1)`` with the finite-difference step chosen where consecutive steps agree best."""
     n, m = pt.n, pt.m
     T = np.concatenate([np.ones(n), np.full(n, w0), np.full(n, w0 * w0), np.ones(m), np.full(m, w0)])
@@ -276,7 +278,7 @@ def _c1(pt: _Point, w0: float, phi: np.ndarray,
     P2, P0 = pt.P(2j * w0), pt.P(0.0)
     den = np.vdot(psi, pt.P(1j * w0, derivative=True) @ phi)
 
-    def at(f: float) -> tuple[complex, np.ndarray, np.ndarray]:
+    def at(f: float) -> tuple[complex, np.ndarray, np.ndarray, float]:
         hB, hC = H_FIRST * f, H_SECOND * f
         B11, _ = fd_bilinear(jac, z, 0.0, X1, X1, step=hB)
         B1b, _ = fd_bilinear(jac, z, 0.0, X1, X1b, step=hB)
@@ -285,7 +287,11 @@ def _c1(pt: _Point, w0: float, phi: np.ndarray,
         C, _ = fd_trilinear(jac, z, 0.0, X1, X1, X1b, step=hC)
         B2, _ = fd_bilinear(jac, z, 0.0, X1, X(h11.astype(complex), 0.0), step=hB)
         B3, _ = fd_bilinear(jac, z, 0.0, X1b, X(h20, 2j * w0), step=hB)
-        return complex(-np.vdot(psi, C + 2 * B2 + B3) / den / 2), h20, h11
+        t = (np.vdot(psi, C), 2 * np.vdot(psi, B2), np.vdot(psi, B3))
+        # rounding of the two solves (Skeel's condition numbers) and of the null vectors on the terms' magnitudes
+        kap = _skeel(P2, h20) + _skeel(P0, h11) + kvec
+        rnd = 10 * EPS * kap * sum(abs(v) for v in t) / abs(den) / 2
+        return complex(-sum(t) / den / 2), h20, h11, rnd
 
     vals, best, rising = [at(1.0)], None, 0
     for k in range(1, 13):
@@ -299,10 +305,10 @@ def _c1(pt: _Point, w0: float, phi: np.ndarray,
                 break
     assert best is not None
     k = best[1]
-    c1, h20, h11 = vals[k]
+    c1, h20, h11, rnd = vals[k]
     # the agreement with both neighbours of the chosen step (a plateau, not a crossing of two curves)
     after = abs(vals[k + 1][0] - c1) if k + 1 < len(vals) else best[0]
-    err = 2 * max(best[0], after) + 1e3 * EPS * abs(c1)
+    err = 2 * max(best[0], after) + rnd + 1e3 * EPS * abs(c1)
     return c1, err, h20, h11, X1 * T
 
 
