@@ -4,8 +4,10 @@ Commands (paper-fig2, with ``max_real`` and ``frequency``; a fresh process each,
 
     brakesqueal map --x k_ip=1e5:1e10:NX:log --y mu=0.05:1:NY --out m.nc
 
-with ``NX x NY`` = 1000 x 1000, 10000 x 1000 and 10000 x 10000, and the
-1e8-point map once more with ``--no-eigen``.  The file is written block by
+with ``NX x NY`` = 1000 x 1000, 10000 x 1000 and 10000 x 10000, the
+1e8-point map once more with ``--no-eigen``, and a 1e8-point map with one very
+long axis (``NX = 5e7``, ``NY = 2``: rows are cut into pieces, axis values are
+formed per block).  The file is written block by
 block (:class:`brakesqueal.results.MapFile`), so the peak RSS should hardly
 grow with the map: the baseline of every row is the 1e6-point map run in the
 same session, and the ratio is peak RSS(n) / peak RSS(1e6).  ``extra_bytes_per_point``
@@ -13,8 +15,8 @@ is the growth beyond the 1e6-point run divided by the extra points.  Maps of at
 most 1.6e7 points also keep ``stable`` and ``status`` (2 bytes per point) and
 locate the stability boundary (contour of the whole grid): the 1e7 row shows
 that cost, the 1e8 row (no boundary) the bounded writer alone.  The 1e8-point
-runs write 1 GB files into a temporary directory and take about 10 s each
-(about 30 s in all); ``BRAKESQUEAL_BENCH_MAP_1E8=0`` leaves them out.
+runs write 1 GB files into a temporary directory and take 5-15 s each
+(about 40 s in all on a quiet machine); ``BRAKESQUEAL_BENCH_MAP_1E8=0`` leaves them out.
 
 Peak RSS from :func:`os.wait4`; the load average (:func:`os.getloadavg`) is
 recorded with every run: on a shared machine wall times are noisy, the peak
@@ -52,14 +54,15 @@ def run() -> list[BenchResult]:
         base_t, base_rss, base_load = 0.0, 0.0, 0.0
         runs = [(nx, ny, ()) for nx, ny in SIZES if big or nx * ny < 10**8]
         if big:
-            runs.append((10000, 10000, ("--no-eigen",)))
+            runs += [(10000, 10000, ("--no-eigen",)), (50_000_000, 2, ())]
         for nx, ny, extra in runs:
             load = os.getloadavg()[0]
             t, rss = measure(cli(nx, ny, *extra), env, 1)
             n = nx * ny
             if n == 10**6 and not extra:
                 base_t, base_rss, base_load = t, rss, load
-            label = f"brakesqueal map {n:.0e} points{' --no-eigen' if extra else ' with max_real and frequency'}"
+            label = (f"brakesqueal map {n:.0e} points ({nx} x {ny})"
+                     f"{' --no-eigen' if extra else ' with max_real and frequency'}")
             res.append(BenchResult(f"{label}: peak RSS", rss, "MB", base_rss, rss / base_rss,
                                    {"wall_s": round(t, 3), "cpu_s": round(CPU[-1], 3),
                                     "baseline_wall_s": round(base_t, 3), "load_avg_1min": round(load, 2),
