@@ -24,7 +24,7 @@ from brakesqueal.cli import main
 from brakesqueal.model import MODELS, ParameterSpace
 from brakesqueal.model.io import model_to_toml
 from brakesqueal.model.options import resolve_space
-from brakesqueal.nonlinear import first_lyapunov
+from brakesqueal.nonlinear import find_periodic_orbit, first_lyapunov
 from brakesqueal.nonlinear.implicit import exact_lyapunov
 from brakesqueal.nonlinear.models import hopf_points, model_system
 
@@ -180,3 +180,22 @@ def test_random_regular_pad_models_against_the_ode_route(rising_friction_model, 
         # a_j ~ |Re c1|^(-1/2): the amplitudes agree to half the relative tolerance of l1
         rtol = 0.5 * tol / abs(ode.l1) + 1e-5
         np.testing.assert_allclose(ex.amplitude_coefficients, ode.amplitude_coefficients, rtol=rtol)
+
+
+def test_limit_cycles_of_the_regularised_pads_follow_the_exact_prediction(rising_friction_model):
+    """Third route: periodic orbits shot on the explicit ODE of a slightly rising friction law (the pads' rates
+    regularised, s = 1e-4 s/m) have the amplitude the exact Coulomb normal form predicts, not the quasi-static one.
+
+    k_ip = 1e6: the quasi-static pad's l1 is 50x smaller, so its predicted amplitude is about 7x larger.
+    """
+    hc = hopf_points(resolve_space(None, None, None, ["k_ip=1e6"]), Axis("Omega", 10.0, 200.0))[0]
+    exact, quasi = hc.hopf, hc.simulated
+    reg = resolve_space(rising_friction_model, None, None, ["k_ip1=1e6", "k_ip2=1e6", "s=-1e-4"])
+    h = hopf_points(reg, Axis("Omega", 10.0, 200.0))[0].hopf
+    assert h.p0 == pytest.approx(exact.p0, rel=2e-2)  # mu(v0) = mu + s Omega r shifts the onset slightly
+    system = model_system(reg, "Omega")
+    dp = 1e-3 * h.p0
+    o = find_periodic_orbit(system, h.cycle_guess(h.p0 + dp), tol=1e-8)
+    tilt = o.amplitude[:2]
+    np.testing.assert_allclose(tilt / exact.amplitude(exact.p0 + dp)[:2], 1.0, atol=1e-2)
+    assert np.all(quasi.amplitude(quasi.p0 + dp)[:2] > 3 * tilt)

@@ -343,7 +343,10 @@ class _Engine:
               t_orient: np.ndarray | None = None, relaxed: bool = False) -> _Point:  # fmt: skip
         y, ev, DG, it = self.correct(y_pred, t_ref, y_ref, relaxed)
         X, T, p = self.unpack(y)
-        orbit = _orbit_from(self.flow, X, T, p, ev, self.xscale, it, 0.0, self.n_samples if samples else 0)
+        try:
+            orbit = _orbit_from(self.flow, X, T, p, ev, self.xscale, it, 0.0, self.n_samples if samples else 0)
+        except FlowError as exc:  # the sampling run failed where the corrector's run did not: a failed step
+            raise _NoConvergence(str(exc)) from None
         t = self.tangent(y, DG, t_ref if t_orient is None else t_orient)
         pt = _Point(y=y, tangent=t, orbit=orbit, iterations=it)
         pt.tests = _tests(pt)
