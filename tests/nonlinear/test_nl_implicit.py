@@ -199,3 +199,21 @@ def test_limit_cycles_of_the_regularised_pads_follow_the_exact_prediction(rising
     tilt = o.amplitude[:2]
     np.testing.assert_allclose(tilt / exact.amplitude(exact.p0 + dp)[:2], 1.0, atol=1e-2)
     assert np.all(quasi.amplitude(quasi.p0 + dp)[:2] > 3 * tilt)
+
+
+def test_branch_of_regularised_pads(rising_friction_model):
+    """The documented how-to: `cycles` on the regularised model continues past the stiff orbits where a
+    sampling run of the explicit integrator failed (it used to end the command), and its first points have
+    the exact Coulomb normal form's amplitude."""
+    from brakesqueal.nonlinear.models import squeal_branch
+
+    exact = hopf_points(resolve_space(None, None, None, ["k_ip=1e6"]), Axis("Omega", 10.0, 200.0))[0].hopf
+    reg = resolve_space(rising_friction_model, None, None, ["k_ip1=1e6", "k_ip2=1e6", "s=-1e-4"])
+    b = squeal_branch(reg, Axis("Omega", 60.0, 120.0), max_points=12)
+    ds = b.data
+    p, tilt = ds["p"].values, ds["tilt_amplitude"].values
+    assert p.size == 12 and p[-1] > 86.0 and ds["stable"].values.all()
+    h = b.hopf.branch_start
+    i = 1  # closest to onset
+    pred = float(np.max(exact.amplitude(exact.p0 + (p[i] - h.p0))[:2]))
+    assert tilt[i] == pytest.approx(pred, rel=2e-2)
