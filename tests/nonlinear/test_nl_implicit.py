@@ -217,3 +217,16 @@ def test_branch_of_regularised_pads(rising_friction_model):
     i = 1  # closest to onset
     pred = float(np.max(exact.amplitude(exact.p0 + (p[i] - h.p0))[:2]))
     assert tilt[i] == pytest.approx(pred, rel=2e-2)
+
+
+def test_tilted_silent_motion_with_rigid_pads():
+    """mu1 h10 != mu2 h20: a tilted silent motion; rigid pads are kept in the linearization (a singular
+    descriptor E). Both routes describe the same equations: same onset and l1, no quasi-static note."""
+    space = resolve_space(None, "paper-fig3", None, ["h10=0.0101", "k_ip=inf"])
+    (hp,) = hopf_points(space, Axis("Omega", 20.0, 50.0))
+    ex, sim = hp.hopf, hp.simulated
+    assert ex is not None and sim is not None  # different states: (q, dq, l1, l2) and (q, dq)
+    assert ex.state_names[-2:] == ("l1", "l2") and "quasi-static" not in hp.message
+    assert ex.p0 == pytest.approx(sim.p0, rel=1e-7)
+    assert abs(ex.l1 - sim.l1) <= 10 * (ex.l1_error + sim.l1_error) + 1e-5 * abs(sim.l1)
+    np.testing.assert_allclose(ex.amplitude_coefficients[:4], sim.amplitude_coefficients, rtol=1e-3)

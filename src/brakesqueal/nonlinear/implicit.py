@@ -112,6 +112,14 @@ class _Point:
         self.lm = linearize(self.params, model=cm)
         self.kept = [cm.algebraic.index(s) for s in self.lm.pad_states]
 
+    def eigenvalues(self) -> np.ndarray:
+        """Eigenvalues of the exact linearization: of ``E^-1 A`` (accurate slow modes) where ``E`` is regular,
+        else the pencil's finite ones (rigid pads kept at a tilted silent motion)."""
+        try:
+            return np.linalg.eigvals(self.lm.A)
+        except np.linalg.LinAlgError:
+            return np.asarray(self.lm.eigenvalues)
+
     def P(self, lam: complex, derivative: bool = False) -> np.ndarray:
         """``P(lambda)`` (or ``P'(lambda)``), square ``n + m``."""
         n, m, J = self.n, self.m, self.J
@@ -183,7 +191,7 @@ def exact_lyapunov(space: Any, name: str, p0: float, *, omega: float | None = No
     lam = complex(cand[np.argmin(np.abs(cand.real) if omega is None else np.abs(cand.imag - omega))])
 
     def lam_at(p: float, target: complex) -> complex:
-        return _track(np.linalg.eigvals(_Point(space, sim, name, p).lm.A), target)
+        return _track(_Point(space, sim, name, p).eigenvalues(), target)
 
     def dlam(p: float, target: complex) -> complex:
         h = 1e-4 * max(abs(p), 1e-3)
@@ -206,7 +214,7 @@ def exact_lyapunov(space: Any, name: str, p0: float, *, omega: float | None = No
             d = dlam(p, lam)  # Newton step with a fresh derivative
             step = -lam.real / d.real
         pt = _Point(space, sim, name, p + step)
-        p, lam, prev = pt.p, _track(np.linalg.eigvals(pt.lm.A), lam), abs(step)
+        p, lam, prev = pt.p, _track(pt.eigenvalues(), lam), abs(step)
         if abs(step) <= 8 * EPS * max(1.0, abs(p)) or abs(lam.real) <= 1e-13 * abs(lam):
             refined = True
             break

@@ -339,18 +339,21 @@ def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = 
             continue
         h = ex.hopf
         simulated, note = None, ""
-        if _soft_quasi_static(sim, space.resolve({axis.name: h.p0})) or \
-                tuple(h.state_names) != tuple(system.state_names or ()):
+        soft = _soft_quasi_static(sim, space.resolve({axis.name: h.p0}))
+        if soft or tuple(h.state_names) != tuple(system.state_names or ()):
+            # the simulated equations' own normal form (their state; with soft pads also their approximation)
             try:
                 y0 = sim.silent(space.resolve({axis.name: h.p0})).y
                 simulated = first_lyapunov(system, y0, h.p0, refine=True, omega=h.omega0)
-                note = (f"the simulation and limit-cycle branches use quasi-static pads (ldot := 0; exact only to "
-                        f"first order): l1 = {simulated.l1:.6g} ({simulated.criticality}) there")
+                if soft:
+                    note = (f"the simulation and limit-cycle branches use quasi-static pads (ldot := 0; exact only "
+                            f"to first order): l1 = {simulated.l1:.6g} ({simulated.criticality}) there")
             except (BrakesquealError, np.linalg.LinAlgError) as exc:
-                note = f"no normal form of the simulated equations (quasi-static pads): {exc}"
+                note = f"no normal form of the simulated equations: {exc}"
             if simulated is not None and simulated.criticality != h.criticality:
-                note += (f"; the criticality differs from the exact {h.criticality}: the simulated branch "
-                         "does not describe the brake near onset")
+                note = (note + "; " if note else "") + (
+                    f"the criticality of the simulated equations ({simulated.criticality}) differs from the exact "
+                    f"{h.criticality}: the simulated branch does not describe the brake near onset")
         out.append(HopfPoint(axis.name, float(h.p0), direction, h, treatment, note, simulated,
                              ex.contact_loss, ex.sliding_reversal, ex.tilt_at_contact_loss,
                              ex.tilt_at_sliding_reversal))
