@@ -20,7 +20,7 @@ import numpy as np
 from .labels import unit
 
 __all__ = ["StabilityMap", "CrossingResult", "CriticalSpeedResult", "open_map", "MapFile", "plot_map_file",
-           "NC3_MAX_VAR_BYTES"]
+           "NC3_MAX_VAR_BYTES", "MAX_PLOT_POINTS", "plot_indices"]
 
 def _status_attrs() -> dict[str, Any]:
     from .status import STATUS_MEANINGS, PointStatus
@@ -479,8 +479,43 @@ def open_map(path: str) -> StabilityMap:
     return StabilityMap(ds)
 
 
+#: Largest number of grid points per axis :func:`plot_map_file` draws (more than the figure's pixels at 300 dpi);
+#: larger maps are drawn from every k-th point.
+MAX_PLOT_POINTS = 1200
+
+
+def plot_indices(n: int, most: int = MAX_PLOT_POINTS) -> np.ndarray:
+    """Indices of the grid points of an axis of ``n`` points a figure draws: all of them up to ``most``,
+    else every ``k``-th (``k = ceil(n / most)``) and the last one (the axis keeps its range).
+
+    Parameters
+    ----------
+    n : int
+        Number of grid points of the axis.
+    most : int
+        Largest number of points drawn (``>= 2``).
+
+    Returns
+    -------
+    ndarray of int64
+        Increasing indices, first ``0`` and last ``n - 1``.
+    """
+    if n <= most:
+        return np.arange(n, dtype=np.int64)
+    k = -(-n // (most - 1))
+    idx = np.arange(0, n, k, dtype=np.int64)
+    return idx if idx[-1] == n - 1 else np.append(idx, n - 1)
+
+
 def plot_map_file(path: str, *, x: str | None = None, title: str | None = None, color: str = "verdict") -> Any:
     """Plot a map file written by :class:`MapFile` or :meth:`StabilityMap.to_netcdf` without xarray.
+
+    Maps with more than :data:`MAX_PLOT_POINTS` points along an axis are drawn
+    from every k-th grid point of that axis (:func:`plot_indices`; the figure
+    has fewer pixels than that): only those points are read from the file
+    (memory-mapped), so the memory does not grow with the map.  Each drawn cell
+    is a computed point with its own verdict and status; the stored, refined
+    boundary is drawn in full.
 
     Parameters
     ----------
@@ -496,20 +531,26 @@ def plot_map_file(path: str, *, x: str | None = None, title: str | None = None, 
     Returns
     -------
     matplotlib.figure.Figure
-        The same figure :meth:`StabilityMap.plot` draws for the map.
+        The same figure :meth:`StabilityMap.plot` draws for the map (up to
+        :data:`MAX_PLOT_POINTS` points per axis).
     """
     from scipy.io import netcdf_file
 
     from .plotting import map_title, plot_map_arrays
 
-    with netcdf_file(path, "r", mmap=False, maskandscale=False) as f:
+    f = netcdf_file(path, "r", mmap=True, maskandscale=False)
+    try:
         outer, inner = f.variables["stable"].dimensions
+        take = {d: plot_indices(int(f.dimensions[d]), MAX_PLOT_POINTS) for d in (outer, inner)}
+        sel = np.ix_(take[outer], take[inner])
+
+        def grid(name: str, dtype: Any = None) -> np.ndarray:
+            return np.array(f.variables[name].data[sel], dtype=dtype)  # a copy of the drawn points only
+
         xn = x or inner
         yn = outer if xn == inner else inner
-        st, ss = np.asarray(f.variables["stable"].data), np.asarray(f.variables["status"].data)
-        field = None
-        if color in f.variables and color in ("max_real", "frequency"):
-            field = np.asarray(f.variables[color].data, dtype=float)
+        st, ss = grid("stable"), grid("status")
+        field = grid(color, float) if color in f.variables and color in ("max_real", "frequency") else None
         if xn == outer:
             st, ss = st.T, ss.T
             field = None if field is None else field.T
@@ -517,13 +558,17 @@ def plot_map_file(path: str, *, x: str | None = None, title: str | None = None, 
         def axis(n: str) -> tuple[str, np.ndarray, str, bool]:
             v = f.variables[n]
             text = {k: (a.decode() if isinstance(a, bytes) else a) for k, a in v._attributes.items()}
-            return n, np.array(v.data, dtype=float), str(text.get("units", "")), text.get("scale") == "log"
+            return n, np.array(v.data[take[n]], dtype=float), str(text.get("units", "")), text.get("scale") == "log"
 
         space = f._attributes.get("space", b"")
         space = space.decode() if isinstance(space, bytes) else str(space)
-        return plot_map_arrays(axis(xn), axis(yn), st.astype(bool), ss,
-                               title=title if title is not None else map_title(space, xn, yn),
-                               boundary=boundary_of(f.variables, (xn, yn)), color=color, field=field)
+        xa, ya = axis(xn), axis(yn)
+        b = boundary_of(f.variables, (xn, yn))
+        label = title if title is not None else map_title(space, xn, yn)
+    finally:
+        f.variables.clear()  # the variables' arrays view the mapped file: drop them so it can be unmapped
+        f.close()
+    return plot_map_arrays(xa, ya, st.astype(bool), ss, title=label, boundary=b, color=color, field=field)
 
 
 @dataclass(frozen=True)

@@ -253,3 +253,33 @@ def test_axis_values_range_equals_a_slice_of_values(ax):
         assert w.dtype == v.dtype and np.array_equal(w, v[i0:i1]), (i0, i1)
     with pytest.raises(ValueError, match="outside"):
         ax.values_range(0, ax.num + 1)
+
+
+def test_plot_indices():
+    from brakesqueal.results import plot_indices
+
+    assert np.array_equal(plot_indices(5, 7), np.arange(5))
+    for n in range(8, 200):
+        idx = plot_indices(n, 7)
+        assert idx[0] == 0 and idx[-1] == n - 1 and idx.size <= 7 and np.all(np.diff(idx) > 0)
+
+
+def test_plot_of_a_large_map_draws_every_kth_point(tmp_path, monkeypatch):
+    """Above MAX_PLOT_POINTS per axis, plot_map_file draws exactly the map sampled at plot_indices (with the whole
+    stored boundary): the same image as StabilityMap.plot of that sample."""
+    import matplotlib.image as mimage
+
+    import brakesqueal.results as results
+
+    monkeypatch.setattr(results, "MAX_PLOT_POINTS", 9)
+    space = ParameterSpace.from_preset("paper-fig2")
+    path = str(tmp_path / "m.nc")
+    write_map(space, Axis("k_ip", -1e6, 1e9, 40), Axis("mu", -0.1, 1.0, 30), path)  # invalid points: hatched
+    ds = results.open_map(path).data
+    sub = ds.isel(mu=results.plot_indices(30, 9), k_ip=results.plot_indices(40, 9))
+    assert sub["stable"].shape == (9, 9) and "boundary_mu" in sub
+    for color in ("verdict", "max_real"):
+        results.plot_map_file(path, x="k_ip", color=color).savefig(tmp_path / "a.png", dpi=60)
+        results.StabilityMap(sub).plot(x="k_ip", color=color).savefig(tmp_path / "b.png", dpi=60)
+        a, b = mimage.imread(tmp_path / "a.png"), mimage.imread(tmp_path / "b.png")
+        assert a.shape == b.shape and np.array_equal(a, b)
