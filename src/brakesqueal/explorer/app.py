@@ -53,6 +53,9 @@ __all__ = ["Explorer", "build_page"]
 
 log = logging.getLogger(__name__)
 
+#: Seconds a session waits for the server's warm-up (:func:`warm_up`) before it serves a page whose root
+#: locus follows from the locus lane (a cold start compiles the model's code for much longer).
+WARM_WAIT_S = 1.5
 #: Milliseconds the state must rest before it is written to the URL.
 URL_DELAY_MS = 400
 #: Milliseconds the state must rest before the critical speeds and the Hopf point are recomputed (longer than
@@ -271,29 +274,32 @@ class Explorer:
             pn.state.onload(self._on_load)
 
     def _first_locus(self) -> bool:
-        """Put the first eigenvalues (and the root locus, when the server's warm-up computed it) into the page
-        itself, so that the first view needs no update after the browser connects.  False if they fail (the
-        locus lane then reports the error)."""
+        """Put the first eigenvalues and root locus into the page itself when the server's warm-up has computed
+        them (waiting at most :data:`WARM_WAIT_S`), so that the first view needs no update after the browser
+        connects.  False otherwise: the locus lane computes them (it waits for the warm-up first)."""
         state, space = self.state, self.space
         key, rng = _locus_key(space, state, self.ranges)
-        tracks = _WARM.tracks_for(key)
-        try:
-            lv = locus_view(space, state.along, rng, tracks=tracks, path=False)
+        tracks = _WARM.tracks_for(key, timeout=WARM_WAIT_S)
+        if tracks is None:
+            return False
+        try:  # one linearization: the model's compiled code is loaded
+            lv = locus_view(space, state.along, rng, tracks=tracks)
         except BrakesquealError:
             return False
-        if tracks is not None:
-            self._tracks_key, self._tracks = key, tracks
-            self._sync_shown = state
-            self._show_locus(state, (space, lv, True), None)
-        else:  # the path follows from the lane
-            self._show_locus(state, (space, lv, False), None)
-            self.locus_lane.submit(state)
+        self._tracks_key, self._tracks = key, tracks
+        self._sync_shown = state
+        self._show_locus(state, (space, lv, True), None)
         return True
 
+    @_batched
     def _on_load(self) -> None:
+        """The page is shown: the map and texts follow, and the simulation's views are built now rather than on
+        the first press of Simulate (a running simulation holds the interpreter in long compiled stretches,
+        and the event loop that builds the views and handles *Cancel* would wait for it)."""
         self._loaded = True
         self._write_url_now()
         self._follow()
+        self._ensure_dynamics()
 
     def _follow(self) -> None:
         """The map (when its inputs changed) and the texts follow the eigenvalues (latest request only)."""
@@ -486,8 +492,8 @@ class Explorer:
     def _ensure_dynamics(self) -> None:
         """Build the views of the simulation and the limit cycles (time history, spectrum, audio, branches).
 
-        Built on the first press of Simulate or Cycles rather than with the page: four empty views fewer to
-        build, send and lay out before the first eigenvalues show.
+        Built once the page has loaded (or on the first press of Simulate or Cycles, if earlier) rather than
+        with the page: four empty views fewer to build, send and lay out before the first eigenvalues show.
         """
         if self.fig_hist is not None:
             return
@@ -806,6 +812,10 @@ class Explorer:
         key, rng = _locus_key(space, state, self.ranges)
         if key == self._tracks_key:
             return space, locus_view(space, state.along, rng, tracks=self._tracks), True
+        warmed = _WARM.tracks_for(key)  # the server's warm-up may be computing this very path
+        if warmed is not None:
+            self._tracks_key, self._tracks = key, warmed
+            return space, locus_view(space, state.along, rng, tracks=warmed), True
         now = locus_view(space, state.along, rng, path=False)
         self._schedule(partial(self._show_locus, state, (space, now, False), None))  # the eigenvalues at once
         if self.locus_lane.superseded:  # a newer value waits: its path, not this one, is worth computing
