@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import shutil
 import socket
 import subprocess
@@ -122,6 +123,8 @@ def main() -> int:
     from brakesqueal import resolve_space
     from brakesqueal.explorer.state import locus_view, map_view, slider_range
 
+    load_start = [round(x, 2) for x in os.getloadavg()]
+
     space = resolve_space(None, "paper-fig2", None, [])
     r_mu, r_k = slider_range(space, "mu"), slider_range(space, "k_ip")
     locus_view(space, "mu", r_mu)
@@ -201,7 +204,9 @@ def main() -> int:
                                float(np.median(maps)) / base_map,
                                details={"best [s]": round(best_map, 3), "target [s]": 1,
                                         "baseline": "map_view in-process (stability_map + refined boundary)"}))
+    load = [round(x, 2) for x in os.getloadavg()]  # the machine may be shared: compare runs at similar loads
     for r in results:
+        r.details["load average (1, 5, 15 min) at start / end"] = f"{load_start} / {load}"
         if not math.isfinite(r.value):
             return 1
     emit(results)
