@@ -108,14 +108,14 @@ def test_map_file_checks_its_input(tmp_path):
         f.close("a longer route name")
 
 
-def _tol_equal(a: xr.Dataset, b: xr.Dataset, eigen: bool) -> None:
-    """``a`` and ``b`` identical, ``max_real``/``frequency`` to rounding (other blocks, other warm starts)."""
+def _tol_equal(a: xr.Dataset, b: xr.Dataset, eigen: bool, rtol: float = 1e-11) -> None:
+    """``a`` and ``b`` identical, ``max_real``/``frequency`` to ``rtol`` (other blocks, other warm starts)."""
     if eigen:
         scale = max(np.nanmax(np.abs(a["max_real"].values)), 2 * np.pi * np.nanmax(a["frequency"].values))
         for v, f in (("max_real", 1.0), ("frequency", 2 * np.pi)):
             va, vb = a[v].values, b[v].values
             assert np.array_equal(np.isnan(va), np.isnan(vb))
-            assert f * np.nanmax(np.abs(va.astype(float) - vb)) <= 1e-11 * scale
+            assert f * np.nanmax(np.abs(va.astype(float) - vb)) <= rtol * scale
             b[v].values[...] = va
     _same(a, b)
 
@@ -125,16 +125,24 @@ def _tol_equal(a: xr.Dataset, b: xr.Dataset, eigen: bool) -> None:
     ("paper-fig2", Axis("k_ip", 1e5, 1e10, 41, log=True), Axis("mu", -0.1, 1.0, 37)),  # invalid points, a boundary
     ("paper-fig2", Axis("k_ip", 1e5, 1e6, 9, log=True), Axis("mu", 0.05, 0.06, 11)),  # no boundary on the map
     ("paper-fig3", Axis("mu1", 0.2, 0.8, 7), Axis("mu2", 0.2, 0.8, 5)),  # per-point route (non-trivial silent motion)
+    ("eight-dof", Axis("k_c", 1e8, 1e10, 14, log=True), Axis("k_cn", 5e6, 5e8, 11, log=True)),  # charpoly route
 ])
 def test_chunked_and_unchunked_writes_give_the_same_map(tmp_path, preset, x, y, eigen):
-    space = ParameterSpace.from_preset(preset)
+    from brakesqueal.model import resolve_space
+
+    space = resolve_space(preset) if preset == "eight-dof" else ParameterSpace.from_preset(preset)
     one, many = tmp_path / "one.nc", tmp_path / "many.nc"
     s1 = write_map(space, x, y, str(one), eigen=eigen, chunk_points=10**7)
-    s2 = write_map(space, x, y, str(many), eigen=eigen, chunk_points=1)  # one outer row per block
+    s2 = write_map(space, x, y, str(many), eigen=eigen, chunk_points=1)  # one point per block
     a, b = _read(one), _read(many)
-    _tol_equal(a, b, eigen)
+    # the characteristic-polynomial roots are accurate to 1e-9 (CHARPOLY_ACCURACY) whatever the warm start
+    _tol_equal(a, b, eigen, 1e-8 if preset == "eight-dof" else 1e-11)
     assert s1.stable_fraction == s2.stable_fraction == pytest.approx(float(a["stable"].values.mean()))
     assert s1.method == s2.method == a.attrs["method"]
+    if preset == "eight-dof":
+        from brakesqueal.analysis.kernels import CHARPOLY_ROUTE
+
+        assert s1.method == CHARPOLY_ROUTE
 
 
 @pytest.mark.parametrize("chunk", [15, 3 * 41 + 5])  # pieces of rows (15, 15, 11), three whole rows
