@@ -242,7 +242,7 @@ def _check_axes(space: object, axes: list[Axis], force: bool, eigen: bool, in_me
         hint = "; --no-eigen needs a fifth of it" if eigen else ""
         raise ParameterError(f"the map has {n:.3g} points: computing and writing it would take about "
                              f"{need / 2**30:.3g} GiB of memory (limit {MAX_MAP_BYTES / 2**30:g} GiB{hint}); use fewer "
-                             "points or a sweep (brakesqueal sweep), which writes chunks to a store")
+                             "points, write_map (the map command, bounded memory) or a sweep (brakesqueal sweep)")
 
 
 def classify_grid(space: object, x: Axis, y: Axis) -> tuple[np.ndarray, str, str]:
