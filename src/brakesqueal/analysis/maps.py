@@ -572,7 +572,7 @@ def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False
     Same results and file content as ``stability_map(...).to_netcdf(path)``
     (read back with :func:`brakesqueal.results.open_map` or
     :func:`xarray.open_dataset`), with less time and memory: each block of
-    ``chunk_points`` points (whole outer rows) is written to its place in the
+    ``chunk_points`` points (whole outer rows, or pieces of a longer row) is written to its place in the
     file (:class:`brakesqueal.results.MapFile`) as soon as it is computed;
     neither xarray nor the map's arrays are held (only ``stable`` and
     ``status`` of maps with at most :data:`BOUNDARY_MAX_POINTS` points, for the
