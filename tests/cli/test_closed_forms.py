@@ -12,6 +12,7 @@ import shutil
 import pytest
 
 from brakesqueal.cli import _closed_forms as data
+from brakesqueal import fingerprint
 from brakesqueal.cli import closed_forms, main
 from brakesqueal.render import render_closed_form
 
@@ -73,7 +74,7 @@ def test_fingerprint_follows_every_source(tmp_path, monkeypatch):
     assert closed_forms.fingerprint(data.SOURCES) == data.FINGERPRINT
     crlf.write_bytes(original)
     assert closed_forms.shipped_text("general", "text") is not None
-    monkeypatch.setattr(closed_forms, "_EXTERNAL", (("sympy", "__init__.py"), ("symengine", "_version.py")))
+    monkeypatch.setattr(fingerprint, "EXTERNAL", (("sympy", "__init__.py"), ("symengine", "_version.py")))
     assert closed_forms.shipped_text("general", "text") is None
 
 

@@ -20,9 +20,9 @@ Check, and regenerate after editing the derivation (or upgrading SymPy/symengine
 
 from __future__ import annotations
 
-import hashlib
-import importlib.util
 from pathlib import Path
+
+from ..fingerprint import sources_digest
 
 __all__ = ["CASES", "FORMATS", "shipped_text", "fingerprint", "derivation_sources", "live_texts", "data_source",
            "write_data"]
@@ -31,8 +31,6 @@ __all__ = ["CASES", "FORMATS", "shipped_text", "fingerprint", "derivation_source
 CASES: tuple[str, ...] = ("general", "symmetric", "asymmetric-friction", "minimal")
 #: Output formats of ``derive --format``.
 FORMATS: tuple[str, ...] = ("text", "latex", "json")
-#: Third-party files whose content enters the fingerprint (their printers and simplifications shape the text).
-_EXTERNAL = (("sympy", "release.py"), ("symengine", "_version.py"))
 _PKG = Path(__file__).resolve().parent.parent
 _DATA = Path(__file__).resolve().parent / "_closed_forms.py"
 
@@ -51,22 +49,7 @@ def fingerprint(sources: tuple[str, ...]) -> str:
         64 hex digits; a missing file hashes as ``missing`` (so it differs from any content), line
         endings are normalised to ``\\n``.
     """
-    h = hashlib.sha256()
-    for rel in sources:
-        try:
-            data = (_PKG / rel).read_bytes().replace(b"\r\n", b"\n")  # a CRLF checkout is the same source
-        except OSError:
-            data = b"missing"
-        h.update(f"{rel}\0{len(data)}\0".encode())
-        h.update(data)
-    for dist, rel in _EXTERNAL:
-        spec = importlib.util.find_spec(dist)
-        origin = Path(spec.origin).parent / rel if spec is not None and spec.origin else None
-        try:
-            h.update(dist.encode() + b"\0" + (origin.read_bytes() if origin else b"missing"))
-        except OSError:
-            h.update(dist.encode() + b"\0unreadable")
-    return h.hexdigest()
+    return sources_digest((rel, _PKG / rel) for rel in sources)
 
 
 def shipped_text(case: str, fmt: str) -> str | None:

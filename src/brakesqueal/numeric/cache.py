@@ -37,7 +37,6 @@ Adding a code generator
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import linecache
 import os
 import re
@@ -52,6 +51,7 @@ from typing import Any, Callable, Iterable, Mapping
 
 from .. import __version__
 from ..errors import BrakesquealError
+from ..fingerprint import sources_digest
 
 __all__ = [
     "GENERATOR_MODULES", "CacheError", "cache_root", "source_fingerprint", "version_dir", "entry_dir",
@@ -77,11 +77,9 @@ GENERATOR_MODULES: tuple[str, ...] = (
     "export/*.py",  # exported code and LaTeX
     "render.py",  # the rendered closed forms cached by ``derive``
     "nonlinear/*.py",  # compiled flows of the continuation (numba) and what they import
+    "fingerprint.py",  # the fingerprint itself
 )
 
-#: Third-party code generators: the content of these files (relative to the
-#: installed package) enters the fingerprint, so upgrading them regenerates the code.
-_EXTERNAL = (("sympy", "release.py"), ("symengine", "_version.py"))
 
 _HEADER = re.compile(rb"# brakesqueal-cache sha256=([0-9a-f]{64}) bytes=([0-9]+)")
 _NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
@@ -135,20 +133,8 @@ def source_fingerprint() -> str:
         12 hex digits; part of :func:`version_dir`, so any change to a file of
         :data:`GENERATOR_MODULES` starts a fresh cache.
     """
-    h = hashlib.sha256()
     pkg = _package_dir()
-    for f in generator_files():
-        data = f.read_bytes()
-        h.update(f"{f.relative_to(pkg).as_posix()}\0{len(data)}\0".encode())
-        h.update(data)
-    for dist, rel in _EXTERNAL:
-        spec = importlib.util.find_spec(dist)
-        origin = Path(spec.origin).parent / rel if spec is not None and spec.origin else None
-        try:
-            h.update(dist.encode() + b"\0" + (origin.read_bytes() if origin else b"missing"))
-        except OSError:
-            h.update(dist.encode() + b"\0unreadable")
-    return h.hexdigest()[:12]
+    return sources_digest((f.relative_to(pkg).as_posix(), f) for f in generator_files())[:12]
 
 
 def version_dir() -> Path:
