@@ -64,7 +64,8 @@ INFO_REST_MS = 250
 _LOG_FORMAT = "return Number((10 ** tick).toPrecision(3)).toExponential();"
 _MAP_PALETTE = ["#f3a5a5", "#a9cdf5", "#c8c8c8"]  # unstable, stable, no verdict
 #: Render level of what moves with every slider step (the current point, its markers): Bokeh repaints only
-#: the overlay layer of a plot when only overlay renderers changed, not its axes, grids and lines.
+#: the overlay layer of a plot when only overlay renderers changed, not its axes, grids and lines.  They have
+#: no legend entries (an overlay repaint erases their legend glyphs); titles and the map's legend text name them.
 _MOVING = "overlay"
 
 
@@ -470,13 +471,11 @@ class Explorer:
         pn = self.pn
         self.src_locus = ColumnDataSource(locus_lines(np.empty(0), np.empty((0, 0))))
         self.src_now = ColumnDataSource({"re": [], "im": []})
-        f = figure(height=330, width=420, title="eigenvalues along the path (root locus)",
+        f = figure(height=330, width=420, title="root locus along the path; red: the current eigenvalues",
                    x_axis_label="Re λ [1/s]", y_axis_label="Im λ [1/s]", tools="pan,wheel_zoom,box_zoom,reset")
         f.line("re", "im", source=self.src_locus, line_width=1.5, color="#4c72b0", alpha=0.8)
-        f.scatter("re", "im", source=self.src_now, size=9, color="#d62728", legend_label="current point",
-                  level=_MOVING)
+        f.scatter("re", "im", source=self.src_now, size=9, color="#d62728", level=_MOVING)
         f.add_layout(Span(location=0, dimension="height", line_color="black", line_dash="dashed", line_width=1))
-        f.legend.location = "top_left"
         f.css_classes = ["bs-locus"]
         self.fig_locus = f
         self.span_f = Span(location=0, dimension="height", line_color="#d62728", line_width=1, level=_MOVING)
@@ -549,14 +548,14 @@ class Explorer:
         from bokeh.plotting import figure
 
         st = self.state
-        f = figure(height=380, width=470, title="stability map (click to move there)",
+        f = figure(height=380, width=470, title="stability map (green cross: the current point; click to move there)",
                    x_axis_label=_label(self.space, st.x) + (" (log)" if x_log else ""),
                    y_axis_label=_label(self.space, st.y) + (" (log)" if y_log else ""),
                    tools="tap,pan,wheel_zoom,box_zoom,reset")
         f.image("image", x="x", y="y", dw="dw", dh="dh", source=self.src_map, color_mapper=self.map_mapper)
         f.line("x", "y", source=self.src_boundary, line_color="black", line_width=2, legend_label="boundary")
         f.scatter("x", "y", source=self.src_point, marker="cross", size=16, line_width=3, color="#2ca02c",
-                  legend_label="current point", level=_MOVING)
+                  level=_MOVING)
         f.legend.location = "bottom_right"
         f.title.text_font_size = "9pt"
         if x_log:
