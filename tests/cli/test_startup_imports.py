@@ -56,7 +56,7 @@ def test_warm_linearize_imports_no_heavy_module(args):
 
 @pytest.mark.parametrize("fmt", ["text", "latex", "json"])
 def test_cold_derive_imports_no_heavy_module_and_no_numpy(fmt, tmp_path):
-    """The paper's closed forms are shipped text (checked in test_closed_forms.py): no SymPy, nothing cached."""
+    """The paper's closed forms are shipped text (checked in test_derive_shipped.py): no SymPy, nothing cached."""
     res = _run("derive", "--case", "general", "--format", fmt, heavy=(*HEAVY, "numpy"),
                env={"BRAKESQUEAL_CACHE_DIR": str(tmp_path / "cache")})
     assert res["rc"] == 0 and res["out"].rstrip("\n") == TEXTS["general", fmt].rstrip("\n")

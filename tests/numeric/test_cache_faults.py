@@ -48,7 +48,7 @@ KINDS = {
     "built": (["linearize", "--model", "six-dof", "--format", "json"], f"*/{_key('six-dof')}/model.py"),
 }  # fmt: skip
 # (``derive`` of the paper's cases prints shipped text and caches nothing while that text is current:
-#  tests/cli/test_closed_forms.py covers its fallback to the cached derivation)
+#  tests/cli/test_derive_shipped.py covers its fallback to the cached derivation)
 
 
 def run(args: list[str], cache_dir: Path, cwd: Path, **env: str) -> subprocess.CompletedProcess:

@@ -9,7 +9,7 @@ matches the installed files, so a cold ``derive`` imports neither SymPy nor NumP
 When anything the derivation reads has changed, :func:`shipped_text` returns
 ``None`` and the command derives as before.
 
-``tests/cli/test_closed_forms.py`` checks every shipped text against the live
+``tests/cli/test_derive_shipped.py`` checks every shipped text against the live
 derivation, that the fingerprint is current and that it covers every code-generating
 module (:data:`brakesqueal.numeric.cache.GENERATOR_MODULES`) the derivation imports.
 Check, and regenerate after editing the derivation (or upgrading SymPy/symengine)::
