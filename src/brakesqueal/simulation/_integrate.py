@@ -23,8 +23,9 @@ METHODS: tuple[str, ...] = ("DOP853-jit", "DOP853", "RK45", "RK23", "Radau", "BD
 POINTS_PER_PERIOD = 20
 #: Largest deviation of the default start along the leading mode: tilt [rad] (a non-tilting disk: coordinate [m]).
 START_AMPLITUDE = 1e-5
-#: Wall time [s] of one call of the compiled integrator (between calls progress is reported and Ctrl-C acts).
-CHUNK_SECONDS = 0.1
+#: Wall time [s] of one call of the compiled integrator (between calls progress is reported, Ctrl-C acts and
+#: other threads get the interpreter lock: the explorer's server stays responsive while a simulation runs).
+CHUNK_SECONDS = 0.02
 #: Output samples post-processed per compiled call (about 0.1 s).
 _POST_BLOCK = 65536
 EventMode = Literal["stop", "continue", "off"]
