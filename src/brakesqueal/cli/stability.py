@@ -232,6 +232,9 @@ def cycles(
     contact: Annotated[str, typer.Option("--contact", help="bilateral: the branch is valid up to the first contact "
                                          "loss (located); unilateral: continued through lift-off and re-contact "
                                          "(F_n = max(0, .), slower).")] = "bilateral",
+    pad_slope: Annotated[Optional[float], typer.Option(
+        "--pad-slope", help="Keep the massless Coulomb pads' tangential rates, regularised by mu + S v "
+                            "(S in (0, 0.01] s/m; error O(S), e.g. 1e-4). Default: quasi-static pads.")] = None,
 ) -> None:
     """Limit cycles from the first Hopf point on a path: amplitude, frequency, stability, where a pad lifts off."""
     from ..analysis.maps import parse_axis
@@ -245,7 +248,12 @@ def cycles(
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     if out:
         check_output(out, what="--out", suffixes=(".nc",))
-    b = squeal_branch(space_from(model, preset, params, set_), axis, max_points=max_points, contact=contact)
+    space = space_from(model, preset, params, set_)
+    if pad_slope is not None:
+        from ..nonlinear.models import regularised_pads
+
+        space = regularised_pads(space, pad_slope)  # checked before anything is computed
+    b = squeal_branch(space, axis, max_points=max_points, contact=contact)
     if out:
         ds = b.data.copy()
         ds.attrs = {k: (json.dumps(v) if isinstance(v, (dict, list, tuple)) or v is None else v)
