@@ -235,7 +235,8 @@ def test_tilted_silent_motion_with_rigid_pads():
 def test_pad_slope_option_equals_the_model_file_route(rising_friction_model, capsys):
     """`squeal_branch(pad_slope=...)` / `cycles --pad-slope` build the same regularised model as the how-to's
     model file (an independent construction: TOML text vs. the spec rewritten in code)."""
-    from brakesqueal.nonlinear.models import regularised_pads, squeal_branch
+    from brakesqueal.model.options import regularised_pads
+    from brakesqueal.nonlinear.models import squeal_branch
 
     coulomb = resolve_space(None, None, None, ["k_ip=1e6"])
     toml = resolve_space(rising_friction_model, None, None, ["k_ip1=1e6", "k_ip2=1e6", "s=-1e-4"])
@@ -248,3 +249,13 @@ def test_pad_slope_option_equals_the_model_file_route(rising_friction_model, cap
     for bad in ("0", "-1e-4", "0.5", "nan"):
         assert main(["cycles", "--set", "k_ip=1e6", "--along", "Omega=60:120", "--pad-slope", bad]) == 2
         assert "pad_slope" in capsys.readouterr().err
+
+
+def test_simulate_with_regularised_pads(capsys):
+    """`simulate --pad-slope`: the pads' deformations become integrator states (their rates are kept)."""
+    assert main(["simulate", "--set", "k_ip=1e6", "--set", "Omega=90", "--t-end", "0.005", "--pad-slope", "1e-4",
+                 "--format", "json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["model"] == "paper+rising-pads" and d["t_end_reached"] == pytest.approx(0.005, abs=1 / 44100)
+    assert main(["simulate", "--set", "k_ip=1e6", "--t-end", "0.005", "--pad-slope", "1"]) == 2
+    assert "pad_slope" in capsys.readouterr().err

@@ -90,6 +90,9 @@ def _simulate_cmd(
         str, typer.Option("--contact", help="bilateral (pads stay pressed) | unilateral (F_n = max(0, .): pads lift "
                                             "off and come back; DOP853-jit only).")
     ] = "bilateral",
+    pad_slope: Annotated[Optional[float], typer.Option(
+        "--pad-slope", help="Keep the massless Coulomb pads' tangential rates, regularised by mu + S v "
+                            "(S in (0, 0.01] s/m; error O(S), e.g. 1e-4). Default: quasi-static pads.")] = None,
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Output samples per second [Hz].")] = 44100.0,
     out: Annotated[Optional[str], typer.Option("--out", help="Write the trajectory to this NetCDF file.")] = None,
     plot: Annotated[Optional[str], typer.Option("--plot", help="Write the plot (time history, phase, spectrum).")] = (
@@ -125,10 +128,11 @@ def _simulate_cmd(
     elif q0 is not None:
         init["perturbation"] = _floats(q0, "--q0")
     _check_outputs(out, plot, wav)
-    from ..model.options import resolve_space
+    from ..model.options import regularised_pads, resolve_space
     from ..interrupts import interrupt_guard
 
-    p = resolve_space(model, preset, params, list(set_ or [])).resolve({})
+    space = resolve_space(model, preset, params, list(set_ or []))
+    p = (space if pad_slope is None else regularised_pads(space, pad_slope)).resolve({})
     with interrupt_guard():  # nested in the program's guard (brakesqueal.cli.main), which ends a stuck run
         tr = _run(p, t_end, method, rtol, atol, events, sample_rate, progress, no_cache, {**init, "contact": contact})
         if wav and tr.t.size < 2:

@@ -250,7 +250,7 @@ def cycles(
         check_output(out, what="--out", suffixes=(".nc",))
     space = space_from(model, preset, params, set_)
     if pad_slope is not None:
-        from ..nonlinear.models import regularised_pads
+        from ..model.options import regularised_pads
 
         space = regularised_pads(space, pad_slope)  # checked before anything is computed
     b = squeal_branch(space, axis, max_points=max_points, contact=contact)

@@ -43,7 +43,7 @@ from .hopf import HopfResult, first_lyapunov
 from .system import PiecewiseSystem, SmoothSystem, Transition
 
 __all__ = ["model_system", "model_piecewise_system", "hopf_points", "HopfPoint",
-           "squeal_branch", "SquealBranch", "SquealSummary", "squeal_summary", "regularised_pads", "MAX_PAD_SLOPE"]
+           "squeal_branch", "SquealBranch", "SquealSummary", "squeal_summary"]
 
 
 def model_system(space: Any, name: str, *, use_cache: bool = True) -> SmoothSystem:
@@ -358,66 +358,6 @@ def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = 
                              ex.contact_loss, ex.sliding_reversal, ex.tilt_at_contact_loss,
                              ex.tilt_at_sliding_reversal))
     return out
-
-
-#: Largest pad slope accepted by :func:`regularised_pads` [s/m] (it changes ``l1`` by O(slope)).
-MAX_PAD_SLOPE = 1e-2
-
-
-def regularised_pads(space: Any, slope: float) -> Any:
-    """``space`` with the pads' tangential rates made regular: Coulomb friction replaced by ``mu + slope v``.
-
-    Every massless pad with Coulomb friction and a finite tangential stiffness gets the rising law
-    ``mu(v) = mu + slope v`` (the law ``linear`` with the field ``slope = -slope``).  Its rate is then a
-    regular state of the explicit equations (pad mode ``~ -k_ip / (N0 slope)``), so the simulation and the
-    limit-cycle branches keep it; as ``slope -> 0`` their normal form tends to the Coulomb pads' exact one
-    (:func:`~.implicit.exact_lyapunov`) at rate O(slope).  The price is also O(slope): the friction level at
-    the silent motion rises by ``slope * Omega * r`` (paper's model, ``k_ip = 1e6``, ``slope = 1e-4``: the
-    onset moves by 0.6 %, ``l1`` by 2.4 %).  Smaller slopes make the pad mode faster (``1e-5`` already
-    defeats the explicit integrator there).
-
-    Parameters
-    ----------
-    space : ParameterSpace
-        The model, preset and overrides.
-    slope : float
-        ``d mu / d v`` [s/m], in ``(0, MAX_PAD_SLOPE]``.
-
-    Returns
-    -------
-    ParameterSpace
-        The same preset and overrides on the modified model (named ``<model>+rising-pads``); ``space``
-        itself when no pad needs it.
-
-    Raises
-    ------
-    ParameterError
-        ``slope`` out of range.
-    """
-    from dataclasses import replace
-
-    from ..errors import ParameterError
-    from ..model.components import FrictionLaw
-
-    try:
-        value = float(slope)
-    except (TypeError, ValueError):
-        value = math.nan
-    if not (0 < value <= MAX_PAD_SLOPE):
-        raise ParameterError(f"The option 'pad_slope' must be in (0, {MAX_PAD_SLOPE:g}] s/m; got {slope!r}")
-    spec = space.resolve({}).model
-    pads, changed = [], False
-    for pad in spec.pads:
-        massless = "tangential" not in pad.dofs
-        finite = not (isinstance(pad.k_ip, (int, float)) and math.isinf(pad.k_ip))
-        if massless and finite and pad.friction.law == "coulomb":
-            pad = replace(pad, friction=FrictionLaw("linear", pad.friction.mu, slope=-value))
-            changed = True
-        pads.append(pad)
-    if not changed:
-        return space
-    new = replace(spec, name=f"{spec.name}+rising-pads", pads=tuple(pads))
-    return type(space)(space.preset.bind(new), dict(space.values))
 
 
 def _periodic_min(values: np.ndarray) -> np.ndarray:
@@ -749,8 +689,9 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
         onset do not depend on the requested range.
     pad_slope : float, optional
         Continue with the pads' tangential rates kept, regularised by a slightly rising friction law
-        (:func:`regularised_pads`; error O(pad_slope)).  Default: massless Coulomb pads are quasi-static
-        in the branch (exact only to first order at the onset; :attr:`HopfPoint.simulated`).
+        (:func:`~brakesqueal.model.options.regularised_pads`; error O(pad_slope)).  Default: massless Coulomb
+        pads are quasi-static in the branch (exact only to first order at the onset;
+        :attr:`HopfPoint.simulated`).
 
     Notes
     -----
@@ -779,6 +720,8 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
     if contact not in ("bilateral", "unilateral"):
         raise ParameterError(f"The option 'contact' must be bilateral or unilateral; got {contact!r}")
     if pad_slope is not None:
+        from ..model.options import regularised_pads
+
         space = regularised_pads(space, pad_slope)
     pts = [hp for hp in hopf_points(space, axis, use_cache=use_cache)
            if hp.branch_start is not None and hp.branch_start.side]
