@@ -35,6 +35,9 @@ SetOpt = Annotated[Optional[list[str]], typer.Option(
     rich_help_panel="Model")]
 FormatOpt = Annotated[OutFormat, typer.Option("--format", help="Output format.")]
 NoCacheOpt = Annotated[bool, typer.Option("--no-cache", help="Derive in-process; do not read or write the cache.")]
+PadSlopeOpt = Annotated[Optional[float], typer.Option(
+    "--pad-slope", help="Keep the massless Coulomb pads' tangential rates, regularised by mu + S v "
+                        "(S in (0, 0.01] s/m; error O(S), e.g. 1e-4). Default: quasi-static pads.")]
 ProgressOpt = Annotated[Optional[bool], typer.Option(
     "--progress/--no-progress", help="Progress on stderr (default: a bar on a terminal, periodic lines otherwise).")]
 

@@ -13,6 +13,7 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ..errors import ParameterError
+from ._options import ModelOpt, PadSlopeOpt, ParamsOpt, PresetOpt, SetOpt, space_from
 
 __all__ = ["register"]
 
@@ -58,16 +59,7 @@ def _check_outputs(out: str | None, plot: str | None, wav: str | None) -> None:
 
 
 def _simulate_cmd(
-    model: Annotated[
-        Optional[str], typer.Option("--model", help="Model TOML file or built-in model (default: the paper's model).")
-    ] = None,
-    preset: Annotated[
-        Optional[str], typer.Option("--preset", help="Named parameter template (default paper-fig2).")
-    ] = None,
-    params: Annotated[Optional[str], typer.Option("--params", help="TOML parameter file.")] = None,
-    set_: Annotated[
-        Optional[list[str]], typer.Option("--set", help="Override NAME=VALUE (repeatable; VALUE may be 'inf').")
-    ] = None,
+    model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
     t_end: Annotated[float, typer.Option("--t-end", help="Simulated time [s].")] = 0.5,
     q0: Annotated[
         Optional[str],
@@ -90,9 +82,7 @@ def _simulate_cmd(
         str, typer.Option("--contact", help="bilateral (pads stay pressed) | unilateral (F_n = max(0, .): pads lift "
                                             "off and come back; DOP853-jit only).")
     ] = "bilateral",
-    pad_slope: Annotated[Optional[float], typer.Option(
-        "--pad-slope", help="Keep the massless Coulomb pads' tangential rates, regularised by mu + S v "
-                            "(S in (0, 0.01] s/m; error O(S), e.g. 1e-4). Default: quasi-static pads.")] = None,
+    pad_slope: PadSlopeOpt = None,
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Output samples per second [Hz].")] = 44100.0,
     out: Annotated[Optional[str], typer.Option("--out", help="Write the trajectory to this NetCDF file.")] = None,
     plot: Annotated[Optional[str], typer.Option("--plot", help="Write the plot (time history, phase, spectrum).")] = (
@@ -128,10 +118,10 @@ def _simulate_cmd(
     elif q0 is not None:
         init["perturbation"] = _floats(q0, "--q0")
     _check_outputs(out, plot, wav)
-    from ..model.options import regularised_pads, resolve_space
     from ..interrupts import interrupt_guard
+    from ..model.options import regularised_pads
 
-    space = resolve_space(model, preset, params, list(set_ or []))
+    space = space_from(model, preset, params, set_)
     p = (space if pad_slope is None else regularised_pads(space, pad_slope)).resolve({})
     with interrupt_guard():  # nested in the program's guard (brakesqueal.cli.main), which ends a stuck run
         tr = _run(p, t_end, method, rtol, atol, events, sample_rate, progress, no_cache, {**init, "contact": contact})

@@ -17,7 +17,8 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ..errors import ParameterError
-from ._options import FormatOpt, ModelOpt, OutFormat, ParamsOpt, PresetOpt, ProgressOpt, SetOpt, space_from
+from ._options import (FormatOpt, ModelOpt, OutFormat, PadSlopeOpt, ParamsOpt, PresetOpt, ProgressOpt, SetOpt,
+                       space_from)
 
 __all__ = ["register"]
 
@@ -232,9 +233,7 @@ def cycles(
     contact: Annotated[str, typer.Option("--contact", help="bilateral: the branch is valid up to the first contact "
                                          "loss (located); unilateral: continued through lift-off and re-contact "
                                          "(F_n = max(0, .), slower).")] = "bilateral",
-    pad_slope: Annotated[Optional[float], typer.Option(
-        "--pad-slope", help="Keep the massless Coulomb pads' tangential rates, regularised by mu + S v "
-                            "(S in (0, 0.01] s/m; error O(S), e.g. 1e-4). Default: quasi-static pads.")] = None,
+    pad_slope: PadSlopeOpt = None,
 ) -> None:
     """Limit cycles from the first Hopf point on a path: amplitude, frequency, stability, where a pad lifts off."""
     from ..analysis.maps import parse_axis
