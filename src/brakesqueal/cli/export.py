@@ -8,9 +8,11 @@ from __future__ import annotations
 
 import sys
 from enum import Enum
-from typing import Annotated, Any, Optional
+from typing import Annotated, Any
 
 import typer
+
+from ._options import ModelOpt, ParamsOpt, PresetOpt, SetOpt, space_from
 
 __all__ = ["register", "describe_source"]
 
@@ -66,21 +68,10 @@ def _export_cmd(
             "the zero state (refused unless that is the silent motion).",
         ),
     ] = What.nonlinear,
-    model: Annotated[
-        Optional[str], typer.Option("--model", help="Model TOML file or built-in model name (default: the paper's).")
-    ] = None,
-    preset: Annotated[
-        Optional[str],
-        typer.Option("--preset", help="Named parameter template for parameters() (default: the model's)."),
-    ] = None,
-    params: Annotated[Optional[str], typer.Option("--params", help="TOML parameter file for parameters().")] = None,
-    set_: Annotated[
-        Optional[list[str]], typer.Option("--set", help="Override NAME=VALUE (repeatable; VALUE may be 'inf').")
-    ] = None,
+    model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
 ) -> None:
     """Write any model's equations (nonlinear or closed-form linear) as C, Octave, Julia, Python or LaTeX."""
     from ..export import TARGETS, check_name, export_code
-    from ..model.options import resolve_space
     from ..outputs import atomic_write, check_output
 
     suffix = TARGETS[to.value]
@@ -88,7 +79,7 @@ def _export_cmd(
     name = "brakesqueal_model" if path is None else path.stem
     check_name(name, to.value)
     sets = list(set_ or [])
-    space = resolve_space(model, preset, params, sets)
+    space = space_from(model, preset, params, sets)
     source = describe_source(space, model, params, sets)
     text = export_code(to.value, what.value, space.resolve({}), name=name, source=source)  # type: ignore[arg-type]
     if path is None:
