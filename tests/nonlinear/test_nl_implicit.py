@@ -259,3 +259,16 @@ def test_simulate_with_regularised_pads(capsys):
     assert d["model"] == "paper+rising-pads" and d["t_end_reached"] == pytest.approx(0.005, abs=1 / 44100)
     assert main(["simulate", "--set", "k_ip=1e6", "--t-end", "0.005", "--pad-slope", "1"]) == 2
     assert "pad_slope" in capsys.readouterr().err
+
+
+def test_predictions_stay_in_the_parameter_range():
+    """Along k_ip (Fig. 2's A and B) a leading-order extrapolation can leave k_ip > 0: it is not reported."""
+    space = ParameterSpace.from_preset("paper-fig2", {"mu": 0.5})
+    pts = hopf_points(space, Axis("k_ip", 1e5, 1e10, log=True))
+    assert len(pts) == 2 and all(hp.hopf is not None for hp in pts)
+    for hp in pts:
+        for v in (hp.contact_loss, hp.sliding_reversal):
+            assert v is None or v > 0
+        if hp.sliding_reversal is not None:  # on the side where the cycles exist
+            assert (hp.sliding_reversal - hp.hopf.p0) * hp.hopf.side > 0
+    assert pts[0].contact_loss is None  # the extrapolation gave k_ip < 0 here

@@ -78,7 +78,8 @@ class PadHopf:
         The normal form in the state ``(Q, Qdot, L_kept)`` of the exact linearization.
     contact_loss : float or None
         Parameter value where the predicted cycle's smallest normal force reaches zero
-        (leading order in the amplitude); ``None`` if it does not fall or there are no cycles.
+        (leading order in the amplitude); ``None`` if it does not fall, there are no cycles, or the
+        extrapolation leaves the parameter's allowed range.
     sliding_reversal : float or None
         Parameter value where a pad's sliding velocity (pad rate included) first reverses on the
         predicted cycle: the end of the model's validity range.
@@ -246,7 +247,22 @@ def exact_lyapunov(space: Any, name: str, p0: float, *, omega: float | None = No
                     pt.state(h11.astype(complex), 0.0).real, multilinear="finite-difference", refined=refined,
                     state_names=names, parameter_name=name, warnings=warnings)  # fmt: skip
     loss, rev, t_loss, t_rev = _events(pt, sim, h, w0, X1, phi)
+    if not _valid(space, name, loss):  # a leading-order extrapolation out of the parameter's range
+        loss, t_loss = None, None
+    if not _valid(space, name, rev):
+        rev, t_rev = None, None
     return PadHopf(h, loss, rev, t_loss, t_rev)
+
+
+def _valid(space: Any, name: str, value: float | None) -> bool:
+    """Whether ``value`` is an allowed value of the path parameter (bounds of the parameter table)."""
+    if value is None:
+        return False
+    try:
+        space.resolve({name: float(value)})
+    except ParameterError:
+        return False
+    return True
 
 
 def _vectors(pt: _Point, w0: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
