@@ -1299,6 +1299,16 @@ def _cp_point(b, rb, m, z, part, w, rad, eigen, acc, maxit):  # type: ignore[no-
 
 
 @numba.njit(**_JIT)
+def _cp_workspace(m, db1):  # type: ignore[no-untyped-def]
+    """Work arrays of the characteristic-polynomial sweeps (degree ``m``, ``db1`` coefficient columns):
+    ``T, RT`` (coefficient tables), ``c, rc, b, rb`` (polynomial and rounding bounds), ``z, w`` (roots and
+    updates), ``rad`` (inclusion radii), ``part`` (cluster labels)."""
+    return (np.empty((m + 1, db1)), np.empty((m + 1, db1)), np.empty(m + 1), np.empty(m + 1), np.empty(m + 1),
+            np.empty(m + 1), np.empty(m, dtype=np.complex128), np.empty(m, dtype=np.complex128), np.empty(m),
+            np.empty(m, dtype=np.int64))
+
+
+@numba.njit(**_JIT)
 def charpoly_grid(Q, RQ, xo, yi, valid, eigen, acc, codes, mr, fr):  # type: ignore[no-untyped-def]
     """Certified verdicts (and ``max Re λ``, frequency) from the exact characteristic polynomial on a grid.
 
@@ -1317,17 +1327,7 @@ def charpoly_grid(Q, RQ, xo, yi, valid, eigen, acc, codes, mr, fr):  # type: ign
     UNDECIDED (the caller recomputes them) and NaN.
     """
     m = Q.shape[0] - 1
-    db1 = Q.shape[2]
-    T = np.empty((m + 1, db1))
-    RT = np.empty((m + 1, db1))
-    c = np.empty(m + 1)
-    rc = np.empty(m + 1)
-    b = np.empty(m + 1)
-    rb = np.empty(m + 1)
-    z = np.empty(m, dtype=np.complex128)
-    w = np.empty(m, dtype=np.complex128)
-    rad = np.empty(m)
-    part = np.empty(m, dtype=np.int64)
+    T, RT, c, rc, b, rb, z, w, rad, part = _cp_workspace(m, Q.shape[2])
     hist = np.empty((3, m), dtype=np.complex128)  # roots (λ units) at the last decided points of the row
     row0 = np.empty(m, dtype=np.complex128)  # roots at the first decided point of the previous row
     part0 = np.empty(m, dtype=np.int64)
@@ -1396,17 +1396,7 @@ def charpoly_points(Q, RQ, xs, ys, eigen, acc, codes, mr, fr):  # type: ignore[n
     """:func:`charpoly_grid` at scattered points ``(xs[k], ys[k])``; each point warm-starts from the previous
     decided one (neighbours along a boundary curve), else from the companion matrix."""
     m = Q.shape[0] - 1
-    db1 = Q.shape[2]
-    T = np.empty((m + 1, db1))
-    RT = np.empty((m + 1, db1))
-    c = np.empty(m + 1)
-    rc = np.empty(m + 1)
-    b = np.empty(m + 1)
-    rb = np.empty(m + 1)
-    z = np.empty(m, dtype=np.complex128)
-    w = np.empty(m, dtype=np.complex128)
-    rad = np.empty(m)
-    part = np.empty(m, dtype=np.int64)
+    T, RT, c, rc, b, rb, z, w, rad, part = _cp_workspace(m, Q.shape[2])
     prev = np.empty(m, dtype=np.complex128)
     prevp = np.empty(m, dtype=np.int64)
     have = False
