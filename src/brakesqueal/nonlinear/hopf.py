@@ -41,7 +41,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..errors import BrakesquealError, ParameterError
-from .system import EPS, H_FIRST, H_SECOND, SmoothSystem
+from .system import EPS, H_FIRST, H_SECOND, SmoothSystem, step_plateau
 
 __all__ = ["HopfResult", "CycleGuess", "first_lyapunov", "hopf_result"]
 
@@ -512,30 +512,11 @@ def first_lyapunov(system: SmoothSystem, x0: Any, p0: float, *, refine: bool = T
             # badly scaled states (SI units, stiff pads): the default step is off the plateau (truncation above it,
             # rounding below); take the step of a geometric sequence (64x larger to 4^10 smaller) where consecutive
             # results agree best, with the agreement on both sides as the error
-            seq: list[tuple[complex, np.ndarray, np.ndarray, float, float]] = []
-            best: tuple[float, int] | None = None
-            rising = 0
-            for k in range(-3, 11):
-                try:
-                    seq.append((c1, h20, h11, terms, kap) if k == 0 else
-                               _c1(system, x, p, A, w0, q, pv, step_factor=4.0 ** -k))  # fmt: skip
-                except (BrakesquealError, np.linalg.LinAlgError):  # a large step left the equations' domain
-                    if k < 0:
-                        continue
-                    break
-                if len(seq) < 2:
-                    continue
-                d = abs(seq[-1][0] - seq[-2][0])
-                if best is None or d < best[0]:
-                    best, rising = (d, len(seq) - 1), 0
-                else:
-                    rising += 1
-                    if rising >= 2 and best[0] <= 1e-4 * abs(seq[best[1]][0]):
-                        break
-            assert best is not None
-            j = best[1]
-            c1, h20, h11, terms, kap = seq[j]
-            fd_err = max(best[0], abs(seq[j + 1][0] - c1) if j + 1 < len(seq) else best[0])
+            at_default = (c1, h20, h11, terms, kap)
+            (c1, h20, h11, terms, kap), before, after = step_plateau(
+                lambda f: at_default if f == 1.0 else _c1(system, x, p, A, w0, q, pv, step_factor=f),
+                range(-3, 11), skip=(BrakesquealError, np.linalg.LinAlgError))
+            fd_err = max(before, after)
     err_round = 10 * EPS * (kap + _eig_condition(A, w0, q, pv)) * terms
     err_off = abs(lam_k.real) / max(abs(lam_k), 1e-300) * terms
     c1_err = fd_err + err_round + err_off

@@ -63,7 +63,7 @@ import numpy as np
 
 from ..errors import BrakesquealError, ParameterError
 from .hopf import HopfResult, _skeel, hopf_result
-from .system import EPS, H_FIRST, H_SECOND, fd_bilinear, fd_trilinear
+from .system import EPS, H_FIRST, H_SECOND, fd_bilinear, fd_trilinear, step_plateau
 
 __all__ = ["PadHopf", "exact_lyapunov"]
 
@@ -317,22 +317,9 @@ def _c1(pt: _Point, w0: float, phi: np.ndarray, psi: np.ndarray,
         rnd = 10 * EPS * kap * sum(abs(v) for v in t) / abs(den) / 2
         return complex(-sum(t) / den / 2), h20, h11, rnd
 
-    vals, best, rising = [at(1.0)], None, 0
-    for k in range(1, 13):
-        vals.append(at(4.0 ** -k))
-        d = abs(vals[-1][0] - vals[-2][0])
-        if best is None or d < best[0]:
-            best, rising = (d, k), 0
-        else:
-            rising += 1
-            if (rising >= 2 and best[0] <= 1e-4 * abs(vals[best[1]][0])) or best[0] <= 1e-8 * abs(vals[best[1]][0]):
-                break
-    assert best is not None
-    k = best[1]
-    c1, h20, h11, rnd = vals[k]
+    (c1, h20, h11, rnd), before, after = step_plateau(at, range(0, 13), settle=1e-8)
     # the agreement with both neighbours of the chosen step (a plateau, not a crossing of two curves)
-    after = abs(vals[k + 1][0] - c1) if k + 1 < len(vals) else best[0]
-    err = 2 * max(best[0], after) + rnd + 1e3 * EPS * abs(c1)
+    err = 2 * max(before, after) + rnd + 1e3 * EPS * abs(c1)
     return c1, err, h20, h11, X1 * T
 
 

@@ -44,6 +44,7 @@ import numpy as np
 from ..errors import ParameterError
 
 __all__ = [
+    "step_plateau",
     "SmoothSystem",
     "Transition",
     "PiecewiseSystem",
@@ -195,6 +196,66 @@ def fd_trilinear(jac: Fun, x: Vec, p: float, u: Vec, v: Vec, w: Vec, *, step: fl
     if not (np.iscomplexobj(u) or np.iscomplexobj(v) or np.iscomplexobj(w)):
         val = val.real
     return val, float(np.max(E @ np.abs(w))) if w.size else 0.0
+
+
+def step_plateau(evaluate: Callable[[float], tuple[Any, ...]], exponents: range, *, settle: float = 0.0,
+                 skip: tuple[type[BaseException], ...] = ()) -> tuple[tuple[Any, ...], float, float]:
+    """The finite-difference step ``4**-k`` (``k`` in ``exponents``) where consecutive results agree best.
+
+    Above the plateau truncation changes the result, below it rounding does; the step with the smallest
+    change from the previous one is taken.  The scan stops two steps after that minimum once it is below
+    ``1e-4`` of the value, or as soon as a change is below ``settle`` of the value.
+
+    Parameters
+    ----------
+    evaluate : callable
+        ``evaluate(factor) -> tuple`` whose first entry is the (complex) value compared.
+    exponents : range
+        The ``k`` tried, increasing (negative ``k``: steps larger than the default).
+    settle : float
+        Relative change small enough to stop at once (0: never).
+    skip : tuple of exception types
+        Failures of ``evaluate`` that are not errors: skipped for ``k < 0`` (a large step left the
+        equations' domain), the end of the scan otherwise.
+
+    Returns
+    -------
+    result, before, after : tuple, float, float
+        ``evaluate`` at the chosen step and its changes from the neighbouring steps (``after`` is
+        ``before`` at the end of the scan).
+
+    Raises
+    ------
+    BrakesquealError
+        Fewer than two steps gave a result.
+    """
+    from ..errors import BrakesquealError
+
+    seq: list[tuple[Any, ...]] = []
+    best: tuple[float, int] | None = None
+    rising = 0
+    for k in exponents:
+        try:
+            seq.append(evaluate(4.0 ** -k))
+        except skip:
+            if k < 0:
+                continue
+            break
+        if len(seq) < 2:
+            continue
+        d = abs(seq[-1][0] - seq[-2][0])
+        if best is None or d < best[0]:
+            best, rising = (d, len(seq) - 1), 0
+        else:
+            rising += 1
+            size = abs(seq[best[1]][0])
+            if (rising >= 2 and best[0] <= 1e-4 * size) or best[0] <= settle * size:
+                break
+    if best is None:
+        raise BrakesquealError("no two finite-difference steps gave a result")
+    j = best[1]
+    after = abs(seq[j + 1][0] - seq[j][0]) if j + 1 < len(seq) else best[0]
+    return seq[j], best[0], after
 
 
 def fd_dp(fun: Callable[[np.ndarray, float], Any], x: Vec, p: float, *, step: float | None = None) -> np.ndarray:
