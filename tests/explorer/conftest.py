@@ -54,7 +54,9 @@ def server() -> Iterator[str]:
     if why:
         pytest.skip(why)
     port = _free_port()
-    proc = subprocess.Popen([sys.executable, "-m", "brakesqueal", "explore", "--no-browser", "--port", str(port)],
+    # _gated_server.py is `python -m brakesqueal` plus the cancel test's gate (see its docstring)
+    proc = subprocess.Popen([sys.executable, str(Path(__file__).with_name("_gated_server.py")), "explore",
+                             "--no-browser", "--port", str(port)],
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     deadline = time.monotonic() + 60
     try:
