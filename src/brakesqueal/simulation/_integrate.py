@@ -707,8 +707,12 @@ def simulate(
         sliding reversal, where Coulomb friction would stick) or
         ``"continue"`` (sliding reversals recorded, the friction direction
         follows ``v_r/|v_r|``).  Not available for pads with rate-dependent
-        friction (their tangential deformation is a state whose law while
-        lifted off is not modelled).
+        friction (their tangential deformation is a state): ``ldot`` enters
+        the pad's balance ``G(Q, Qdot, l, ldot) = 0`` through the friction
+        force and ``F_n``, so ``dG/dldot`` shrinks with ``F_n`` (at ``F_n = 0``
+        only the support damper's share is left) and can change sign while
+        the pad is still pressed: the pad mode ``-G_l / G_ldot`` diverges
+        before lift-off (``docs/simulation.md``, unilateral contact).
 
     Returns
     -------
@@ -778,8 +782,11 @@ def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sampl
     unilateral = contact == "unilateral"
     if unilateral and model.dynamic:
         raise ParameterError(f"contact='unilateral' is not available for pads with rate-dependent friction "
-                             f"({', '.join(model.dynamic)}): their tangential deformation is a state whose law "
-                             "while lifted off is not modelled; use coulomb friction or contact='bilateral'")
+                             f"({', '.join(model.dynamic)}): their rate ldot solves the friction balance G(Q, Qdot, l, "
+                             "ldot) = 0, whose slope dG/dldot shrinks with F_n (to the support damper's share at "
+                             "F_n = 0) and can change sign before F_n = 0, so the pad mode diverges before the "
+                             "pad lifts off (docs/simulation.md, unilateral contact); use coulomb friction or "
+                             "contact='bilateral'")
     try:
         st = model.silent(params)
     except SilentMotionError as exc:

@@ -1,0 +1,114 @@
+"""Unilateral contact with pads whose tangential deformation is a state (rate-dependent friction): refused, and why.
+
+The pads of ``regularised_pads(space, slope)`` (friction ``mu + slope v``) keep their tangential rate
+``ldot`` as the root of the friction balance ``G(Q, Qdot, l, ldot) = 0``.  ``ldot`` enters ``G`` through the
+friction force ``F_n mu(v) t_p`` and through ``F_n`` itself (the support damper acts on ``hdot``, which
+depends on ``ldot`` on a tilted disk), so ``dG/dldot`` shrinks with ``F_n``: at ``F_n = 0`` only the damper's
+share is left.  On the paper-fig3 parameters (``mu = 0.5``, ``k_ip = 1e6``, slope ``1e-4``, ``Omega = 130``)
+the tests below show, with the generated ``pad_balance`` and central differences of it (independent of its
+generated derivative), that ``dG/dldot`` falls by more than two orders of magnitude while ``F_n`` falls from
+the preload to about 115 N (integrated) and changes sign while the pad is still pressed (the last 2.5 us
+extrapolated to first order from the last integrated state, the root ``ldot`` followed): the pad mode ``-G_l/G_ldot``
+passes through infinity and becomes unstable before lift-off.  The compiled integrator consequently fails
+there (before any ``F_n`` reaches 0), which is why ``contact="unilateral"`` refuses these pads instead of
+modelling a lift-off it cannot reach.  (Measured 2026-11-27: ``dG/dldot`` changes sign at ``F_n`` about 98 N.)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from brakesqueal.errors import ParameterError
+from brakesqueal.model.options import regularised_pads, resolve_space
+from brakesqueal.simulation import simulate, simulation_model
+
+SETS = ["mu1=0.5", "mu2=0.5", "k_ip1=1e6", "k_ip2=1e6"]
+
+
+@pytest.fixture(scope="module")
+def case():
+    space = regularised_pads(resolve_space(preset="paper-fig3", sets=SETS), 1e-4)
+    params = space.resolve({"Omega": 130.0})
+    sim = simulation_model(params.model)
+    assert sim.pad_kinds == ("dynamic", "dynamic")
+    st = sim.silent(params)
+    modes = sim.linear_modes(params)
+    v = np.real(modes.right[:, 0])
+    x0 = st.y + 5e-3 * v / np.abs(v[:2]).max()  # a tilt of 5 mrad along the leading mode: F_n swings by ~3 kN
+    tr = simulate(sim, params, 3e-4, x0=x0, contact="bilateral", events="off", sample_rate=1e8)
+    return sim, params, st, x0, tr
+
+
+def test_unilateral_contact_refuses_dynamic_pads_and_names_them(case):
+    sim, params, st, x0, _tr = case
+    with pytest.raises(ParameterError, match=r"rate-dependent friction \(l1, l2\).*dG/dldot"):
+        simulate(sim, params, 1e-3, x0=x0, contact="unilateral", events="continue")
+
+
+def _G(sim, p, y, l, dl, j):
+    g = np.empty(2 * l.size + 1)
+    sim.kernels.pad_balance(np.ascontiguousarray(y), l, dl, p, g)
+    return g[j], g[l.size + j]
+
+
+def _dG_fd(sim, p, y, l, dl, j):
+    """Central difference of the generated G_j in ldot_j (step 1e-4 m/s; independent of the generated dG/dldot)."""
+    e = 1e-4
+    a, b = dl.copy(), dl.copy()
+    a[j] += e
+    b[j] -= e
+    return (_G(sim, p, y, l, a, j)[0] - _G(sim, p, y, l, b, j)[0]) / (2 * e)
+
+
+def test_the_pressed_pad_rate_balance_degenerates_before_lift_off(case):
+    sim, params, st, _x0, tr = case
+    p = sim.parameter_vector(params)
+    # the pressed equations cannot be integrated to F_n = 0: the run fails while every pad is still pressed
+    assert tr.status == "failed"
+    ok = np.isfinite(tr.contact[:, 0, 0])
+    Fn = tr.contact[ok, :, 0]
+    assert Fn.min() > 50.0  # N: no pad reached F_n = 0
+    i = int(np.flatnonzero(ok)[-1])
+    j = int(np.argmin(tr.contact[i, :, 0]))  # the pad approaching lift-off
+    y, l, dl = tr.y[i], tr.l[i].copy(), tr.l_rates[i].copy()
+    # generated derivative against central differences, at the start and at the last state
+    for yy, ll, dd in ((tr.y[0], tr.l[0].copy(), tr.l_rates[0].copy()), (y, l, dl)):
+        g, gd = _G(sim, p, yy, ll, dd, j)
+        assert abs(g) < 1e-12
+        assert gd == pytest.approx(_dG_fd(sim, p, yy, ll, dd, j), rel=1e-5)
+    gd0, gd1 = _G(sim, p, tr.y[0], tr.l[0].copy(), tr.l_rates[0].copy(), j)[1], _G(sim, p, y, l, dl, j)[1]
+    assert gd0 > 0 and gd1 > 0  # G_l = 1: the pad mode -1/G_ldot is stable so far ...
+    assert gd1 < 0.01 * gd0  # ... but more than 100 times faster than at the start (F_n: ~3 kN -> ~115 N)
+    # continue the approach to lift-off (the state extrapolated along its rate, l along ldot) and follow the
+    # root ldot of G_j: its slope changes sign while F_n > 0 (a fold of the rate balance before lift-off)
+    f = np.empty(y.size)
+    sim.kernels.rhs(np.ascontiguousarray(y), l.copy(), dl.copy(), p, st.ztol, np.empty(2 * l.size + 1),
+                    np.empty(sim.n * sim.n + sim.n), f)
+    cb = np.empty(7 * len(sim.pads))
+    root = dl[j]
+    slopes, forces = [], []
+    for dt in np.linspace(0.0, 2.5e-6, 11):
+        ys, ls = y + f * dt, l + dl * dt
+
+        def G(d, ys=ys, ls=ls):
+            dd = dl.copy()
+            dd[j] = d
+            return _G(sim, p, ys, ls, dd, j)[0]
+
+        grid = root + np.linspace(-2.0, 2.0, 401)  # the root moves by < 2 m/s per step
+        vals = np.array([G(d) for d in grid])
+        k = np.flatnonzero(np.sign(vals[:-1]) != np.sign(vals[1:]))
+        assert k.size, "no root of the rate balance near the followed one"
+        k0 = k[np.argmin(np.abs(grid[k] - root))]
+        root = brentq(G, grid[k0], grid[k0 + 1], xtol=1e-12)
+        dd = dl.copy()
+        dd[j] = root
+        sim.kernels.contact(np.ascontiguousarray(ys), ls, dd, p, cb)
+        forces.append(cb[7 * j])
+        slopes.append(_dG_fd(sim, p, ys, ls, dd, j))
+    forces, slopes = np.array(forces), np.array(slopes)
+    assert slopes[0] > 0 and slopes.min() < 0
+    first = int(np.flatnonzero(slopes < 0)[0])
+    assert forces[first] > 20.0  # N: the slope has changed sign while the pad is still pressed
