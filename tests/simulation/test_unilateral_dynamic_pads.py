@@ -7,11 +7,11 @@ depends on ``ldot`` on a tilted disk), so ``dG/dldot`` shrinks with ``F_n``: at 
 share is left.  On the paper-fig3 parameters (``mu = 0.5``, ``k_ip = 1e6``, slope ``1e-4``, ``Omega = 130``)
 the tests below show, with the generated ``pad_balance`` and central differences of it (independent of its
 generated derivative), that ``dG/dldot`` falls by more than two orders of magnitude while ``F_n`` falls from
-the preload to about 115 N (integrated) and changes sign while the pad is still pressed (the last 2.5 us
-extrapolated to first order from the last integrated state, the root ``ldot`` followed): the pad mode ``-G_l/G_ldot``
-passes through infinity and becomes unstable before lift-off.  The compiled integrator consequently fails
+the preload to about 100-115 N (integrated), and that the root ``ldot`` folds (``dG/dldot = 0``) while the pad
+is still pressed (followed along a first-order extrapolation from the last state with ``F_n >= 200 N``):
+the pad mode ``-G_l/G_ldot`` passes through infinity before lift-off.  The compiled integrator consequently fails
 there (before any ``F_n`` reaches 0), which is why ``contact="unilateral"`` refuses these pads instead of
-modelling a lift-off it cannot reach.  (Measured 2026-11-27: ``dG/dldot`` changes sign at ``F_n`` about 98 N.)
+modelling a lift-off it cannot reach.  (Measured 2026-11-27: the fold at ``F_n`` about 97-105 N.)
 """
 
 from __future__ import annotations
@@ -81,15 +81,18 @@ def test_the_pressed_pad_rate_balance_degenerates_before_lift_off(case):
     gd0, gd1 = _G(sim, p, tr.y[0], tr.l[0].copy(), tr.l_rates[0].copy(), j)[1], _G(sim, p, y, l, dl, j)[1]
     assert gd0 > 0 and gd1 > 0  # G_l = 1: the pad mode -1/G_ldot is stable so far ...
     assert gd1 < 0.01 * gd0  # ... but more than 100 times faster than at the start (F_n: ~3 kN -> ~115 N)
-    # continue the approach to lift-off (the state extrapolated along its rate, l along ldot) and follow the
-    # root ldot of G_j: its slope changes sign while F_n > 0 (a fold of the rate balance before lift-off)
+    # from the last integrated state with F_n >= 200 N (independent of how far the integrator gets), continue the
+    # approach to lift-off to first order (state along its rate, l along ldot) and follow the root ldot of G_j:
+    # before F_n reaches 0 its slope dG/dldot falls to 0 (the followed root meets another one and disappears: a
+    # fold of the rate balance, where the pad mode -G_l/G_ldot passes through infinity)
+    i = int(np.flatnonzero(ok & (tr.contact[:, j, 0] >= 200.0))[-1])
+    y, l, dl = tr.y[i], tr.l[i].copy(), tr.l_rates[i].copy()
     f = np.empty(y.size)
     sim.kernels.rhs(np.ascontiguousarray(y), l.copy(), dl.copy(), p, st.ztol, np.empty(2 * l.size + 1),
                     np.empty(sim.n * sim.n + sim.n), f)
     cb = np.empty(7 * len(sim.pads))
-    root = dl[j]
-    slopes, forces = [], []
-    for dt in np.linspace(0.0, 2.5e-6, 11):
+    root, start, end_force = dl[j], None, None
+    for dt in np.linspace(0.0, 6e-6, 121):
         ys, ls = y + f * dt, l + dl * dt
 
         def G(d, ys=ys, ls=ls):
@@ -97,18 +100,24 @@ def test_the_pressed_pad_rate_balance_degenerates_before_lift_off(case):
             dd[j] = d
             return _G(sim, p, ys, ls, dd, j)[0]
 
-        grid = root + np.linspace(-2.0, 2.0, 401)  # the root moves by < 2 m/s per step
-        vals = np.array([G(d) for d in grid])
-        k = np.flatnonzero(np.sign(vals[:-1]) != np.sign(vals[1:]))
-        assert k.size, "no root of the rate balance near the followed one"
-        k0 = k[np.argmin(np.abs(grid[k] - root))]
-        root = brentq(G, grid[k0], grid[k0 + 1], xtol=1e-12)
         dd = dl.copy()
         dd[j] = root
         sim.kernels.contact(np.ascontiguousarray(ys), ls, dd, p, cb)
-        forces.append(cb[7 * j])
-        slopes.append(_dG_fd(sim, p, ys, ls, dd, j))
-    forces, slopes = np.array(forces), np.array(slopes)
-    assert slopes[0] > 0 and slopes.min() < 0
-    first = int(np.flatnonzero(slopes < 0)[0])
-    assert forces[first] > 20.0  # N: the slope has changed sign while the pad is still pressed
+        force = cb[7 * j]
+        assert force > 0.0, "the followed root reached F_n = 0"
+        grid = root + np.linspace(-1.0, 1.0, 201)
+        vals = np.array([G(d) for d in grid])
+        k = np.flatnonzero(np.sign(vals[:-1]) != np.sign(vals[1:]))
+        if not k.size:
+            end_force = force  # the followed root has disappeared (fold)
+            break
+        k0 = k[np.argmin(np.abs(grid[k] - root))]
+        root = brentq(G, grid[k0], grid[k0 + 1], xtol=1e-12)
+        dd[j] = root
+        slope = _dG_fd(sim, p, ys, ls, dd, j)
+        start = slope if start is None else start
+        if slope <= 0.0:
+            end_force = force  # the slope has changed sign
+            break
+    assert start is not None and start > 0
+    assert end_force is not None and end_force > 20.0  # N: the rate balance folds while the pad is still pressed
