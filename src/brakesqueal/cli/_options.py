@@ -38,6 +38,9 @@ NoCacheOpt = Annotated[bool, typer.Option("--no-cache", help="Derive in-process;
 PadSlopeOpt = Annotated[Optional[float], typer.Option(
     "--pad-slope", help="Keep the massless Coulomb pads' tangential rates, regularised by mu + S v "
                         "(S in (0, 0.01] s/m; error O(S), e.g. 1e-4). Default: quasi-static pads.")]
+StickSpeedOpt = Annotated[Optional[float], typer.Option(
+    "--stick-speed", help="With --pad-slope: regularise stick-slip too, mu v / sqrt(v^2 + V^2) + S v (V in (0, 1] m/s; "
+                          "a sticking pad creeps at speeds of order V; error O(V), e.g. 1e-3).")]
 ProgressOpt = Annotated[Optional[bool], typer.Option(
     "--progress/--no-progress", help="Progress on stderr (default: a bar on a terminal, periodic lines otherwise).")]
 
@@ -45,6 +48,23 @@ ProgressOpt = Annotated[Optional[bool], typer.Option(
 def note(message: str) -> None:
     """One informational line on stderr (``brakesqueal: note: ...``)."""
     print(f"brakesqueal: note: {message}", file=sys.stderr)
+
+
+def pads_option(space: Any, pad_slope: float | None, stick_speed: float | None) -> Any:
+    """``space`` with the pads of ``--pad-slope`` and ``--stick-speed``.
+
+    See :func:`brakesqueal.model.options.regularised_pads`.
+    """
+    from ..errors import ParameterError
+
+    if pad_slope is None:
+        if stick_speed is not None:
+            raise ParameterError("--stick-speed regularises the pads of --pad-slope; give --pad-slope too "
+                                 "(e.g. --pad-slope 1e-4 --stick-speed 1e-3)")
+        return space
+    from ..model.options import regularised_pads
+
+    return regularised_pads(space, pad_slope, stick_speed)
 
 
 def space_from(model: str | None, preset: str | None, params: str | None, sets: list[str] | None) -> Any:

@@ -18,7 +18,7 @@ import typer
 
 from ..errors import ParameterError
 from ._options import (FormatOpt, ModelOpt, OutFormat, PadSlopeOpt, ParamsOpt, PresetOpt, ProgressOpt, SetOpt,
-                       space_from)
+                       StickSpeedOpt, pads_option, space_from)
 
 __all__ = ["register"]
 
@@ -234,6 +234,7 @@ def cycles(
                                          "loss (located); unilateral: continued through lift-off and re-contact "
                                          "(F_n = max(0, .), slower).")] = "bilateral",
     pad_slope: PadSlopeOpt = None,
+    stick_speed: StickSpeedOpt = None,
 ) -> None:
     """Limit cycles from the first Hopf point on a path: amplitude, frequency, stability, where a pad lifts off."""
     from ..analysis.maps import parse_axis
@@ -248,10 +249,7 @@ def cycles(
     if out:
         check_output(out, what="--out", suffixes=(".nc",))
     space = space_from(model, preset, params, set_)
-    if pad_slope is not None:
-        from ..model.options import regularised_pads
-
-        space = regularised_pads(space, pad_slope)  # checked before anything is computed
+    space = pads_option(space, pad_slope, stick_speed)  # checked before anything is computed
     b = squeal_branch(space, axis, max_points=max_points, contact=contact)
     if out:
         ds = b.data.copy()

@@ -15,7 +15,18 @@ law        fields                             ``mu(v)``
 coulomb    ``mu``                             ``mu`` (the paper's model, eqs. 31-32)
 linear     ``mu``, ``slope``                  ``mu - slope v`` (falling for ``slope > 0``)
 stribeck   ``mu``, ``mu_s``, ``v_s``          ``mu + (mu_s - mu) exp(-v / v_s)``
+stick      ``mu``, ``v_reg``, ``slope``       ``mu v / sqrt(v^2 + v_reg^2) - slope v``
 ========== ================================== ==========================================
+
+``stick`` is Coulomb friction with *regularised stick-slip*: the friction force
+``mu(|v_r|) F_n v_r / |v_r| = F_n (mu / sqrt(|v_r|^2 + v_reg^2) - slope) v_r``
+is smooth through ``v_r = 0`` and bounded by ``mu F_n`` plus the slope's term.
+A pad that should stick creeps instead, at a relative speed below
+``v_reg |f_t| / sqrt((mu F_n)^2 - f_t^2)`` (``f_t`` its tangential spring force),
+and sliding reversals (the pad faster than the disk) are ordinary motion.  With
+``slope < 0`` (a rising term) a massless pad's tangential rate is a regular
+state whose balance has a root for every spring force.  The error against
+set-valued Coulomb stick-slip is O(``v_reg``) plus O(``slope``) (``docs/simulation.md``, stick-slip).
 """
 
 from __future__ import annotations
@@ -70,25 +81,34 @@ class LawDef:
     rate_dependent : bool
         Whether ``mu`` depends on ``v``; a massless pad with such a law keeps
         its tangential rate as a first-order state (``docs/theory.md``).
+    text : str
+        The formula as shown to users (model-file schema, ``brakesqueal show``).
     """
 
     name: str
     fields: Mapping[str, FieldDef]
     formula: Callable[[Any, Any, Mapping[str, Any]], Any]
     rate_dependent: bool
+    text: str = ""
 
 
 _MU = FieldDef("", "kinetic friction coefficient at {owner}", 0.0, _INF, False, True)
 
 #: Every friction law, by name.
 LAWS: Mapping[str, LawDef] = MappingProxyType({law.name: law for law in (
-    LawDef("coulomb", {}, lambda sm, v, f: f["mu"], rate_dependent=False),
+    LawDef("coulomb", {}, lambda sm, v, f: f["mu"], rate_dependent=False, text="mu(v) = mu"),
     LawDef("linear", {"slope": FieldDef("s/m", "friction slope -dmu/dv at {owner}", -_INF, _INF, True, True)},
-           lambda sm, v, f: f["mu"] - f["slope"] * v, rate_dependent=True),
+           lambda sm, v, f: f["mu"] - f["slope"] * v, rate_dependent=True, text="mu(v) = mu - slope * v"),
     LawDef("stribeck", {"mu_s": FieldDef("", "static friction coefficient (Stribeck) at {owner}", 0.0, _INF,
                                          False, True),
                         "v_s": FieldDef("m/s", "Stribeck speed at {owner}", 0.0, _INF, True, True)},
-           lambda sm, v, f: f["mu"] + (f["mu_s"] - f["mu"]) * sm.exp(-v / f["v_s"]), rate_dependent=True),
+           lambda sm, v, f: f["mu"] + (f["mu_s"] - f["mu"]) * sm.exp(-v / f["v_s"]), rate_dependent=True,
+           text="mu(v) = mu + (mu_s - mu) * exp(-v / v_s)"),
+    LawDef("stick", {"v_reg": FieldDef("m/s", "stick-slip regularisation speed at {owner}", 0.0, _INF, True, True),
+                     "slope": FieldDef("s/m", "friction slope -dmu/dv (beyond stick) at {owner}", -_INF, _INF,
+                                       True, True)},
+           lambda sm, v, f: f["mu"] * v / sm.sqrt(v**2 + f["v_reg"] ** 2) - f["slope"] * v, rate_dependent=True,
+           text="mu(v) = mu * v / sqrt(v^2 + v_reg^2) - slope * v"),
 )})
 
 #: The field every law has.

@@ -9,7 +9,8 @@ from typing import Any
 from ..errors import ParameterError
 from .parameters import ParameterSpace, Parameters, parse_sets
 
-__all__ = ["resolve_space", "resolve_parameters", "regularised_pads", "DEFAULT_PRESET", "MAX_PAD_SLOPE"]
+__all__ = ["resolve_space", "resolve_parameters", "regularised_pads", "DEFAULT_PRESET", "MAX_PAD_SLOPE",
+           "MAX_STICK_SPEED"]
 
 #: The preset used when neither a model, a preset nor a parameter file is given.
 DEFAULT_PRESET = "paper-fig2"
@@ -112,9 +113,22 @@ def resolve_parameters(model: Any = None, preset: str | None = None, params: str
 
 #: Largest pad slope accepted by :func:`regularised_pads` [s/m] (it changes ``l1`` by O(slope)).
 MAX_PAD_SLOPE = 1e-2
+#: Largest stick-slip regularisation speed accepted by :func:`regularised_pads` [m/s].
+MAX_STICK_SPEED = 1.0
 
 
-def regularised_pads(space: Any, slope: float) -> Any:
+def _in_range(option: str, value: Any, high: float, unit: str) -> float:
+    """``value`` as a float in ``(0, high]``, else a ParameterError naming ``option``."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        x = math.nan
+    if not (0 < x <= high):
+        raise ParameterError(f"The option '{option}' must be in (0, {high:g}] {unit}; got {value!r}")
+    return x
+
+
+def regularised_pads(space: Any, slope: float, stick_speed: float | None = None) -> Any:
     """``space`` with the pads' tangential rates made regular: Coulomb friction replaced by ``mu + slope v``.
 
     Every massless pad with Coulomb friction and a finite tangential stiffness gets the rising law ``mu(v) =
@@ -132,6 +146,13 @@ def regularised_pads(space: Any, slope: float) -> Any:
         The model, preset and overrides.
     slope : float
         ``d mu / d v`` [s/m], in ``(0, MAX_PAD_SLOPE]``.
+    stick_speed : float, optional
+        Also regularise stick-slip: the law ``stick`` (:mod:`~brakesqueal.model.friction`),
+        ``mu(v) = mu v / sqrt(v^2 + stick_speed^2) + slope v``, so that the friction force is smooth through
+        zero relative velocity and a pad that would stick creeps at a relative speed of order
+        ``stick_speed`` [m/s], in ``(0, MAX_STICK_SPEED]``.  Sliding reversals are then ordinary motion
+        (``docs/simulation.md``, stick-slip); the error is O(``stick_speed``) besides O(``slope``), and the
+        friction level at the silent motion falls by about ``mu stick_speed^2 / (2 (Omega r)^2)``.
 
     Returns
     -------
@@ -142,28 +163,26 @@ def regularised_pads(space: Any, slope: float) -> Any:
     Raises
     ------
     ParameterError
-        ``slope`` out of range.
+        ``slope`` or ``stick_speed`` out of range.
     """
     from dataclasses import replace
 
     from .components import FrictionLaw
 
-    try:
-        value = float(slope)
-    except (TypeError, ValueError):
-        value = math.nan
-    if not (0 < value <= MAX_PAD_SLOPE):
-        raise ParameterError(f"The option 'pad_slope' must be in (0, {MAX_PAD_SLOPE:g}] s/m; got {slope!r}")
+    value = _in_range("pad_slope", slope, MAX_PAD_SLOPE, "s/m")
+    v_reg = None if stick_speed is None else _in_range("stick_speed", stick_speed, MAX_STICK_SPEED, "m/s")
     spec = space.resolve({}).model
     pads, changed = [], False
     for pad in spec.pads:
         massless = "tangential" not in pad.dofs
         finite = not (isinstance(pad.k_ip, (int, float)) and math.isinf(pad.k_ip))
         if massless and finite and pad.friction.law == "coulomb":
-            pad = replace(pad, friction=FrictionLaw("linear", pad.friction.mu, slope=-value))
+            law = (FrictionLaw("linear", pad.friction.mu, slope=-value) if v_reg is None
+                   else FrictionLaw("stick", pad.friction.mu, v_reg=v_reg, slope=-value))
+            pad = replace(pad, friction=law)
             changed = True
         pads.append(pad)
     if not changed:
         return space
-    new = replace(spec, name=f"{spec.name}+rising-pads", pads=tuple(pads))
+    new = replace(spec, name=f"{spec.name}+{'rising-pads' if v_reg is None else 'stick-slip-pads'}", pads=tuple(pads))
     return type(space)(space.preset.bind(new), dict(space.values))

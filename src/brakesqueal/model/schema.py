@@ -147,9 +147,7 @@ def _disk() -> dict[str, Any]:
 
 def _law_text(law: Any) -> str:
     fields = ", ".join(["mu", *law.fields])
-    formulas = {"coulomb": "mu(v) = mu", "linear": "mu(v) = mu - slope * v",
-                "stribeck": "mu(v) = mu + (mu_s - mu) * exp(-v / v_s)"}  # fmt: skip
-    formula = formulas.get(law.name)
+    formula = law.text
     return f"{law.name}: {formula} (fields: {fields})" if formula else f"{law.name} (fields: {fields})"
 
 

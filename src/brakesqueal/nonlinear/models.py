@@ -660,7 +660,8 @@ class SquealBranch:
 
 def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: bool = True,
                   tol: float = 1e-8, contact: str = "bilateral", ds: float | None = None,
-                  ds_max: float = 0.05, pad_slope: float | None = None) -> SquealBranch:
+                  ds_max: float = 0.05, pad_slope: float | None = None,
+                  stick_speed: float | None = None) -> SquealBranch:
     """Continue the limit cycles from the first Hopf point on a path and find where a pad loses contact.
 
     Parameters
@@ -692,6 +693,10 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
         (:func:`~brakesqueal.model.options.regularised_pads`; error O(pad_slope)).  Default: massless Coulomb
         pads are quasi-static in the branch (exact only to first order at the onset;
         :attr:`HopfPoint.simulated`).
+    stick_speed : float, optional
+        With ``pad_slope``: regularise stick-slip too (the law ``stick``, a sticking pad creeps at speeds of
+        order ``stick_speed``; error O(stick_speed)).  Sliding reversals are then ordinary motion: they are
+        still reported per point (``sliding_reversal``) but do not end the model's validity.
 
     Notes
     -----
@@ -722,7 +727,10 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
     if pad_slope is not None:
         from ..model.options import regularised_pads
 
-        space = regularised_pads(space, pad_slope)
+        space = regularised_pads(space, pad_slope, stick_speed)
+    elif stick_speed is not None:
+        raise ParameterError("stick_speed regularises the pads of pad_slope; give pad_slope too")
+    stick = any(pad.friction.law == "stick" for pad in space.resolve({}).model.pads)
     pts = [hp for hp in hopf_points(space, axis, use_cache=use_cache)
            if hp.branch_start is not None and hp.branch_start.side]
     if not pts:
@@ -790,7 +798,7 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
                              float(p[i]), float(values[i]), guess(i), ptol=ptol)
 
     loss = located(worst, 0)  # the grazing orbit is a bilateral orbit: shot with the smooth system
-    end = located(margin, 1) if contact == "bilateral" else None
+    end = located(margin, 1) if contact == "bilateral" and not stick else None
     import xarray as xr
 
     pad_c = {"pad": list(sim.pads)}
@@ -807,7 +815,8 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
     ds["tilt_amplitude"] = xr.DataArray(amp, dims=("point",), attrs={"units": "rad", "long_name":
                                         "largest first-harmonic amplitude of the disk tilt"})
     ds["sliding_reversal"] = xr.DataArray(reversal, dims=("point",), attrs={"long_name": "a pressed pad's sliding "
-                                          "velocity reverses on the cycle (outside the model's validity)"})
+                                          "velocity reverses on the cycle " + ("(regularised stick-slip)" if stick
+                                                                               else "(outside the model's validity)")})
     ds["in_contact"] = xr.DataArray(worst > 0, dims=("point",),
                                     attrs={"long_name": "every pad pressed over the whole period (bilateral "
                                                         "equations valid)"})
@@ -815,6 +824,7 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
     ds.attrs["contact_loss_predicted"] = np.nan if predicted is None else predicted
     ds.attrs["validity_end"] = np.nan if end is None else end
     ds.attrs["contact"] = contact
+    ds.attrs["stick_slip"] = "regularised" if stick else "none"
     out = SquealBranch(hp, br, loss, tuple(sim.pads), contact)
     summ = squeal_summary(out)
     ds.attrs["summary"] = json.dumps(summ.to_dict(), default=float)
@@ -860,8 +870,9 @@ def squeal_summary(branch: SquealBranch) -> SquealSummary:
             hyst = (min(f, onset), max(f, onset))
     rev = ds["sliding_reversal"].values.astype(bool)
     located_end = float(ds.attrs.get("validity_end", np.nan))
+    stick = ds.attrs.get("stick_slip") == "regularised"  # a sliding reversal is then ordinary motion
     validity_end = located_end if math.isfinite(located_end) else (float(p[np.flatnonzero(rev)[0]])
-                                                                    if rev.any() else None)
+                                                                    if rev.any() and not stick else None)
     tab = []
     for i in range(p.size):
         tab.append({"p": float(p[i]), "frequency_hz": float(ds["frequency"].values[i]),

@@ -278,7 +278,7 @@ def solve_pads(y, l, dl, p, ztol, g):
         for j in range(_M):
             d = g[j] / g[_M + j]
             if not abs(d) < 1e300:
-                return False
+                return _solve_pads_bracketed(y, l, dl, p, ztol, g)
             if _KIND[j] == 0:
                 l[j] -= d
                 z = l[j]
@@ -289,7 +289,86 @@ def solve_pads(y, l, dl, p, ztol, g):
                 done = False
         if done:
             return True
-    return False
+    return _solve_pads_bracketed(y, l, dl, p, ztol, g)
+
+
+@njit(cache=True)
+def _pad_value(y, l, dl, p, g, j, z):
+    """G_j and dG_j/dz_j with pad j's unknown set to z (the other pads' entries are not used)."""
+    if _KIND[j] == 0:
+        l[j] = z
+    else:
+        dl[j] = z
+    pad_balance(y, l, dl, p, g)
+    return g[j], g[_M + j]
+
+
+@njit(cache=True)
+def _solve_pads_bracketed(y, l, dl, p, ztol, g):
+    """The fallback of solve_pads when Newton from the warm start fails: per pad, a sign change of G_j is
+    bracketed by steps doubling away from 0 (the silent motion's value) in the descent direction, then the
+    root is found by Newton steps kept inside the bracket (bisection otherwise).  Needed where G_j is nearly
+    a step (a pad near stick with regularised stick-slip, ``docs/simulation.md``): Newton overshoots there.
+    The converged solutions of solve_pads are unchanged; only its failures are retried.
+    """
+    for j in range(_M):
+        a = 0.0
+        ga, da = _pad_value(y, l, dl, p, g, j, a)
+        if not abs(ga) < 1e300:
+            return False
+        if ga == 0.0:
+            continue
+        h = 1e-6 + ztol[j]
+        sgn = -1.0 if ga * da > 0.0 else 1.0  # towards the root of a monotone G_j
+        found = False
+        b, gb = a, ga
+        for _ in range(400):
+            b = a + sgn * h
+            gb, db = _pad_value(y, l, dl, p, g, j, b)
+            if not abs(gb) < 1e300:
+                return False
+            if (gb > 0.0) != (ga > 0.0) or gb == 0.0:
+                found = True
+                break
+            a, ga = b, gb
+            h *= 2.0
+            if h > 1e30:
+                break
+        if not found:
+            return False
+        # now G_j(a) and G_j(b) differ in sign: Newton inside [lo, hi], bisection when it leaves
+        lo, hi, glo = (a, b, ga) if a < b else (b, a, gb)
+        z = b
+        gz, dz = gb, db
+        ok = False
+        for _ in range(400):
+            step_ok = abs(dz) > 0.0 and abs(gz / dz) < 1e300
+            zn = z - gz / dz if step_ok else 0.5 * (lo + hi)
+            if not (lo < zn < hi):
+                zn = 0.5 * (lo + hi)
+            if abs(zn - z) <= 1e-13 * abs(zn) + ztol[j] or hi - lo <= 2e-13 * abs(zn) + 2.0 * ztol[j]:
+                z = zn
+                ok = True
+                break
+            z = zn
+            gz, dz = _pad_value(y, l, dl, p, g, j, z)
+            if not abs(gz) < 1e300:
+                return False
+            if gz == 0.0:
+                ok = True
+                break
+            if (gz > 0.0) == (glo > 0.0):
+                lo, glo = z, gz
+            else:
+                hi = z
+        if not ok:
+            return False
+        if _KIND[j] == 0:
+            l[j] = z
+        else:
+            dl[j] = z
+    pad_balance(y, l, dl, p, g)
+    return True
 
 
 @njit(cache=True)
