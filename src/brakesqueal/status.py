@@ -7,9 +7,9 @@ codes, never on message text.
 
 from __future__ import annotations
 
-from enum import IntEnum
+from enum import Enum, IntEnum
 
-__all__ = ["PointStatus", "STATUS_MEANINGS", "status_of_error"]
+__all__ = ["PointStatus", "RunStatus", "STATUS_MEANINGS", "status_of_error"]
 
 
 class PointStatus(IntEnum):
@@ -33,6 +33,22 @@ class PointStatus(IntEnum):
     def meaning(self) -> str:
         """Snake-case meaning (``"no_silent_motion"``)."""
         return _MEANINGS[self]
+
+
+class RunStatus(str, Enum):
+    """How a simulation run ended (:attr:`brakesqueal.simulation.Trajectory.status`).
+
+    A ``str`` enum: it compares equal to its value (``status == "finished"``), is written as that string in
+    JSON and NetCDF attributes, and is decided by the integrator's return code, never by message text.
+    """
+
+    FINISHED = "finished"                  #: reached the end time
+    CONTACT_LOSS = "contact-loss"          #: stopped at a pad's contact loss (``events="stop"``)
+    SLIDING_REVERSAL = "sliding-reversal"  #: stopped at a pad's sliding reversal (``events="stop"``)
+    FAILED = "failed"                      #: the integration failed (the message says why)
+
+    def __str__(self) -> str:
+        return str(self.value)
 
 
 _MEANINGS = {

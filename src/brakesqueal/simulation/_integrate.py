@@ -11,6 +11,7 @@ from typing import Any, Callable, Literal, Sequence
 import numpy as np
 
 from ..errors import BrakesquealError, ParameterError, SilentMotionError
+from ..status import RunStatus
 from .estimate import LinearModes, linear_modes
 from .trajectory import EstimationRecord, Trajectory
 
@@ -936,14 +937,15 @@ class _Run:
         pad = self.model.pads[k % self.npad]
         return (("contact-loss", "sliding-reversal", "re-contact")[k // self.npad]), pad
 
-    def _status(self, code: int, t: float, k_event: int, t_event: float | None) -> tuple[str, str]:
+    def _status(self, code: int, t: float, k_event: int, t_event: float | None) -> tuple[RunStatus, str]:
         if code == 0:
-            return "finished", "reached the end time"
+            return RunStatus.FINISHED, "reached the end time"
         if code == 1:
             kind, pad = self._event_name(k_event)
             if kind == "contact-loss":
-                return kind, f"pad '{pad}' lost contact (F_n <= 0) at t = {t_event:.6g} s"
-            return kind, f"sliding at pad '{pad}' reversed (v_r . v_r0 <= 0) at t = {t_event:.6g} s"
+                return RunStatus.CONTACT_LOSS, f"pad '{pad}' lost contact (F_n <= 0) at t = {t_event:.6g} s"
+            return (RunStatus.SLIDING_REVERSAL,
+                    f"sliding at pad '{pad}' reversed (v_r . v_r0 <= 0) at t = {t_event:.6g} s")
         reason = {
             -1: "step size became too small",
             -2: "the state became non-finite or the pad equations G = 0 could not be solved",
@@ -951,7 +953,7 @@ class _Run:
             -4: "a pad's contact switched twice within 10 minimal steps (chattering contact, e.g. a pad pressed "
                 "with zero force while the disk moves along its surface)",
         }.get(code, f"integrator error {code}")
-        return "failed", f"integration failed at t = {t:.6g} s: {reason}"
+        return RunStatus.FAILED, f"integration failed at t = {t:.6g} s: {reason}"
 
     def jit(self, max_steps: int) -> dict[str, Any]:
         from ._interrupt import check_interrupt

@@ -426,7 +426,8 @@ class Trajectory:
     Attributes
     ----------
     status, message : str
-        How the run ended (see :class:`Summary`) and a one-line explanation.
+        How the run ended (a :class:`~brakesqueal.status.RunStatus`, which is a ``str``; see
+        :class:`Summary`) and a one-line explanation.
     t : ndarray, shape (N,)
         Uniform output times [s].
     y : ndarray, shape (N, 2n + k)
@@ -788,7 +789,7 @@ class Trajectory:
         e = self.energy()
         audio, what = self.audio_velocity()
         attrs: dict[str, Any] = {
-            "status": self.status, "message": self.message, "model": self.model, "method": self.method,
+            "status": str(self.status), "message": self.message, "model": self.model, "method": self.method,
             "rtol": self.rtol, "atol": self.atol.tolist(), "t_start": self.t_span[0], "t_end": self.t_span[1],
             "parameters": json.dumps(self.params.to_json_dict()),
             "t_event": math.nan if self.t_event is None else self.t_event,
