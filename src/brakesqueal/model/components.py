@@ -5,6 +5,14 @@ A component field is either a number or the *name* of a model parameter
 parameters.  Validation happens when a spec is built and names the component
 in every message.
 
+This module is the one definition of the components: every field carries its
+metadata (:func:`param`: the role's unit, meaning, interval and a schema
+note; :func:`attribute`: the schema fragment of a non-parameter field), and
+:data:`COMPONENTS` registers each kind (its model-file table, list or single
+table, how messages name it).  Roles (:mod:`.roles`), model files
+(:mod:`.io`) and the schema (:mod:`.schema`) are derived from them
+(``docs/extending.md``).
+
 Physical conventions (see ``docs/model-builder.md``):
 
 * A pad at angle ``angle_deg`` sits at ``Rz(angle) (0, -radius, 0)``; the
@@ -25,27 +33,30 @@ Physical conventions (see ``docs/model-builder.md``):
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
 import re
+import sys
+import textwrap
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal, Union
 
 from ..errors import ParameterError
 from .expressions import RESERVED_NAMES
+from .friction import FieldDef
 
 if TYPE_CHECKING:
     from .parameters import Preset
     from .roles import ParameterRoles
 
-__all__ = ["Value", "FrictionLaw", "Disk", "Pad", "Caliper", "ModelSpec", "MAX_PADS", "MAX_COORDINATES"]
+__all__ = ["Value", "FrictionLaw", "Disk", "Pad", "Caliper", "ModelSpec", "MAX_PADS", "MAX_COORDINATES", "Kind",
+           "COMPONENTS", "param", "attribute", "components"]
 
 Value = Union[float, str]
 FACES = ("upper", "lower")
 _NAME = re.compile(r"^\w+$", re.ASCII)
-
-
-def _is_name(v: object) -> bool:
-    return isinstance(v, str)
 
 
 def _check_value(
@@ -65,6 +76,87 @@ def _check_value(
         raise ParameterError(f"{component}: {field_name} must be a number or a parameter name; got {v!r}")
     if math.isnan(v) or (math.isinf(v) and not (allow_inf and v > 0)):
         raise ParameterError(f"{component}: {field_name} must be finite{' or +inf' if allow_inf else ''}; got {v}")
+
+
+# ------------------------------------------------------------------------------------- field definitions
+# The one description of every component field (parameters: role and schema note; others: schema fragment);
+# roles.py, io.py, schema.py and the classes' Parameters sections (_document) are derived from it.
+_INF = math.inf
+_MAX_FLOAT = sys.float_info.max
+_POS = (0.0, _INF, True, True)      # (0, inf)
+_NONNEG = (0.0, _INF, False, True)  # [0, inf)
+_REAL = (-_INF, _INF, True, True)   # (-inf, inf)
+_POS_INF = (0.0, _INF, True, False)  # (0, inf]
+
+
+def param(default: Any, unit: str, description: str, interval: tuple[float, float, bool, bool], note: str = "",
+          *, unless: str | None = None) -> Any:
+    """A component field holding a number or a parameter name: its *role* and schema note in the field's metadata.
+
+    Parameters
+    ----------
+    default : float, str or None
+        Default value (a parameter name, a number, or ``None`` for an optional field).
+    unit, description : str
+        SI unit (``""``: dimensionless) and meaning, a template with ``{owner}`` (``"pad '1' (upper face)"``).
+    interval : tuple of (float, float, bool, bool)
+        ``(low, high, low_open, high_open)``; ``high = inf`` with ``high_open = False`` allows ``+inf``.
+    note : str, optional
+        Extra sentence(s) for the model-file schema (starting with a space).
+    unless : str, optional
+        A flag field of the component; when it is false the field does not enter the equations (still
+        checked; its role comes after the used ones).
+    """
+    return field(default=default, metadata={"role": FieldDef(unit, description, *interval), "note": note,
+                                            "unless": unless})
+
+
+def attribute(schema: Mapping[str, Any], default: Any = dataclasses.MISSING, *,
+              default_factory: Any = dataclasses.MISSING) -> Any:
+    """A component field that is not a parameter (a name, a choice, a flag, a list, a friction law).
+
+    Parameters
+    ----------
+    schema : Mapping
+        Its JSON Schema fragment (``"type": "number"``: ``"inf"`` is a number; ``"array"``: a list, held as a tuple).
+    default, default_factory : optional
+        As for :func:`dataclasses.field` (neither: a required key).
+    """
+    return field(default=default, default_factory=default_factory, metadata={"schema": dict(schema)})  # type: ignore[call-overload]
+
+
+def _check_fields(obj: Any, component: str) -> None:
+    """Check a component's fields by their definitions: parameters, names, choices and lists (``component``: label)."""
+    for f in dataclasses.fields(obj):
+        v, fd, schema = getattr(obj, f.name), f.metadata.get("role"), f.metadata.get("schema", {})
+        if fd is not None:  # a number (finite, or +inf where the role allows it) or a parameter name
+            _check_value(component, f.name, v, allow_inf=math.isinf(fd.high) and not fd.high_open,
+                         optional=f.default is None)
+        elif schema.get("$ref") == _COMPONENT_NAME["$ref"] and v is not None:
+            if not isinstance(v, str):
+                raise ParameterError(f"{component}: '{f.name}' must be a string; got {v!r}")
+            if not _NAME.match(v):
+                raise ParameterError(f"{component}: {f.name} {v!r}: a component name must be letters, digits or '_'")
+        elif "enum" in schema and v not in schema["enum"]:
+            raise ParameterError(f"{component}: {f.name} must be {' or '.join(map(repr, schema['enum']))}; got {v!r}")
+        elif schema.get("type") == "array":
+            allowed, least = schema["items"]["enum"], schema.get("minItems", 0)
+            if any(x not in allowed for x in v) or len(set(v)) != len(v) or len(v) < least:
+                raise ParameterError(f"{component}: {f.name} must be {'a non-empty list of ' if least else ''}distinct "
+                                     f"entries of {', '.join(map(repr, allowed))}; got {list(v)}")
+
+
+def _has_dof(dof: str) -> dict[str, Any]:
+    return {"required": ["dofs"], "properties": {"dofs": {"contains": {"const": dof}}}}
+
+
+def _positive_with(dof: str, key: str) -> dict[str, Any]:
+    return {"if": {"anyOf": [{"not": {"required": ["dofs"]}}, _has_dof(dof)]},
+            "then": {"properties": {key: {"not": {"const": 0}}}}}  # fmt: skip
+
+
+_COMPONENT_NAME = {"$ref": "#/$defs/componentName"}
+_tilt = functools.partial(param, unless="tilting")  # a disk field unused when the disk does not tilt
 
 
 class FrictionLaw:
@@ -163,107 +255,73 @@ def _friction_law(law: str, mu: Value, fields: dict[str, Value]) -> FrictionLaw:
 class Disk:
     """The rigid disk: tilting DOFs ``q1, q2`` on rotational supports, constant spin ``Omega``.
 
-    Every field except ``tilting`` is a number or the name of a model
-    parameter (default: the paper's names); the fields are checked by
-    :meth:`validate` when a :class:`ModelSpec` is built.
-
-    Parameters
-    ----------
-    Theta : float or str, optional
-        Moment of inertia about a diameter (the body axes ``x3``, ``y3``)
-        [kg m²]; ``I3 = diag(Theta, Theta, Phi)`` in eqs. (36)-(38).
-    Phi : float or str, optional
-        Moment of inertia about the disk's axis ``z3`` [kg m²].
-    k_t : float or str, optional
-        Stiffness of the rotational supports [N m/rad] (``K_m``, eq. 45).
-    d_t : float or str, optional
-        Damping of the rotational supports [N m s/rad] (``D_m``, eq. 45).
-    h_upper : float or str, optional
-        Distance ``h10`` from O to the upper surface [m]; ``"upper"`` pads
-        touch the face ``z0 = -h_upper`` (eq. 14).
-    h_lower : float or str, optional
-        Distance ``h20`` from O to the lower surface [m]; ``"lower"`` pads
-        touch the face ``z0 = +h_lower`` (eq. 15).
-    Omega : float or str, optional
-        Constant spin rate ``Omega_d`` of the non-holonomic constraint,
-        eq. (40) [rad/s].
-    radius : float or str, optional
-        Outer radius [m], only used to check that the pads sit on the disk
-        (default ``inf``: no check).
-    tilting : bool, optional
-        ``True`` (default): the tilt angles ``q1, q2`` are DOFs.  ``False``
-        locks the tilt: the disk becomes a rotating belt (speed ``Omega r``
-        at a pad's radius ``r``) for its pads (planar pad models); ``Theta``,
-        ``Phi``, ``k_t`` and ``d_t`` then do not enter the equations but
-        still need values.
+    Every field except ``tilting`` is a number or the name of a model parameter (default: the paper's
+    names); ``I3 = diag(Theta, Theta, Phi)`` in eqs. (36)-(38), ``k_t``, ``d_t`` are ``K_m``, ``D_m`` of
+    eq. (45).  With ``tilting=False`` the disk is a rotating belt (speed ``Omega r`` at a pad's radius
+    ``r``) for planar pad models.
     """
 
-    Theta: Value = "Theta"
-    Phi: Value = "Phi"
-    k_t: Value = "k_t"
-    d_t: Value = "d_t"
-    h_upper: Value = "h10"
-    h_lower: Value = "h20"
-    Omega: Value = "Omega"
-    radius: Value = math.inf
-    tilting: bool = True
+    Theta: Value = _tilt("Theta", "kg m^2", "moment of inertia of the disk about a diameter (eqs. 36-38)", _POS)
+    Phi: Value = _tilt("Phi", "kg m^2", "moment of inertia of the disk about its axis (eqs. 36-38)", _POS)
+    k_t: Value = _tilt("k_t", "N m/rad", "stiffness of the disk's rotational supports (eq. 45)", _NONNEG)
+    d_t: Value = _tilt("d_t", "N m s/rad", "damping of the disk's rotational supports (eq. 45)", _NONNEG)
+    h_upper: Value = param("h10", "m", "distance from O to the upper disk surface (eq. 14)", _REAL,
+                           " 'upper' pads touch the face z0 = -h_upper; h_upper + h_lower must be > 0.")
+    h_lower: Value = param("h20", "m", "distance from O to the lower disk surface (eq. 15)", _REAL,
+                           " 'lower' pads touch the face z0 = +h_lower; h_upper + h_lower must be > 0.")
+    Omega: Value = param("Omega", "rad/s", "spin rate of the disk (eq. 40; reverse rotation is not modelled, "
+                         "mirror the model instead)", _POS)
+    radius: Value = param(math.inf, "m", "outer radius of the disk (inf: not checked)", _POS_INF,
+                          " Only used to check that every pad's radius is at most the disk radius.")
+    tilting: bool = attribute({
+        "type": "boolean", "default": True,
+        "description": "true: the tilt angles q1, q2 are degrees of freedom. false: the tilt is locked and the "
+                       "disk is a belt moving at Omega * radius under each pad (planar pad models; then some pad "
+                       "needs a mass with a DOF).",
+    }, True)  # fmt: skip
 
     def validate(self) -> None:
         """Check the fields; raise :class:`ParameterError` naming the disk."""
-        for f in ("Theta", "Phi", "k_t", "d_t", "h_upper", "h_lower", "Omega"):
-            _check_value("disk", f, getattr(self, f))
-        _check_value("disk", "radius", self.radius, allow_inf=True)
+        _check_fields(self, "disk")
 
 
 @dataclass(frozen=True)
 class Pad:
-    """One brake pad in point contact with a disk face.
+    """One brake pad in point contact with a disk face."""
 
-    Parameters
-    ----------
-    name : str
-        Unique component name.
-    face : {"upper", "lower"}
-        Which disk face it touches.
-    angle_deg : float
-        Angular position around ``z0`` (0 = the paper's pads, at ``y0 = -radius``).
-    radius : float or str
-        Distance of the contact line from the axis [m].
-    k, d : float or str
-        Normal support stiffness [N/m] and damping [N s/m].
-    preload : float or str
-        Normal preload ``N0`` [N] (> 0).
-    k_ip : float or str
-        Tangential support stiffness [N/m]; ``inf`` = rigid.
-    d_ip : float or str
-        Tangential damper [N s/m]; needs a tangential DOF.
-    mass : float or str, optional
-        Pad mass [kg]; needs ``dofs``.
-    dofs : tuple of {"normal", "tangential"}
-        Directions in which the mass moves as its own DOF.
-    k_c, d_c : float or str, optional
-        Contact stiffness and damping, needed by a normal DOF.
-    friction : FrictionLaw
-        The friction law at this contact.
-    mount : str, optional
-        Name of the :class:`Caliper` carrying the pad's supports (default: ground).
-    """
-
-    name: str
-    face: Literal["upper", "lower"]
-    angle_deg: float = 0.0
-    radius: Value = "r"
-    k: Value = "k"
-    d: Value = "d"
-    preload: Value = "N0"
-    k_ip: Value = math.inf
-    d_ip: Value = 0.0
-    mass: Value | None = None
-    dofs: tuple[str, ...] = ()
-    k_c: Value | None = None
-    d_c: Value = 0.0
-    friction: FrictionLaw = field(default_factory=FrictionLaw)
-    mount: str | None = None
+    name: str = attribute({**_COMPONENT_NAME, "description": "Unique component name (ASCII letters, digits, '_'; "
+                                                            "unique among pads and calipers)."})
+    face: Literal["upper", "lower"] = attribute({
+        "enum": list(FACES), "description": "Disk face the pad touches: 'upper' (face z0 = -h_upper, pushes along "
+                                            "+z0) or 'lower' (face z0 = +h_lower, pushes along -z0)."})
+    angle_deg: float = attribute({
+        "type": "number", "minimum": -_MAX_FLOAT, "maximum": _MAX_FLOAT, "default": 0.0,
+        "description": "[deg] angular position of the pad around z0 (0 = the paper's pads, at y0 = -radius). A "
+                       "finite number (not a parameter name)."}, 0.0)
+    radius: Value = param("r", "m", "effective braking radius of {owner}", _POS, " Must not exceed the disk radius.")
+    k: Value = param("k", "N/m", "normal support stiffness of {owner}", _NONNEG)
+    d: Value = param("d", "N s/m", "normal support damping of {owner}", _NONNEG)
+    preload: Value = param("N0", "N", "normal preload of {owner}", _POS)
+    k_ip: Value = param(math.inf, "N/m", "tangential support stiffness of {owner} (inf = rigid)", _POS_INF,
+                        " Default 'inf' (rigid); a tangential DOF needs a finite k_ip.")
+    d_ip: Value = param(0.0, "N s/m", "tangential support damping of {owner}", _NONNEG,
+                        " Must be 0 unless the pad has a tangential DOF.")
+    mass: Value | None = param(None, "kg", "mass of {owner}", _POS,
+                               " Needs at least one entry in dofs; absent = massless pad.")
+    dofs: tuple[str, ...] = attribute({
+        "type": "array", "uniqueItems": True, "default": [], "items": {"enum": ["normal", "tangential"]},
+        "description": "Directions in which the pad mass moves as its own DOF (distinct entries of 'normal', "
+                       "'tangential'); empty = massless pad (normal force from its equilibrium, tangentially "
+                       "quasi-static). Non-empty needs mass."}, ())
+    k_c: Value | None = param(None, "N/m", "contact stiffness of {owner}", _POS,
+                              " Needed by a normal DOF: the contact force is preload + k_c * penetration + d_c * "
+                              "its rate.")
+    d_c: Value = param(0.0, "N s/m", "contact damping of {owner}", _NONNEG)
+    friction: FrictionLaw = attribute({"$ref": "#/$defs/friction", "description": "Friction law at this contact "
+                                       "(default: coulomb with mu = parameter 'mu')."}, default_factory=FrictionLaw)
+    mount: str | None = attribute({**_COMPONENT_NAME, "description": "Name of the [[calipers]] entry carrying the "
+                                   "pad's normal and tangential supports (absent: the supports act on ground)."},
+                                  None)
 
     @property
     def label(self) -> str:
@@ -272,27 +330,11 @@ class Pad:
 
     def validate(self) -> None:
         """Check the fields; raise :class:`ParameterError` naming the pad."""
-        if not isinstance(self.name, str):
-            raise ParameterError(f"pad: 'name' must be a string; got {self.name!r}")
         c = self.label
-        if not _NAME.match(self.name):
-            raise ParameterError(f"{c}: a component name must be letters, digits or '_'")
-        if self.face not in FACES:
-            raise ParameterError(f"{c}: face must be 'upper' or 'lower'; got {self.face!r}")
-        if (
-            isinstance(self.angle_deg, bool)
-            or not isinstance(self.angle_deg, (int, float))
-            or not math.isfinite(self.angle_deg)
-        ):
+        _check_fields(self, c)
+        a = self.angle_deg
+        if isinstance(a, bool) or not isinstance(a, (int, float)) or not math.isfinite(a):
             raise ParameterError(f"{c}: angle_deg must be a finite number of degrees; got {self.angle_deg!r}")
-        for f in ("radius", "k", "d", "preload", "d_ip", "d_c"):
-            _check_value(c, f, getattr(self, f))
-        _check_value(c, "k_ip", self.k_ip, allow_inf=True)
-        _check_value(c, "mass", self.mass, optional=True)
-        _check_value(c, "k_c", self.k_c, optional=True)
-        bad = [x for x in self.dofs if x not in ("normal", "tangential")]
-        if bad or len(set(self.dofs)) != len(self.dofs):
-            raise ParameterError(f"{c}: dofs must be distinct entries of 'normal', 'tangential'; got {list(self.dofs)}")
         if self.dofs and self.mass is None:
             raise ParameterError(f"{c}: a DOF without mass ({', '.join(self.dofs)}): give the pad a mass")
         if self.mass is not None and not self.dofs:
@@ -316,53 +358,126 @@ class Caliper:
     caliper act between the pad and the caliper instead of ground; a pad at
     ``angle_deg`` sees the tangential translation projected on its own
     tangent.  The coordinates are ``wc_<name>`` and ``uc_<name>`` [m].
-
-    Parameters
-    ----------
-    name : str
-        Unique component name (letters, digits, ``_``), referenced by the
-        ``mount`` field of a :class:`Pad`.
-    mass : float or str, optional
-        Caliper mass [kg] (> 0; default parameter ``m_c``).
-    dofs : tuple of {"normal", "tangential"}, optional
-        Translations that are DOFs (non-empty; default both).
-    k_n : float or str, optional
-        Normal spring to ground [N/m] (default parameter ``k_cn``; must not be
-        0 with a normal DOF).
-    d_n : float or str, optional
-        Normal damper to ground [N s/m] (default 0).
-    k_t : float or str, optional
-        Tangential spring to ground [N/m] (default parameter ``k_ct``; must not
-        be 0 with a tangential DOF).
-    d_t : float or str, optional
-        Tangential damper to ground [N s/m] (default 0).
     """
 
-    name: str
-    mass: Value = "m_c"
-    dofs: tuple[str, ...] = ("normal", "tangential")
-    k_n: Value = "k_cn"
-    d_n: Value = 0.0
-    k_t: Value = "k_ct"
-    d_t: Value = 0.0
+    name: str = attribute({**_COMPONENT_NAME, "description": "Unique component name (ASCII letters, digits, '_'), "
+                                                            "referenced by the mount key of pads."})
+    mass: Value = param("m_c", "kg", "mass of {owner}", _POS)
+    dofs: tuple[str, ...] = attribute({
+        "type": "array", "minItems": 1, "uniqueItems": True, "default": ["normal", "tangential"],
+        "items": {"enum": ["normal", "tangential"]},
+        "description": "Translations of the caliper that are DOFs: 'normal' (along z0, coordinate wc_<name>) and/or "
+                       "'tangential' (along x0, coordinate uc_<name>) [m]. Non-empty; default both."},
+        ("normal", "tangential"))
+    k_n: Value = param("k_cn", "N/m", "normal stiffness of {owner} to ground", _NONNEG,
+                       " Must be > 0 with a normal DOF.")
+    d_n: Value = param(0.0, "N s/m", "normal damping of {owner} to ground", _NONNEG)
+    k_t: Value = param("k_ct", "N/m", "tangential stiffness of {owner} to ground", _NONNEG,
+                       " Must be > 0 with a tangential DOF.")
+    d_t: Value = param(0.0, "N s/m", "tangential damping of {owner} to ground", _NONNEG)
 
     def validate(self) -> None:
         """Check the fields; raise :class:`ParameterError` naming the caliper."""
-        if not isinstance(self.name, str):
-            raise ParameterError(f"caliper: 'name' must be a string; got {self.name!r}")
-        c = f"caliper '{self.name}'"
-        if not _NAME.match(self.name):
-            raise ParameterError(f"{c}: a component name must be letters, digits or '_'")
-        if not self.dofs or any(x not in ("normal", "tangential") for x in self.dofs):
-            raise ParameterError(f"{c}: dofs must be a non-empty list of 'normal', 'tangential'")
-        for f in ("mass", "k_n", "d_n", "k_t", "d_t"):
-            _check_value(c, f, getattr(self, f))
+        _check_fields(self, f"caliper '{self.name}'")
 
 
 #: Largest number of pads a model may have (assembly cost grows quickly with it).
 MAX_PADS = 24
 #: Largest number of generalized coordinates of a model.
 MAX_COORDINATES = 24
+
+
+@dataclass(frozen=True, eq=False)
+class Kind:
+    """A kind of component: how models hold it, model files write it and messages name it.
+
+    Attributes
+    ----------
+    cls : type
+        Its frozen dataclass (fields made with :func:`param` and :func:`attribute`).
+    key, table : str
+        Role prefix and schema definition (``"pad"``); :class:`ModelSpec` attribute and model-file key (``"pads"``).
+    many : bool
+        A list of components (``[[pads]]``, a tuple in the spec) rather than one table (``[disk]``).
+    owner : callable
+        ``owner(component)``: how roles name a component (``"pad '1' (upper face)"``).
+    schema_owner, doc, description : str
+        How the schema names one (``"this pad"``); its descriptions of the model-file key and of one component.
+    required : bool
+        A model needs at least one (lists).
+    max_count : int or None
+        Largest number of them (lists).
+    rules : tuple of dict
+        Cross-field JSON Schema rules (``allOf``) of one component.
+    """
+
+    cls: type
+    key: str
+    table: str
+    many: bool
+    owner: Callable[[Any], str]
+    schema_owner: str
+    doc: str
+    description: str
+    required: bool = False
+    max_count: int | None = None
+    rules: tuple[dict[str, Any], ...] = ()
+
+
+#: Every kind of component, by role prefix, in the order of model files (register a new kind here).
+COMPONENTS: dict[str, Kind] = {kind.key: kind for kind in (
+    Kind(Disk, "disk", "disk", False, lambda d: "the disk", "the disk",
+         "The disk ([disk] table; optional, every key has a default).",
+         "The rigid disk (table [disk]): tilting DOFs q1, q2 on rotational supports, constant spin Omega. Every "
+         "key is optional; a missing key takes its default, which is a parameter name (Theta, Phi, k_t, d_t, h10, "
+         "h20, Omega) that [parameters] must then define."),
+    Kind(Pad, "pad", "pads", True, lambda p: f"pad '{p.name}' ({p.face} face)", "this pad",
+         f"The pads ([[pads]] tables): at least 1, at most {MAX_PADS}.",
+         "One brake pad in point contact with a disk face (one [[pads]] table per pad).", required=True,
+         max_count=MAX_PADS, rules=(
+             {"if": {"required": ["dofs"], "properties": {"dofs": {"minItems": 1}}}, "then": {"required": ["mass"]}},
+             {"if": {"required": ["mass"]}, "then": {"required": ["dofs"], "properties": {"dofs": {"minItems": 1}}}},
+             {"if": _has_dof("normal"), "then": {"required": ["k_c"]}},
+             {"if": _has_dof("tangential"),
+              "then": {"required": ["k_ip"], "properties": {"k_ip": {"not": {"anyOf": [
+                  {"const": "inf"}, {"type": "number", "minimum": _MAX_FLOAT}]}}}},
+              "else": {"properties": {"d_ip": {"const": 0}}}})),
+    Kind(Caliper, "caliper", "calipers", True, lambda c: f"caliper '{c.name}'", "the caliper",
+         "Optional caliper masses ([[calipers]] tables).",
+         "A rigid caliper (mounting) mass on springs to ground, coupling the supports of the pads mounted on it "
+         "(one [[calipers]] table per caliper).",
+         rules=(_positive_with("normal", "k_n"), _positive_with("tangential", "k_t"))),
+)}  # fmt: skip
+
+
+def _document(kind: Kind) -> None:
+    """Append to a kind's class docstring its numpydoc Parameters section, written from the fields' metadata."""
+    lines = ["", "Parameters", "----------"]
+    for f in dataclasses.fields(kind.cls):
+        has_default = f.default is not dataclasses.MISSING or f.default_factory is not dataclasses.MISSING
+        if "role" in f.metadata:
+            r, typ = f.metadata["role"], "float or str"
+            interval = f"{'(' if r.low_open else '['}{r.low:g}, {r.high:g}{')' if r.high_open else ']'}"
+            text = (f"{r.description.format(owner=kind.schema_owner)}{f' [{r.unit}]' if r.unit else ''}, a number "
+                    f"in {interval} or a parameter name.{f.metadata['note']}")
+        else:
+            typ, text = str(f.type), f.metadata["schema"]["description"]
+        if f.default is not dataclasses.MISSING and f.default is not None and "Default" not in text:
+            text += f" Default {f.default!r}."
+        lines += [f"{f.name} : {typ}{', optional' if has_default else ''}",
+                  *textwrap.wrap(text[0].upper() + text[1:], 100, initial_indent="    ", subsequent_indent="    ")]
+    kind.cls.__doc__ = (kind.cls.__doc__ or "").rstrip() + "\n" + "\n".join(("    " + x).rstrip() for x in lines)
+
+
+for _kind in COMPONENTS.values():
+    _document(_kind)
+
+
+def components(spec: ModelSpec) -> Iterator[tuple[Kind, Any]]:
+    """Every component of a model as ``(kind, component)``, in :data:`COMPONENTS` order (``spec``: a ModelSpec)."""
+    for kind in COMPONENTS.values():
+        held = getattr(spec, kind.table)
+        yield from ((kind, c) for c in (held if kind.many else (held,)))
 
 
 def _check_type(where: str, key: str, value: object, kind: type | tuple[type, ...], what: str) -> None:
@@ -416,8 +531,9 @@ class ModelSpec:
     descriptions: dict[str, str] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "pads", tuple(self.pads))
-        object.__setattr__(self, "calipers", tuple(self.calipers))
+        for kind in COMPONENTS.values():
+            if kind.many:
+                object.__setattr__(self, kind.table, tuple(getattr(self, kind.table)))
         object.__setattr__(self, "presets", tuple(self.presets))
         self.validate()
 
@@ -427,34 +543,33 @@ class ModelSpec:
 
         where = f"model '{self.name}'"
         _check_type("model", "name", self.name, str, "a string")
-        _check_type(where, "disk", self.disk, Disk, "a disk table")
         _check_type(where, "parameters", self.parameters, dict, "a table of parameter values")
         for key in ("description", "reference"):
             _check_type(where, key, getattr(self, key), str, "a string")
-        if not self.pads:
-            raise ParameterError(f"{where}: needs at least one pad")
-        if len(self.pads) > MAX_PADS:
-            raise ParameterError(f"{where}: has {len(self.pads)} pads; at most {MAX_PADS} are supported")
-        for comp in (*self.pads, *self.calipers):
-            if not isinstance(comp, (Pad, Caliper)):
-                raise ParameterError(f"{where}: pads and calipers must be tables; got {comp!r}")
-        self.disk.validate()
+        for kind in COMPONENTS.values():
+            held = getattr(self, kind.table)
+            if not kind.many:
+                _check_type(where, kind.table, held, kind.cls, f"a {kind.key} table")
+                continue
+            if kind.required and not held:
+                raise ParameterError(f"{where}: needs at least one {kind.key}")
+            if kind.max_count is not None and len(held) > kind.max_count:
+                raise ParameterError(f"{where}: has {len(held)} {kind.table}; at most {kind.max_count} are supported")
+            for comp in held:
+                if not isinstance(comp, kind.cls):
+                    raise ParameterError(f"{where}: {kind.table} must be {kind.key} tables; got {comp!r}")
         names: set[str] = set()
-        comps: tuple[Pad | Caliper, ...] = (*self.pads, *self.calipers)
-        for comp in comps:
+        for kind, comp in components(self):
             comp.validate()
-            if comp.name in names:
-                raise ParameterError(f"{where}: duplicate component name '{comp.name}'")
-            names.add(comp.name)
+            if kind.many and hasattr(comp, "name"):
+                if comp.name in names:
+                    raise ParameterError(f"{where}: duplicate component name '{comp.name}'")
+                names.add(comp.name)
         calipers = {c.name for c in self.calipers}
         for p in self.pads:
             if p.mount is not None and p.mount not in calipers:
                 raise ParameterError(f"{p.label}: mount '{p.mount}' is not a caliper of the model")
-        n = (
-            (2 if self.disk.tilting else 0)
-            + sum(len(p.dofs) for p in self.pads)
-            + sum(len(c.dofs) for c in self.calipers)
-        )
+        n = (2 if self.disk.tilting else 0) + sum(len(getattr(c, "dofs", ())) for _, c in components(self))
         if n == 0:
             raise ParameterError(f"{where}: has no degree of freedom (a non-tilting disk needs a pad with mass)")
         if n > MAX_COORDINATES:
@@ -505,17 +620,14 @@ class ModelSpec:
             if isinstance(v, str) and v not in out:
                 out.append(v)
 
-        d = self.disk
-        for f in ("Theta", "Phi", "k_t", "d_t", "h_upper", "h_lower", "Omega", "radius"):
-            add(getattr(d, f))
-        for p in self.pads:
-            for f in ("radius", "k", "d", "preload", "k_ip", "d_ip", "mass", "k_c", "d_c"):
-                add(getattr(p, f))
-            for v in p.friction.values().values():
-                add(v)
-        for c in self.calipers:
-            for f in ("mass", "k_n", "d_n", "k_t", "d_t"):
-                add(getattr(c, f))
+        for _, comp in components(self):
+            for f in dataclasses.fields(comp):
+                v = getattr(comp, f.name)
+                if "role" in f.metadata:
+                    add(v)
+                elif isinstance(v, FrictionLaw):
+                    for x in v.values().values():
+                        add(x)
         return out
 
     def stiffness_names(self) -> set[str]:

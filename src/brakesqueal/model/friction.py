@@ -44,7 +44,7 @@ _INF = math.inf
 
 @dataclass(frozen=True)
 class FieldDef:
-    """One field of a friction law: unit, meaning and allowed interval (for :mod:`.roles`).
+    """One parameter-valued field of a friction law or a component: unit, meaning and allowed interval (:mod:`.roles`).
 
     Attributes
     ----------
@@ -107,7 +107,8 @@ LAWS: Mapping[str, LawDef] = MappingProxyType({law.name: law for law in (
     LawDef("stick", {"v_reg": FieldDef("m/s", "stick-slip regularisation speed at {owner}", 0.0, _INF, True, True),
                      "slope": FieldDef("s/m", "friction slope -dmu/dv (beyond stick) at {owner}", -_INF, _INF,
                                        True, True)},
-           lambda sm, v, f: f["mu"] * v / sm.sqrt(v**2 + f["v_reg"] ** 2) - f["slope"] * v, rate_dependent=True,
+           # written as v * (...) so that mu(v) v_r / v cancels symbolically: the force is defined at v_r = 0
+           lambda sm, v, f: v * (f["mu"] / sm.sqrt(v**2 + f["v_reg"] ** 2) - f["slope"]), rate_dependent=True,
            text="mu(v) = mu * v / sqrt(v^2 + v_reg^2) - slope * v"),
 )})
 

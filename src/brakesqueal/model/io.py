@@ -41,10 +41,11 @@ import dataclasses
 import math
 import re
 import tomllib
+from dataclasses import MISSING
 from typing import Any, Mapping
 
 from ..errors import ParameterError
-from .components import Caliper, Disk, FrictionLaw, ModelSpec, Pad
+from .components import COMPONENTS, FrictionLaw, Kind, ModelSpec
 from .expressions import evaluate
 from .parameters import Preset, Value
 
@@ -54,10 +55,7 @@ __all__ = ["spec_from_dict", "spec_to_dict", "load_model", "model_to_toml", "rea
 #: Largest model, parameter or study file read.
 MAX_FILE_BYTES = 1 << 20
 
-_TOP = ("name", "description", "reference", "parameters", "disk", "pads", "calipers", "presets")
 _PRESET_KEYS = ("description", "reference", "free", "fixed", "tied", "auxiliary")
-#: Component fields that hold text, never a number (``"inf"`` there is a name).
-_TEXT_FIELDS = ("name", "face", "mount", "dofs")
 _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
 _ESCAPES = {"\\": "\\\\", '"': '\\"', "\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f", "\r": "\\r"}
 
@@ -129,24 +127,34 @@ def read_toml(path: str, what: str) -> dict[str, Any]:
     return read_toml_text(path, what)[1]
 
 
-def _fields(cls: type, data: Mapping[str, Any], where: str) -> dict[str, Any]:
+def _fields(kind: Kind, data: Mapping[str, Any], where: str) -> dict[str, Any]:
+    """The keyword arguments of a component from its table (fields as :mod:`.components` defines them)."""
     from ..suggest import did_you_mean
 
-    names = [f.name for f in dataclasses.fields(cls)]
+    fields = dataclasses.fields(kind.cls)
+    names = [f.name for f in fields]
     unknown = sorted(set(data) - set(names))
     if unknown:
         raise ParameterError(f"{where}: unknown key '{unknown[0]}'{did_you_mean(unknown[0], names)}; valid keys: "
                              f"{', '.join(names)}")
+    missing = [f"'{f.name}'" for f in fields if f.name not in data and f.default is f.default_factory is MISSING]
+    if missing:
+        raise ParameterError(f"{where}: a {kind.key} needs {' and '.join(missing)}")
     out = {}
-    for k, v in data.items():
-        if v == "inf" and k not in _TEXT_FIELDS:  # a component may be named "inf"
-            v = math.inf
-        if k == "dofs":
+    for f in (f for f in fields if f.name in data):
+        v, schema = data[f.name], f.metadata.get("schema", {})
+        if f.default_factory is FrictionLaw:
+            if not isinstance(v, dict):
+                raise ParameterError(f"{where}: {f.name} must be a table like {{ law = 'coulomb', mu = 'mu1' }}")
+            v = FrictionLaw(**{k: (math.inf if x == "inf" else x) for k, x in v.items()})  # type: ignore[arg-type]
+        elif schema.get("type") == "array":
             if not isinstance(v, (list, tuple)):
-                raise ParameterError(f"{where}: 'dofs' must be a list such as [\"normal\", \"tangential\"]; "
-                                     f"got {v!r}")
+                example = ", ".join(f'"{x}"' for x in schema.get("items", {}).get("enum", ()))
+                raise ParameterError(f"{where}: '{f.name}' must be a list such as [{example}]; got {v!r}")
             v = tuple(v)
-        out[k] = v
+        elif v == "inf" and ("role" in f.metadata or schema.get("type") == "number"):  # elsewhere "inf" is a name
+            v = math.inf
+        out[f.name] = v
     return out
 
 
@@ -205,44 +213,40 @@ def spec_from_dict(data: Mapping[str, Any], *, source: str = "model") -> ModelSp
 
     if not isinstance(data, Mapping):
         raise ParameterError(f"{source}: must be a table")
-    unknown = sorted(set(data) - set(_TOP))
+    top = ("name", "description", "reference", "parameters", *(k.table for k in COMPONENTS.values()), "presets")
+    unknown = sorted(set(data) - set(top))
     if unknown:
-        raise ParameterError(f"{source}: unknown key '{unknown[0]}'{did_you_mean(unknown[0], _TOP)}; valid keys: "
-                             f"{', '.join(_TOP)}")
+        raise ParameterError(f"{source}: unknown key '{unknown[0]}'{did_you_mean(unknown[0], top)}; valid keys: "
+                             f"{', '.join(top)}")
     for key in ("name", "description", "reference"):
         if key in data and not isinstance(data[key], str):
             raise ParameterError(f"{source}: key '{key}' must be a string; got {data[key]!r}")
-    pads_raw = data.get("pads")
-    if not isinstance(pads_raw, list) or not pads_raw:
-        raise ParameterError(f"{source}: needs a non-empty list of [[pads]] tables")
+    for kind in COMPONENTS.values():
+        if kind.many and kind.required and not (isinstance(data.get(kind.table), list) and data[kind.table]):
+            raise ParameterError(f"{source}: needs a non-empty list of [[{kind.table}]] tables")
     params: dict[str, float] = {}
     for k, v in _table(data, "parameters", source).items():
         if isinstance(v, bool) or not isinstance(v, (int, float, str)):
             raise ParameterError(f"{source}: parameters.{k} must be a number or an expression string; got {v!r}")
         params[k] = float(v) if not isinstance(v, str) else evaluate(v, {}, what=f"{source}: parameter '{k}'")
-    pads = []
     try:
-        for i, raw in enumerate(pads_raw):
-            where = f"{source}: pads[{i}]" + (f" ('{raw.get('name')}')" if isinstance(raw, dict) else "")
-            if not isinstance(raw, dict):
-                raise ParameterError(f"{where}: must be a table")
-            raw = dict(raw)
-            fr = raw.pop("friction", {})
-            if not isinstance(fr, dict):
-                raise ParameterError(f"{where}: friction must be a table like {{ law = 'coulomb', mu = 'mu1' }}")
-            if "name" not in raw or "face" not in raw:
-                raise ParameterError(f"{where}: a pad needs 'name' and 'face'")
-            fr = {k: (math.inf if v == "inf" else v) for k, v in fr.items()}
-            pads.append(Pad(**_fields(Pad, raw, where), friction=FrictionLaw(**fr)))
-        calipers = []
-        for i, raw in enumerate(_table(data, "calipers", source, kind=list, what="a list of [[calipers]] tables")):
-            where = f"{source}: calipers[{i}]"
-            if not isinstance(raw, dict) or "name" not in raw:
-                raise ParameterError(f"{where}: a caliper needs a 'name'")
-            calipers.append(Caliper(**_fields(Caliper, raw, where)))
-        disk = Disk(**_fields(Disk, _table(data, "disk", source), f"{source}: disk"))
+        held: dict[str, Any] = {}
+        for kind in COMPONENTS.values():
+            if not kind.many:
+                table = _table(data, kind.table, source)
+                held[kind.table] = kind.cls(**_fields(kind, table, f"{source}: {kind.table}"))
+                continue
+            items = []
+            for i, raw in enumerate(_table(data, kind.table, source, kind=list,
+                                           what=f"a list of [[{kind.table}]] tables")):
+                where = f"{source}: {kind.table}[{i}]" + (f" ('{raw['name']}')" if isinstance(raw, dict)
+                                                          and "name" in raw else "")
+                if not isinstance(raw, dict):
+                    raise ParameterError(f"{where}: must be a table")
+                items.append(kind.cls(**_fields(kind, raw, where)))
+            held[kind.table] = tuple(items)
         return ModelSpec(
-            name=str(data.get("name", "model")), disk=disk, pads=tuple(pads), calipers=tuple(calipers),
+            name=str(data.get("name", "model")), **held,
             parameters=params, description=str(data.get("description", "")),
             reference=str(data.get("reference", "")), presets=_presets(data, source),
         )  # fmt: skip
@@ -284,17 +288,19 @@ def spec_to_dict(spec: ModelSpec, *, presets: bool = True) -> dict[str, Any]:
         out = {}
         for f in dataclasses.fields(obj):
             v = getattr(obj, f.name)
-            if f.name == "friction":
-                out["friction"] = {"law": v.law, **{k: _plain(x) for k, x in v.values().items()}}
+            if isinstance(v, FrictionLaw):
+                out[f.name] = {"law": v.law, **{k: _plain(x) for k, x in v.values().items()}}
             elif v is not None:
                 out[f.name] = _plain(v)
         return out
 
     d: dict[str, Any] = {
         "name": spec.name, "description": spec.description, "reference": spec.reference,
-        "parameters": {k: _plain(v) for k, v in spec.parameters.items()}, "disk": comp(spec.disk),
-        "pads": [comp(p) for p in spec.pads], "calipers": [comp(c) for c in spec.calipers],
+        "parameters": {k: _plain(v) for k, v in spec.parameters.items()},
     }  # fmt: skip
+    for kind in COMPONENTS.values():
+        held = getattr(spec, kind.table)
+        d[kind.table] = [comp(c) for c in held] if kind.many else comp(held)
     if presets and spec.presets:
         d["presets"] = {p.name: {"description": p.description, "reference": p.reference,
                                  "free": {k: _plain(v) for k, v in p.free.items()},
@@ -378,11 +384,10 @@ def model_to_toml(spec: ModelSpec) -> str:
     lines = [f"name = {_toml_value(d['name'])}", f"description = {_toml_value(d['description'])}",
              f"reference = {_toml_value(d['reference'])}", "", "[parameters]"]  # fmt: skip
     lines += [f"{_toml_key(k)} = {_toml_value(v)}" for k, v in d["parameters"].items()]
-    lines += ["", "[disk]"] + [f"{k} = {_toml_value(v)}" for k, v in d["disk"].items()]
-    for p in d["pads"]:
-        lines += ["", "[[pads]]"] + [f"{k} = {_toml_value(v)}" for k, v in p.items()]
-    for c in d["calipers"]:
-        lines += ["", "[[calipers]]"] + [f"{k} = {_toml_value(v)}" for k, v in c.items()]
+    for kind in COMPONENTS.values():
+        header = f"[[{kind.table}]]" if kind.many else f"[{kind.table}]"
+        for c in d[kind.table] if kind.many else [d[kind.table]]:
+            lines += ["", header] + [f"{k} = {_toml_value(v)}" for k, v in c.items()]
     for name, p in d.get("presets", {}).items():
         lines += ["", f"[presets.{_toml_key(name)}]"] + [f"{k} = {_toml_value(v)}" for k, v in p.items()]
     return "\n".join(lines) + "\n"

@@ -3,7 +3,9 @@
 A parameter of a model is a *name* used by one or more component fields
 (:mod:`.components`); the field is its *role*: ``pad.k`` (a normal support
 stiffness), ``disk.Omega`` (the spin rate of eq. 40), ``friction.mu`` ...
-This module holds the one table of roles.  Every input channel (presets,
+The roles are defined with the fields themselves (:func:`.components.param`,
+:data:`.friction.LAWS`); this module derives the table :data:`ROLES` and the
+roles of a model's parameters from them.  Every input channel (presets,
 parameter files, ``--set``, model files, map and sweep axes, the explorer)
 validates through :func:`problems` (scalars) or :func:`valid_mask` (arrays),
 so a value is accepted or refused the same way everywhere.
@@ -20,12 +22,17 @@ Besides each role's interval, two rules hold for every parameter:
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
+from functools import lru_cache
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
+
+from .friction import FieldDef
 
 __all__ = ["Role", "ROLES", "MAX_MAGNITUDE", "ParameterRoles", "parameter_roles", "problems", "valid_mask",
            "format_interval", "role_message"]
@@ -37,31 +44,17 @@ _INF = math.inf
 
 
 @dataclass(frozen=True)
-class Role:
-    """What a component field means and which values it allows.
+class Role(FieldDef):
+    """What a component field means and which values it allows: its :class:`~.friction.FieldDef` and its key.
 
     Attributes
     ----------
     key : str
-        ``"<component>.<field>"``, e.g. ``"pad.k_ip"``.
-    unit : str
-        SI unit (``""``: dimensionless).
-    description : str
-        Template with ``{owner}`` (e.g. ``"pad '1' (upper face)"``).
-    low, high : float
-        Interval bounds.
-    low_open, high_open : bool
-        Whether the bounds are excluded; ``high = inf`` with ``high_open =
-        False`` allows ``+inf`` (rigid tangential supports, unbounded disks).
+        ``"<component>.<field>"``, e.g. ``"pad.k_ip"``; the other attributes are those of the FieldDef (a
+        ``description`` template with ``{owner}``; ``high = inf`` with ``high_open = False`` allows ``+inf``).
     """
 
-    key: str
-    unit: str
-    description: str
-    low: float
-    high: float
-    low_open: bool
-    high_open: bool
+    key: str = ""
 
     @property
     def allows_inf(self) -> bool:
@@ -93,59 +86,48 @@ def format_interval(low: float, high: float, low_open: bool, high_open: bool) ->
     return f"{'(' if low_open else '['}{_fmt(low)}, {_fmt(high)}{')' if high_open else ']'}"
 
 
-def _role(key: str, unit: str, desc: str, low: float, high: float, low_open: bool, high_open: bool) -> Role:
-    return Role(key, unit, desc, low, high, low_open, high_open)
+def _from_def(key: str, f: FieldDef) -> Role:
+    return Role(**{g.name: getattr(f, g.name) for g in dataclasses.fields(f)}, key=key)
 
 
-_POS = (0.0, _INF, True, True)      # (0, inf)
-_NONNEG = (0.0, _INF, False, True)  # [0, inf)
-_REAL = (-_INF, _INF, True, True)   # (-inf, inf)
-_POS_INF = (0.0, _INF, True, False)  # (0, inf]
+@lru_cache(maxsize=8)
+def _derive(kinds: tuple[Any, ...]) -> Mapping[str, Role]:
+    from .components import FrictionLaw
+    from .friction import LAWS, MU_FIELD
 
-#: Every role, keyed ``"<component>.<field>"``.
-ROLES: Mapping[str, Role] = {r.key: r for r in (
-    _role("disk.Theta", "kg m^2", "moment of inertia of the disk about a diameter (eqs. 36-38)", *_POS),
-    _role("disk.Phi", "kg m^2", "moment of inertia of the disk about its axis (eqs. 36-38)", *_POS),
-    _role("disk.k_t", "N m/rad", "stiffness of the disk's rotational supports (eq. 45)", *_NONNEG),
-    _role("disk.d_t", "N m s/rad", "damping of the disk's rotational supports (eq. 45)", *_NONNEG),
-    _role("disk.h_upper", "m", "distance from O to the upper disk surface (eq. 14)", *_REAL),
-    _role("disk.h_lower", "m", "distance from O to the lower disk surface (eq. 15)", *_REAL),
-    _role("disk.Omega", "rad/s", "spin rate of the disk (eq. 40; reverse rotation is not modelled, mirror the "
-          "model instead)", *_POS),
-    _role("disk.radius", "m", "outer radius of the disk (inf: not checked)", *_POS_INF),
-    _role("pad.radius", "m", "effective braking radius of {owner}", *_POS),
-    _role("pad.k", "N/m", "normal support stiffness of {owner}", *_NONNEG),
-    _role("pad.d", "N s/m", "normal support damping of {owner}", *_NONNEG),
-    _role("pad.preload", "N", "normal preload of {owner}", *_POS),
-    _role("pad.k_ip", "N/m", "tangential support stiffness of {owner} (inf = rigid)", *_POS_INF),
-    _role("pad.d_ip", "N s/m", "tangential support damping of {owner}", *_NONNEG),
-    _role("pad.mass", "kg", "mass of {owner}", *_POS),
-    _role("pad.k_c", "N/m", "contact stiffness of {owner}", *_POS),
-    _role("pad.d_c", "N s/m", "contact damping of {owner}", *_NONNEG),
-    _role("friction.mu", "", "kinetic friction coefficient at {owner}", *_NONNEG),
-    _role("caliper.mass", "kg", "mass of {owner}", *_POS),
-    _role("caliper.k_n", "N/m", "normal stiffness of {owner} to ground", *_NONNEG),
-    _role("caliper.d_n", "N s/m", "normal damping of {owner} to ground", *_NONNEG),
-    _role("caliper.k_t", "N/m", "tangential stiffness of {owner} to ground", *_NONNEG),
-    _role("caliper.d_t", "N s/m", "tangential damping of {owner} to ground", *_NONNEG),
-)}
-
-def _friction_roles() -> dict[str, Role]:
-    from .friction import LAWS
-
-    out = {}
+    out: dict[str, Role] = {}
+    for kind in kinds:
+        for f in dataclasses.fields(kind.cls):
+            if "role" in f.metadata:
+                out[f"{kind.key}.{f.name}"] = _from_def(f"{kind.key}.{f.name}", f.metadata["role"])
+            elif f.default_factory is FrictionLaw:
+                out.setdefault("friction.mu", _from_def("friction.mu", MU_FIELD))
     for law in LAWS.values():
-        for name, f in law.fields.items():
-            out[f"friction.{name}"] = Role(f"friction.{name}", f.unit, f.description, f.low, f.high, f.low_open,
-                                           f.high_open)
-    return out
+        out |= {f"friction.{name}": _from_def(f"friction.{name}", f) for name, f in law.fields.items()}
+    return MappingProxyType(out)
 
 
-ROLES = {**ROLES, **_friction_roles()}
+def _table() -> Mapping[str, Role]:
+    from .components import COMPONENTS
 
-_DISK_FIELDS = ("Theta", "Phi", "k_t", "d_t", "h_upper", "h_lower", "Omega", "radius")
-_PAD_FIELDS = ("radius", "k", "d", "preload", "k_ip", "d_ip", "mass", "k_c", "d_c")
-_CALIPER_FIELDS = ("mass", "k_n", "d_n", "k_t", "d_t")
+    return _derive(tuple(COMPONENTS.values()))
+
+
+class _Roles(Mapping[str, Role]):
+    """Every role, derived from :data:`.components.COMPONENTS` (also kinds registered later) and the friction laws."""
+
+    def __getitem__(self, key: str) -> Role:
+        return _table()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(_table())
+
+    def __len__(self) -> int:
+        return len(_table())
+
+
+#: Every role, keyed ``"<component>.<field>"`` (read from the component and friction-law definitions).
+ROLES: Mapping[str, Role] = _Roles()
 
 
 @dataclass(frozen=True)
@@ -214,52 +196,38 @@ class ParameterRoles:
         return bool(roles) and all(r.allows_inf for r, _ in roles)
 
 
-def _owner_pad(pad: Any) -> str:
-    return f"pad '{pad.name}' ({pad.face} face)"
-
-
 def parameter_roles(spec: Any) -> ParameterRoles:
     """Collect the roles of the named parameters of ``spec`` (a :class:`~.components.ModelSpec`)."""
+    from .components import COMPONENTS, FrictionLaw, components
+
     uses: dict[str, list[tuple[Role, str]]] = {}
     fixed: list[tuple[Role, str, float]] = []
-
-    def add(kind: str, field: str, value: Any, owner: str) -> None:
-        if value is None:
-            return
-        role = ROLES[f"{kind}.{field}"]
+    used: list[tuple[Role, Any, str]] = []
+    unused: list[tuple[Role, Any, str]] = []  # fields that do not enter the equations: their roles come last
+    table = _table()
+    for kind, comp in components(spec):
+        owner = kind.owner(comp)
+        for f in dataclasses.fields(comp):
+            v, unless = getattr(comp, f.name), f.metadata.get("unless")
+            if "role" in f.metadata:
+                later = unless and not getattr(comp, unless)
+                (unused if later else used).append((table[f"{kind.key}.{f.name}"], v, owner))
+            elif isinstance(v, FrictionLaw):
+                used += [(table[f"friction.{name}"], x, owner) for name, x in v.values().items()]
+    for role, value, owner in (*used, *unused):
         if isinstance(value, str):
             lst = uses.setdefault(value, [])
             if (role, owner) not in lst:
                 lst.append((role, owner))
-        elif not isinstance(value, bool):
+        elif value is not None and not isinstance(value, bool):
             fixed.append((role, owner, float(value)))
-
+    owner_pad, owner_caliper = COMPONENTS["pad"].owner, COMPONENTS["caliper"].owner
     d = spec.disk
-    for f in _DISK_FIELDS:
-        if not d.tilting and f in ("Theta", "Phi", "k_t", "d_t"):
-            continue
-        add("disk", f, getattr(d, f), "the disk")
-    for p in spec.pads:
-        owner = _owner_pad(p)
-        for f in _PAD_FIELDS:
-            add("pad", f, getattr(p, f), owner)
-        for f, v in p.friction.values().items():
-            add("friction", f, v, owner)
-    cal_dofs = []
-    for c in spec.calipers:
-        owner = f"caliper '{c.name}'"
-        for f in _CALIPER_FIELDS:
-            add("caliper", f, getattr(c, f), owner)
-        for dof, f in (("normal", "k_n"), ("tangential", "k_t")):
-            if dof in c.dofs:
-                cal_dofs.append((owner, f, getattr(c, f)))
-    # non-tilting disks still name Theta etc.: give them their roles (values are unused but must be valid)
-    if not d.tilting:
-        for f in ("Theta", "Phi", "k_t", "d_t"):
-            add("disk", f, getattr(d, f), "the disk")
+    cal_dofs = [(owner_caliper(c), f, getattr(c, f)) for c in spec.calipers
+                for dof, f in (("normal", "k_n"), ("tangential", "k_t")) if dof in c.dofs]
     return ParameterRoles(
         uses={k: tuple(v) for k, v in uses.items()}, fixed=tuple(fixed), thickness=(d.h_upper, d.h_lower),
-        pad_radii=tuple((_owner_pad(p), p.radius) for p in spec.pads), disk_radius=d.radius,
+        pad_radii=tuple((owner_pad(p), p.radius) for p in spec.pads), disk_radius=d.radius,
         caliper_dofs=tuple(cal_dofs),
     )
 

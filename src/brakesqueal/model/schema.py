@@ -21,7 +21,8 @@ names, a ``mount`` naming an existing caliper, the number of coordinates,
 presets that define every parameter) is left to the reader,
 :func:`brakesqueal.model.io.load_model`.
 
-The file is generated from the package's own tables (component fields,
+The file is generated from the package's own tables (the component kinds of
+:data:`brakesqueal.model.components.COMPONENTS` and their fields,
 :data:`brakesqueal.model.friction.LAWS`, :data:`brakesqueal.model.roles.ROLES`)
 by :func:`build_schema`; after changing them, regenerate it with
 ``python -m brakesqueal.model.schema --write`` (a test compares the two).
@@ -76,14 +77,9 @@ def schema() -> dict[str, Any]:
 
 
 # ---------------------------------------------------------------------------------------------- generation
-def _default(v: Any) -> Any:
-    if isinstance(v, float) and math.isinf(v):
-        return "inf"
-    return list(v) if isinstance(v, tuple) else v
-
-
 def _value(role_key: str, owner: str, extra: str = "", default: Any = dataclasses.MISSING) -> dict[str, Any]:
     """A field that is a number in its role's interval or a parameter name (or ``inf`` where allowed)."""
+    from .io import _plain
     from .roles import MAX_MAGNITUDE, ROLES
 
     r = ROLES[role_key]
@@ -106,43 +102,36 @@ def _value(role_key: str, owner: str, extra: str = "", default: Any = dataclasse
             + (", 'inf'," if r.allows_inf else "") + " or the name of a parameter of [parameters]." + extra)
     out: dict[str, Any] = {"description": text, "anyOf": alternatives}
     if default is not dataclasses.MISSING and default is not None:
-        out["default"] = _default(default)
+        out["default"] = _plain(default)
     return out
 
 
-def _defaults(cls: Any) -> dict[str, Any]:
-    return {f.name: f.default for f in dataclasses.fields(cls) if f.default is not dataclasses.MISSING}
+def _component(kind: Any) -> dict[str, Any]:
+    """The schema of one component of a kind (:data:`.components.COMPONENTS`), from its dataclass fields."""
+    props: dict[str, Any] = {}
+    fields = dataclasses.fields(kind.cls)
+    for f in fields:
+        if "role" in f.metadata:
+            unless = f.metadata["unless"]
+            note = f.metadata["note"] + (f" Unused (but checked) when {unless} = false." if unless else "")
+            props[f.name] = _value(f"{kind.key}.{f.name}", kind.schema_owner, note, f.default)
+        else:
+            props[f.name] = dict(f.metadata["schema"])
+    out: dict[str, Any] = {"title": kind.cls.__name__, "type": "object", "additionalProperties": False}
+    required = [f.name for f in fields if f.default is f.default_factory is dataclasses.MISSING]
+    out |= ({"required": required} if required else {}) | {"description": kind.description, "properties": props}
+    return out | ({"allOf": list(kind.rules)} if kind.rules else {})
 
 
-def _has_dof(dof: str) -> dict[str, Any]:
-    return {"required": ["dofs"], "properties": {"dofs": {"contains": {"const": dof}}}}
-
-
-def _disk() -> dict[str, Any]:
-    from .components import Disk
-
-    defaults = _defaults(Disk)
-    unused = " Unused (but checked) when tilting = false."
-    extra = {
-        "Theta": unused, "Phi": unused, "k_t": unused, "d_t": unused,
-        "h_upper": " 'upper' pads touch the face z0 = -h_upper; h_upper + h_lower must be > 0.",
-        "h_lower": " 'lower' pads touch the face z0 = +h_lower; h_upper + h_lower must be > 0.",
-        "Omega": "",
-        "radius": " Only used to check that every pad's radius is at most the disk radius.",
-    }  # fmt: skip
-    props = {f: _value(f"disk.{f}", "the disk", text, defaults[f]) for f, text in extra.items()}
-    props["tilting"] = {
-        "type": "boolean", "default": True,
-        "description": "true: the tilt angles q1, q2 are degrees of freedom. false: the tilt is locked and the "
-                       "disk is a belt moving at Omega * radius under each pad (planar pad models; then some pad "
-                       "needs a mass with a DOF).",
-    }  # fmt: skip
-    return {
-        "title": "Disk", "type": "object", "additionalProperties": False, "properties": props,
-        "description": "The rigid disk (table [disk]): tilting DOFs q1, q2 on rotational supports, constant "
-                       "spin Omega. Every key is optional; a missing key takes its default, which is a parameter "
-                       "name (Theta, Phi, k_t, d_t, h10, h20, Omega) that [parameters] must then define.",
-    }  # fmt: skip
+def _listed(kind: Any) -> dict[str, Any]:
+    """The model file's key of a kind: a table, or a list of tables."""
+    ref = {"$ref": f"#/$defs/{kind.key}"}
+    if not kind.many:
+        return {**ref, "description": kind.doc}
+    count = {"minItems": 1} if kind.required else {}
+    count |= {} if kind.max_count is None else {"maxItems": kind.max_count}
+    default: dict[str, Any] = {} if kind.required else {"default": []}
+    return {"type": "array", **count, "items": ref, **default, "description": kind.doc}
 
 
 def _law_text(law: Any) -> str:
@@ -178,86 +167,6 @@ def _friction() -> dict[str, Any]:
         "description": "Friction law at the pad's contact (inline table friction = { law = ..., mu = ... } or a "
                        "[pads.friction] table): the kinetic friction coefficient as a function of the sliding "
                        f"speed v [m/s]. {texts}. Missing table: coulomb with mu = parameter 'mu'.",
-    }  # fmt: skip
-
-
-def _pad() -> dict[str, Any]:
-    from .components import FACES, Pad
-
-    defaults = _defaults(Pad)
-    extra = {
-        "radius": " Must not exceed the disk radius.", "k": "", "d": "", "preload": "",
-        "k_ip": " Default 'inf' (rigid); a tangential DOF needs a finite k_ip.",
-        "d_ip": " Must be 0 unless the pad has a tangential DOF.",
-        "mass": " Needs at least one entry in dofs; absent = massless pad.",
-        "k_c": " Needed by a normal DOF: the contact force is preload + k_c * penetration + d_c * its rate.",
-        "d_c": "",
-    }  # fmt: skip
-    props: dict[str, Any] = {
-        "name": {"$ref": "#/$defs/componentName",
-                 "description": "Unique component name (ASCII letters, digits, '_'; unique among pads and "
-                                "calipers)."},
-        "face": {"enum": list(FACES),
-                 "description": "Disk face the pad touches: 'upper' (face z0 = -h_upper, pushes along +z0) or "
-                                "'lower' (face z0 = +h_lower, pushes along -z0)."},
-        "angle_deg": {"type": "number", "minimum": -_MAX_FLOAT, "maximum": _MAX_FLOAT, "default": 0.0,
-                      "description": "[deg] angular position of the pad around z0 (0 = the paper's pads, at "
-                                     "y0 = -radius). A finite number (not a parameter name)."},
-        "dofs": {"type": "array", "uniqueItems": True, "default": [], "items": {"enum": ["normal", "tangential"]},
-                 "description": "Directions in which the pad mass moves as its own DOF (distinct entries of "
-                                "'normal', 'tangential'); empty = massless pad (normal force from its "
-                                "equilibrium, tangentially quasi-static). Non-empty needs mass."},
-        "friction": {"$ref": "#/$defs/friction",
-                     "description": "Friction law at this contact (default: coulomb with mu = parameter 'mu')."},
-        "mount": {"$ref": "#/$defs/componentName",
-                  "description": "Name of the [[calipers]] entry carrying the pad's normal and tangential "
-                                 "supports (absent: the supports act on ground)."},
-    }  # fmt: skip
-    props |= {f: _value(f"pad.{f}", "this pad", text, defaults.get(f)) for f, text in extra.items()}
-    infinite = {"anyOf": [{"const": "inf"}, {"type": "number", "minimum": _MAX_FLOAT}]}
-    return {
-        "title": "Pad", "type": "object", "additionalProperties": False, "required": ["name", "face"],
-        "description": "One brake pad in point contact with a disk face (one [[pads]] table per pad).",
-        "properties": {f.name: props[f.name] for f in dataclasses.fields(Pad)},
-        "allOf": [
-            {"if": {"required": ["dofs"], "properties": {"dofs": {"minItems": 1}}}, "then": {"required": ["mass"]}},
-            {"if": {"required": ["mass"]}, "then": {"required": ["dofs"], "properties": {"dofs": {"minItems": 1}}}},
-            {"if": _has_dof("normal"), "then": {"required": ["k_c"]}},
-            {"if": _has_dof("tangential"),
-             "then": {"required": ["k_ip"], "properties": {"k_ip": {"not": infinite}}},
-             "else": {"properties": {"d_ip": {"const": 0}}}},
-        ],
-    }  # fmt: skip
-
-
-def _caliper() -> dict[str, Any]:
-    from .components import Caliper
-
-    defaults = _defaults(Caliper)
-    extra = {"mass": "", "k_n": " Must be > 0 with a normal DOF.", "d_n": "",
-             "k_t": " Must be > 0 with a tangential DOF.", "d_t": ""}  # fmt: skip
-    props: dict[str, Any] = {
-        "name": {"$ref": "#/$defs/componentName",
-                 "description": "Unique component name (ASCII letters, digits, '_'), referenced by the mount key "
-                                "of pads."},
-        "dofs": {"type": "array", "minItems": 1, "uniqueItems": True, "default": list(defaults["dofs"]),
-                 "items": {"enum": ["normal", "tangential"]},
-                 "description": "Translations of the caliper that are DOFs: 'normal' (along z0, coordinate "
-                                "wc_<name>) and/or 'tangential' (along x0, coordinate uc_<name>) [m]. Non-empty; "
-                                "default both."},
-    }  # fmt: skip
-    props |= {f: _value(f"caliper.{f}", "the caliper", text, defaults[f]) for f, text in extra.items()}
-
-    def positive_with(dof: str, key: str) -> dict[str, Any]:
-        return {"if": {"anyOf": [{"not": {"required": ["dofs"]}}, _has_dof(dof)]},
-                "then": {"properties": {key: {"not": {"const": 0}}}}}  # fmt: skip
-
-    return {
-        "title": "Caliper", "type": "object", "additionalProperties": False, "required": ["name"],
-        "description": "A rigid caliper (mounting) mass on springs to ground, coupling the supports of the pads "
-                       "mounted on it (one [[calipers]] table per caliper).",
-        "properties": {f.name: props[f.name] for f in dataclasses.fields(Caliper)},
-        "allOf": [positive_with("normal", "k_n"), positive_with("tangential", "k_t")],
     }  # fmt: skip
 
 
@@ -298,17 +207,21 @@ def build_schema() -> dict[str, Any]:
     Returns
     -------
     dict
-        The JSON Schema (draft 2020-12): component fields from the
-        :class:`~brakesqueal.model.components.Disk`,
-        :class:`~brakesqueal.model.components.Pad` and
-        :class:`~brakesqueal.model.components.Caliper` dataclasses, units
-        and ranges from :data:`brakesqueal.model.roles.ROLES`, friction laws
-        from :data:`brakesqueal.model.friction.LAWS`.
+        The JSON Schema (draft 2020-12): one key and one definition per
+        component kind of :data:`brakesqueal.model.components.COMPONENTS`
+        (fields, notes and cross-field rules from its dataclass and entry),
+        units and ranges from :data:`brakesqueal.model.roles.ROLES`, friction
+        laws from :data:`brakesqueal.model.friction.LAWS`.
     """
-    from .components import MAX_PADS
+    from .components import COMPONENTS, FrictionLaw
     from .expressions import RESERVED_NAMES
 
     reserved = sorted(RESERVED_NAMES)
+    components: dict[str, Any] = {}
+    for kind in COMPONENTS.values():
+        components[kind.key] = _component(kind)
+        if any(f.default_factory is FrictionLaw for f in dataclasses.fields(kind.cls)):
+            components.setdefault("friction", _friction())
     return {
         "$schema": "https://json-schema.org/draft/2020-12/schema",
         "$id": SCHEMA_ID,
@@ -336,12 +249,7 @@ def build_schema() -> dict[str, Any]:
                 "propertyNames": {"$ref": "#/$defs/parameterName"},
                 "additionalProperties": {"$ref": "#/$defs/numberOrExpression"},
             },
-            "disk": {"$ref": "#/$defs/disk",
-                     "description": "The disk ([disk] table; optional, every key has a default)."},
-            "pads": {"type": "array", "minItems": 1, "maxItems": MAX_PADS, "items": {"$ref": "#/$defs/pad"},
-                     "description": f"The pads ([[pads]] tables): at least 1, at most {MAX_PADS}."},
-            "calipers": {"type": "array", "items": {"$ref": "#/$defs/caliper"}, "default": [],
-                         "description": "Optional caliper masses ([[calipers]] tables)."},
+            **{kind.table: _listed(kind) for kind in COMPONENTS.values()},
             "presets": {"type": "object", "default": {}, "additionalProperties": {"$ref": "#/$defs/preset"},
                         "description": "Optional named presets ([presets.NAME] tables)."},
         },
@@ -363,7 +271,7 @@ def build_schema() -> dict[str, Any]:
                 "description": "A number (SI units) or a constant expression string such as \"16*pi\" or "
                                "\"inf\" (numbers, + - * / **, sqrt sin cos tan exp log abs, pi, inf).",
             },
-            "disk": _disk(), "pad": _pad(), "friction": _friction(), "caliper": _caliper(), "preset": _preset(),
+            **components, "preset": _preset(),
         },
     }  # fmt: skip
 
