@@ -141,3 +141,30 @@ def test_the_pad_solve_converges_from_any_warm_start(vs):
                 sim.kernels.pad_balance(y, l, d, p, g)
                 side.append(g[j])
             assert side[0] * side[1] < 0, (y, root)
+
+
+@pytest.mark.parametrize("method", ["DOP853-jit", "RK45"])
+def test_with_stick_slip_events_stop_only_at_contact_loss(method):
+    """events="stop" (the default): the rising-law pads' run stops at its first sliding reversal (at a near
+    stick their sliding velocity turns through reversal; the end of that model's validity), while with
+    regularised stick-slip the same start sticks and runs to the end.  A start that loses contact: the stick-law
+    pads' sliding reverses just before (recorded, passed) and the run stops at the contact loss, where the
+    rising law's run (events recorded) has it."""
+    space = resolve_space(preset="paper-fig3", sets=[*SETS, "Omega=1"])
+    t_end = 0.002
+    kick = [0.0, 0.0, 30.0, 0.0, 0.0, 0.0]  # F_n stays above 850 N
+    if method == "DOP853-jit":  # (solve_ivp checks events at its step ends only and misses these brief dips)
+        plain = simulate(None, regularised_pads(space, SLOPE).resolve({}), t_end, perturbation=kick)
+        assert plain.status == "sliding-reversal" and plain.t_event < t_end
+        stick = simulate(None, regularised_pads(space, SLOPE, 1e-3).resolve({}), t_end, perturbation=kick)
+        assert stick.status == "finished" and not stick.event_times
+    lift = [0.0, 0.0, 60.0, 0.0, 0.0, 0.0]  # the tilt reaches 5.5e-3 rad: a pad's F_n falls through 0 at 70 us
+    ref = simulate(None, regularised_pads(space, SLOPE).resolve({}), t_end, perturbation=lift, method=method,
+                   events="continue")
+    t_loss = min(v[0] for k, v in ref.event_times.items() if k.startswith("contact-loss"))
+    tr = simulate(None, regularised_pads(space, SLOPE, 1e-3).resolve({}), t_end, perturbation=lift, method=method)
+    assert tr.status == "contact-loss" and tr.t_event == pytest.approx(t_loss, rel=1e-5)
+    # as F_n -> 0 the friction can no longer hold the pad's spring: it slips forward (a true reversal),
+    # which is recorded and passed
+    rev = [t for k, v in tr.event_times.items() if k.startswith("sliding-reversal") for t in v]
+    assert all(t < tr.t_event for t in rev) and (rev or method != "DOP853-jit")

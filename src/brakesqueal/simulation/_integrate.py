@@ -680,7 +680,11 @@ def simulate(
         sliding velocity of that pad) of any pad; ``"continue"`` records the
         event times (``contact-loss-pad-<name>``, ``sliding-reversal-pad-<name>``)
         and integrates on with the same equations (bilateral contact, friction
-        direction ``v_r/|v_r|``); ``"off"`` ignores them.
+        direction ``v_r/|v_r|``); ``"off"`` ignores them.  When every pad has
+        regularised stick-slip (law ``stick``,
+        :func:`~brakesqueal.model.options.regularised_pads` with ``stick_speed``)
+        a sliding reversal is ordinary motion: ``"stop"`` stops at a contact
+        loss only and records the reversals in :attr:`Trajectory.event_times`.
     max_step : float
         Largest step [s].
     max_steps : int
@@ -932,6 +936,8 @@ class _Run:
         self.t_out, self.est, self.events, self.progress = t_out, est, events, progress
         self.npad = len(model.pads)
         self.engaged = engaged
+        #: every pad has regularised stick-slip (law ``stick``): ``events="stop"`` stops at contact loss only
+        self.stick = bool(model.spec.pads) and all(pad.friction.law == "stick" for pad in model.spec.pads)
 
     def _event_name(self, k: int) -> tuple[str, str]:
         pad = self.model.pads[k % self.npad]
@@ -952,6 +958,8 @@ class _Run:
             -3: "the step budget max_steps was exhausted",
             -4: "a pad's contact switched twice within 10 minimal steps (chattering contact, e.g. a pad pressed "
                 "with zero force while the disk moves along its surface)",
+            -5: "an expression of the equations divided by zero (e.g. a pad's friction direction v_r/|v_r| at "
+                "exactly zero sliding speed; regularised stick-slip, law 'stick', is defined there)",
         }.get(code, f"integrator error {code}")
         return RunStatus.FAILED, f"integration failed at t = {t:.6g} s: {reason}"
 
@@ -963,6 +971,8 @@ class _Run:
         N = self.y0.size
         Y = np.full((self.t_out.size, N), np.nan)
         mode = {"off": 0, "stop": 1, "continue": 2}[self.events]
+        if mode == 1 and self.stick:
+            mode = 5  # a sliding reversal is ordinary motion: recorded; a contact loss stops
         eng = np.ones(self.npad, dtype=np.int64)
         if self.engaged is not None:
             mode = 4 if self.events == "stop" else 3
@@ -985,11 +995,15 @@ class _Run:
                 status = -3
                 break
             w0 = time.perf_counter()
-            status, t, h, i_out, i_est, n_ev, k_event, t_event = k.dop853(
-                y, f, l, dl, ev_old, ev_prev, self.p, st.ztol, st.vr0, t, self.t1, h, self.rtol, self.atol,
-                self.max_step, self.t_out, i_out, Y, est.t0, est.dt, i_est, est.buf, mode, ev_t, ev_k, n_ev, chunk,
-                stats, y_event, eng, *tables)  # fmt: skip
-            if mode >= 3:  # unilateral: every switch is kept (the buffer is drained after each call)
+            try:
+                status, t, h, i_out, i_est, n_ev, k_event, t_event = k.dop853(
+                    y, f, l, dl, ev_old, ev_prev, self.p, st.ztol, st.vr0, t, self.t1, h, self.rtol, self.atol,
+                    self.max_step, self.t_out, i_out, Y, est.t0, est.dt, i_est, est.buf, mode, ev_t, ev_k, n_ev, chunk,
+                    stats, y_event, eng, *tables)  # fmt: skip
+            except ZeroDivisionError:  # numba raises for 0.0 ** -1 under any error model
+                status = -5
+                break
+            if mode in (3, 4):  # unilateral: every switch is kept (the buffer is drained after each call)
                 drained_t.append(ev_t[:n_ev].copy())
                 drained_k.append(ev_k[:n_ev].copy())
                 n_ev = 0
@@ -1001,7 +1015,7 @@ class _Run:
             if status != 2:
                 break
             budget = int(min(max(budget * CHUNK_SECONDS / max(dt, 1e-4), 16), 10_000_000))
-        if mode >= 3:
+        if mode in (3, 4):
             ev_t = np.concatenate(drained_t) if drained_t else np.zeros(0)
             ev_k = np.concatenate(drained_k) if drained_k else np.zeros(0, dtype=np.int64)
             n_ev = ev_t.size
@@ -1010,7 +1024,7 @@ class _Run:
         for i in range(min(n_ev, ev_t.size)):
             kind, pad = self._event_name(int(ev_k[i]))
             recorded.setdefault(f"{kind}-pad-{pad}", []).append(float(ev_t[i]))
-            if mode >= 3 and kind != "sliding-reversal":
+            if mode in (3, 4) and kind != "sliding-reversal":
                 switches[int(ev_k[i]) % self.npad].append(float(ev_t[i]))
         te = float(t_event) if status == 1 else None
         st_, msg = self._status(status, t, k_event, te)
@@ -1050,11 +1064,15 @@ class _Run:
             def make(i: int) -> Callable[[float, np.ndarray], float]:
                 def ev(t: float, y: np.ndarray) -> float:
                     yy = np.ascontiguousarray(y, dtype=float)
+                    # the same start every call: an event function must be a function of y alone (SciPy's root
+                    # finder re-evaluates the step's ends; a warm start from the last call can change the sign)
+                    lev[:], dlev[:] = self.l0, self.dl0
                     k.solve_pads(yy, lev, dlev, p, st.ztol, gev)
                     k.event_values(yy, lev, dlev, p, st.vr0, cb, vals)
                     return float(vals[i])
 
-                ev.terminal = self.events == "stop"  # type: ignore[attr-defined]
+                # with regularised stick-slip a sliding reversal (i >= npad) is recorded, not terminal
+                ev.terminal = self.events == "stop" and not (self.stick and i >= npad)  # type: ignore[attr-defined]
                 ev.direction = -1  # type: ignore[attr-defined]
                 return ev
 
@@ -1079,8 +1097,12 @@ class _Run:
             if not first:
                 te = te[te > a]
             ts, inv = np.unique(np.concatenate([t_out[i0:i1], te, [b]]), return_inverse=True)
-            sol = solve_ivp(fun, (a, b), y, method=method, t_eval=ts, rtol=self.rtol, atol=self.atol,
-                            max_step=self.max_step, events=evfuns or None)  # fmt: skip
+            try:
+                sol = solve_ivp(fun, (a, b), y, method=method, t_eval=ts, rtol=self.rtol, atol=self.atol,
+                                max_step=self.max_step, events=evfuns or None)  # fmt: skip
+            except ZeroDivisionError:  # numba raises for 0.0 ** -1 under any error model
+                code, t_end, sol_msg = -5, a, ""
+                break
             nfev += int(sol.nfev)
             got = sol.t.size
             Yc = np.ascontiguousarray(sol.y.T)
@@ -1108,5 +1130,7 @@ class _Run:
         if code == -2:
             msg = f"solve_ivp ({method}) failed: {sol_msg}"
         return {"status": st_, "message": msg, "Y": Y, "n": n, "nfev": nfev, "t_event": t_event,
-                "y_event": y_event, "event_times": recorded if self.events == "continue" else {},
+                "y_event": y_event,
+                "event_times": recorded if self.events == "continue" else (
+                    {k_: v for k_, v in recorded.items() if k_.startswith("sliding-reversal")} if self.stick else {}),
                 "event_pad": names[k_event][1] if code == 1 else None}  # fmt: skip

@@ -261,7 +261,7 @@ _DECORATOR = '@njit(cache=True, error_model="numpy")'
 # The static part of the kernel module: pad solve, RHS, events, post-processing, DOP853 with dense output.
 _TEMPLATE = r'''
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def solve_pads(y, l, dl, p, ztol, g):
     """Newton iterations for G = 0 per pad, in place from the current l, dl (warm start).
 
@@ -276,9 +276,10 @@ def solve_pads(y, l, dl, p, ztol, g):
         pad_balance(y, l, dl, p, g)
         done = True
         for j in range(_M):
-            d = g[j] / g[_M + j]
-            if not abs(d) < 1e300:
+            den = g[_M + j]
+            if den == 0.0 or not abs(g[j]) < 1e300 * abs(den):  # (python's error model: no division by 0)
                 return _solve_pads_bracketed(y, l, dl, p, ztol, g)
+            d = g[j] / den
             if _KIND[j] == 0:
                 l[j] -= d
                 z = l[j]
@@ -292,7 +293,7 @@ def solve_pads(y, l, dl, p, ztol, g):
     return _solve_pads_bracketed(y, l, dl, p, ztol, g)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _pad_value(y, l, dl, p, g, j, z):
     """G_j and dG_j/dz_j with pad j's unknown set to z (the other pads' entries are not used)."""
     if _KIND[j] == 0:
@@ -303,7 +304,7 @@ def _pad_value(y, l, dl, p, g, j, z):
     return g[j], g[_M + j]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _solve_pads_bracketed(y, l, dl, p, ztol, g):
     """The fallback of solve_pads when Newton from the warm start fails: per pad, a sign change of G_j is
     bracketed by steps doubling away from 0 (the silent motion's value) in the descent direction, then the
@@ -371,7 +372,7 @@ def _solve_pads_bracketed(y, l, dl, p, ztol, g):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rhs(y, l, dl, p, ztol, g, mw, out):
     """out = dy/dt for y = (Q, Qdot, L_dyn); the pad unknowns l, dl are solved (and updated) on the way.
 
@@ -383,7 +384,7 @@ def rhs(y, l, dl, p, ztol, g, mw, out):
     _accelerations(y, dl, ok, mw, out)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rhs_u(y, l, dl, p, ztol, g, mw, eng, D, out):
     """rhs with unilateral contact: the contact force of every pad with eng[j] == 0 (lifted off) removed.
 
@@ -404,7 +405,7 @@ def rhs_u(y, l, dl, p, ztol, g, mw, eng, D, out):
     _accelerations(y, dl, ok, mw, out)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _accelerations(y, dl, ok, mw, out):
     """out = (Qdot, Qddot, Ldot_dyn) from M, f in mw (M Qddot = -f, partial pivoting); NaN if singular or not ok."""
     n = _N
@@ -450,7 +451,7 @@ def _accelerations(y, dl, ok, mw, out):
         out[n] = math.nan
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def event_values(y, l, dl, p, vr0, cb, out):
     """Per pad F_n (contact loss at <= 0), then per pad v_r . v_r0 (sliding reversal at <= 0); l, dl solved."""
     contact(y, l, dl, p, cb)
@@ -460,7 +461,7 @@ def event_values(y, l, dl, p, vr0, cb, out):
         out[_NPAD + j] = cb[b + 1] * vr0[3 * j] + cb[b + 2] * vr0[3 * j + 1] + cb[b + 3] * vr0[3 * j + 2]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def event_values_u(y, l, dl, p, vr0, cb, eng, out):
     """event_values with unilateral contact: a lifted pad's contact function is -F_n (re-contact at <= 0) and its
     sliding-reversal function is 1 (no friction)."""
@@ -471,7 +472,7 @@ def event_values_u(y, l, dl, p, vr0, cb, eng, out):
             out[_NPAD + j] = 1.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def dense_eval(F, y_old, x, out):
     """SciPy's Dop853DenseOutput at normalized time x in [0, 1]."""
     n = y_old.shape[0]
@@ -487,7 +488,7 @@ def dense_eval(F, y_old, x, out):
         out[j] = acc + y_old[j]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def post_process(Y, count, l, dl, p, ztol, L_out, dL_out, C_out, E_out):
     """Pad unknowns, contact quantities and energy terms at the first ``count`` rows of Y (in place).
 
@@ -521,7 +522,7 @@ def post_process(Y, count, l, dl, p, ztol, L_out, dL_out, C_out, E_out):
             E_out[i, k] = eb[k]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _error_norm(K, E5, E3, h, scale):
     n = scale.shape[0]
     e5 = 0.0
@@ -539,7 +540,7 @@ def _error_norm(K, E5, E3, h, scale):
     return abs(h) * e5 / math.sqrt((e5 + 0.01 * e3) * n)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _event_at(k, x, F, y, l, dl, p, ztol, vr0, g, cb, ev, yint, eng):
     """Event function k at normalized time x of the step (pad unknowns solved from l, dl, updated)."""
     dense_eval(F, y, x, yint)
@@ -548,7 +549,7 @@ def _event_at(k, x, F, y, l, dl, p, ztol, vr0, g, cb, ev, yint, eng):
     return ev[k]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _bisect(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb, eng):
     """First x in [a, b] with event k <= 0, given event k > 0 at a and <= 0 at b (60 halvings; returns the <= 0 end)."""
     lb[:] = l0
@@ -562,7 +563,7 @@ def _bisect(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb, eng)
     return b
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _golden(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb, eng):
     """Minimum of event k on [a, b] (48 golden-section steps): returns (x, value); stops early at a value <= 0."""
     lb[:] = l0
@@ -594,7 +595,7 @@ def _golden(k, a, b, F, y, l0, dl0, p, ztol, vr0, g, cb, ev, yint, lb, dlb, eng)
     return d, fd
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol, max_step, t_out, i_out, Y, te0, dte,
            i_est, Yest, event_mode, ev_t, ev_k, n_ev, budget, stats, y_event, eng, A, B, C, E3, E5, D):
     """Adaptive DOP853 from t towards t1 (SciPy's algorithm), at most ``budget`` accepted steps per call.
@@ -608,7 +609,8 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
     (row i % Yest.shape[0]).  event_mode: 0 = none, 1 = stop at the first event, 2 = record and continue,
     3 = unilateral contact (eng[j] = 1 pressed, 0 lifted; a contact event ends the step there and switches the
     pad: recorded as k = j for a lift-off, 2 NPAD + j for a re-contact), sliding reversals recorded, 4 = the same
-    but stop at a sliding reversal.
+    but stop at a sliding reversal, 5 = stop at the first contact loss, record sliding reversals (pads with
+    regularised stick-slip, for which a reversal is ordinary motion).
     Returns (status, t, h_abs, i_out, i_est, n_ev, k_event, t_event): status 0 = reached t1,
     1 = stopped at an event (state in y_event), 2 = budget used or event buffer full (call again to continue),
     -1 = step size too small, -2 = non-finite state or pad equations unsolvable, -4 = a pad switched twice
@@ -650,7 +652,7 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
     t_event = math.nan
     steps = 0
     while t < t1:
-        if steps >= budget or (event_mode >= 3 and n_ev + 2 * _NPAD + 2 > ev_t.shape[0]):
+        if steps >= budget or ((event_mode == 3 or event_mode == 4) and n_ev + 2 * _NPAD + 2 > ev_t.shape[0]):
             return (2, t, h_abs, i_out, i_est, n_ev, k_event, t_event)
         min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
         if h_abs > max_step:
@@ -794,7 +796,7 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
                         if event_mode == 3 and k >= _NPAD:
                             slide_t[k - _NPAD] = tk  # recorded below if before a contact switch
                             break
-                        if event_mode == 2:
+                        if event_mode == 2 or (event_mode == 5 and k >= _NPAD):
                             if n_ev < ev_t.shape[0]:
                                 ev_t[n_ev] = tk
                                 ev_k[n_ev] = k
@@ -806,12 +808,12 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
                                 dense_eval(F, y, xc, y_event)
                             break
                     i = nxt
-            if event_mode == 1 and first >= 0:
+            if (event_mode == 1 or event_mode == 5) and first >= 0:
                 stop = True
                 t_stop = tf
                 k_event = first
                 t_event = tf
-            if event_mode >= 3:
+            if event_mode == 3 or event_mode == 4:
                 for k in range(_NPAD):
                     if slide_t[k] == slide_t[k] and slide_t[k] <= tf:
                         ev_t[n_ev] = slide_t[k]
