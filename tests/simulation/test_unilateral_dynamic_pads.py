@@ -67,6 +67,7 @@ def test_the_pressed_pad_rate_balance_degenerates_before_lift_off(case):
     p = sim.parameter_vector(params)
     # the pressed equations cannot be integrated to F_n = 0: the run fails while every pad is still pressed
     assert tr.status == "failed"
+    assert "cannot reach contact loss when its rate balance degenerates first" in tr.message  # says why
     ok = np.isfinite(tr.contact[:, 0, 0])
     Fn = tr.contact[ok, :, 0]
     assert Fn.min() > 50.0  # N: no pad reached F_n = 0

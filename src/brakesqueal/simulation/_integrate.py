@@ -844,8 +844,16 @@ def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sampl
     if unilateral:
         engaged = engagement_at(t_out[:n], eng0.astype(bool), res.get("switch_times", [[] for _ in range(npad)]))
         C[:, 0::7] = np.where(engaged, C[:, 0::7], 0.0)  # the acting normal force max(0, F_n)
+    message = res["message"]
+    if res["status"] == RunStatus.FAILED and model.dynamic and n:
+        Fn = C[:, 0::7]
+        last = np.flatnonzero(np.all(np.isfinite(Fn), axis=1))
+        if last.size and (ref := float(np.max(np.abs(Fn[0])))) > 0 and float(Fn[last[-1]].min()) < 0.2 * ref:
+            message += (f"; a pad's normal force had fallen to {float(Fn[last[-1]].min()):.4g} N (from "
+                        f"{ref:.4g} N): a pad with rate-dependent friction cannot reach contact loss when its rate "
+                        "balance degenerates first (docs/simulation.md, unilateral contact)")
     return Trajectory(
-        status=res["status"], message=res["message"], t=t_out[:n], y=Y, l=L, contact=C.reshape(n, npad, 7),
+        status=res["status"], message=message, t=t_out[:n], y=Y, l=L, contact=C.reshape(n, npad, 7),
         energy_terms=E, params=params, q0=np.asarray(st.silent.q0, dtype=float).copy(), method=method, rtol=rtol,
         atol=atol_v, t_span=(t0, t1), t_event=res.get("t_event"), y_event=res.get("y_event"),
         event_times=res.get("event_times", {}), stats={"nfev": res["nfev"], "wall_s": wall, **res.get("stats", {})},
