@@ -429,6 +429,8 @@ EXEMPT = {
                            "kernels and the crossings, generates no code",
     "nonlinear/implicit.py": "Hopf normal form of the implicit model equations: evaluates the compiled residual "
                              "Jacobians and the linearization, generates no code",
+    "nonlinear/harmonic.py": "limit cycles of the implicit model equations by harmonic balance: evaluates the "
+                             "compiled residuals and Jacobians, generates no code",
 }  # fmt: skip
 
 

@@ -235,6 +235,13 @@ def cycles(
                                          "(F_n = max(0, .), slower).")] = "bilateral",
     pad_slope: PadSlopeOpt = None,
     stick_speed: StickSpeedOpt = None,
+    exact_pads: Annotated[bool, typer.Option("--exact-pads", help="Harmonic balance on the implicit equations: the "
+                                             "massless Coulomb pads exact (tangential rates kept, no "
+                                             "regularisation); bilateral, text or json output only.")] = False,
+    harmonics: Annotated[int, typer.Option("--harmonics", min=1, max=200, help="With --exact-pads: initial number "
+                                           "of harmonics (raised while the truncation error exceeds 1e-6).")] = 6,
+    max_harmonics: Annotated[int, typer.Option("--max-harmonics", min=1, max=400, help="With --exact-pads: largest "
+                                               "number of harmonics (the branch stops where more are needed).")] = 60,
 ) -> None:
     """Limit cycles from the first Hopf point on a path: amplitude, frequency, stability, where a pad lifts off."""
     from ..analysis.maps import parse_axis
@@ -244,6 +251,11 @@ def cycles(
     axis = parse_axis(along, with_num=False)
     if contact not in ("bilateral", "unilateral"):
         raise ParameterError(f"The option '--contact' must be bilateral or unilateral; got {contact!r}")
+    if exact_pads:
+        _cycles_exact_pads(axis, space_from(model, preset, params, set_), fmt=fmt, max_points=max_points,
+                           harmonics=harmonics, max_harmonics=max_harmonics, contact=contact, pad_slope=pad_slope,
+                           stick_speed=stick_speed, plot=plot, out=out)
+        return
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     if out:
@@ -286,6 +298,40 @@ def cycles(
         lines.append(f"note: {b.hopf.message}")
     summary = b.summary.text() if b.summary is not None else ""
     sys.stdout.write("\n".join(lines) + "\n" + summary)
+
+
+def _cycles_exact_pads(axis: Any, space: Any, *, fmt: OutFormat, max_points: int, harmonics: int,
+                       max_harmonics: int, contact: str, pad_slope: float | None, stick_speed: float | None,
+                       plot: str | None, out: str | None) -> None:
+    """``cycles --exact-pads``: the harmonic-balance branch of the implicit equations, as text or JSON."""
+    from ..nonlinear.harmonic import harmonic_branch
+
+    for flag, bad in (("--contact unilateral", contact != "bilateral"), ("--pad-slope", pad_slope is not None),
+                      ("--stick-speed", stick_speed is not None), ("--plot", bool(plot)), ("--out", bool(out))):
+        if bad:
+            raise ParameterError(f"The option '--exact-pads' cannot be combined with {flag} (the exact pads are "
+                                 "bilateral and unregularised; text or json output)")
+    if max_harmonics < harmonics:
+        raise ParameterError(f"The option '--max-harmonics' must be >= --harmonics = {harmonics}; got {max_harmonics}")
+    b = harmonic_branch(space, axis, max_points=max_points, harmonics=harmonics, max_harmonics=max_harmonics)
+    if fmt == OutFormat.json:
+        sys.stdout.write(json.dumps(b.to_dict(), indent=2, default=float) + "\n")
+        return
+    h = b.hopf.hopf
+    lines = [f"Hopf point {axis.name} = {h.p0:.12g}: {h.criticality} (l1 = {h.l1:.6g} ± {h.l1_error:.2g}), "
+             f"{h.frequency0_hz:.6g} Hz (exact pads: tangential rates kept)",
+             f"{len(b.points)} branch points by harmonic balance ({b.status}: {b.message})",
+             f"stability: {b.stability}"]
+    head = (f"{axis.name:>12} {'f [Hz]':>10} {'tilt [rad]':>11} " + " ".join(f"{'Fn min ' + p:>10}" for p in b.pads)
+            + f" {'slide min':>10} {'H':>3} {'trunc':>8} {'resid':>8}  stable")
+    lines.append(head)
+    for pt in b.points:
+        tilt = f"{pt.tilt_amplitude:11.4g}" if pt.tilt_amplitude is not None else f"{'-':>11}"
+        st = "-" if pt.stable is None else ("yes" if pt.stable else "no")
+        lines.append(f"{pt.p:12.8g} {pt.frequency_hz:10.6g} {tilt} " + " ".join(f"{f:10.5g}" for f in pt.F_n_min)
+                     + f" {pt.sliding_margin_min:10.4g} {pt.harmonics:3d} {pt.truncation_error:8.1e} "
+                       f"{pt.residual:8.1e}  {st}")
+    sys.stdout.write("\n".join(lines) + "\n")
 
 
 def register(app: typer.Typer) -> None:

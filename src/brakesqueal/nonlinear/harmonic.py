@@ -1,0 +1,769 @@
+r"""Limit cycles of a brake model with the exact massless Coulomb pads, by harmonic balance.
+
+The model's equations are implicit, ``r(Q, Qdot, Qddot, L, Ldot) = 0`` (eq. 44 and the pads' balances
+``G = (l - u_m) + c_ip (f_t + mu* N0) = 0``, eqs. 33-34; the generated residuals of
+:class:`~brakesqueal.codegen.compiled.CompiledModel` with their exact Jacobian).  With Coulomb friction the
+pad's rate ``Ldot`` enters ``G`` only through the friction direction and ``F_n``: at the silent motion it
+drops out (``dG/dLdot = 0``), so the explicit simulation treats the pads as quasi-static (exact to first
+order) or regularises them (``mu + S v``, error ``O(S)``).  Harmonic balance needs neither: the periodic
+orbit is sought directly in the implicit equations,
+
+.. math::
+
+   u(t) = (Q, L)(t) = c_0 + \sum_{k=1}^{H} a_k \cos k\omega t + b_k \sin k\omega t,
+
+with ``Qdot``, ``Qddot``, ``Ldot`` from the series, and the residuals ``r`` evaluated at ``M = 4H + 4``
+equally spaced phases and projected on the same ``2H + 1`` harmonics (alternating frequency-time
+Galerkin method).  Unknowns: the coefficients, ``omega`` and the parameter ``p``; equations: the
+``(n + m)(2H + 1)`` projected residuals, the phase condition ``b_1 = 0`` of a reference coordinate and a
+pseudo-arclength condition.  Newton's method uses the exact Jacobian of ``r`` (the generated code, chained
+through the series); only ``d r / d p`` is a central difference (``p`` enters through the resolved parameter
+vector).  The branch starts from the exact normal form (:func:`~.implicit.exact_lyapunov`: eigenvector
+``phi`` of the pencil, ``|z|^2 = -mu' (p - p0) / Re c1``), corrected at a fixed first-harmonic amplitude
+just past the Hopf point, and is continued until ``max_points``, the end of the range, a pad's normal force
+reaching 0 over the period (contact loss: the bilateral equations end) or a pad's sliding velocity
+reversing (Coulomb friction would stick: the end of the model's validity); both events are located by the
+Illinois method on the parameter.
+
+Truncation error: the largest of the two highest harmonics relative to the first (each coordinate in its
+own scale); above ``harmonic_tol`` the number of harmonics is raised (up to ``max_harmonics``), beyond that
+the branch stops with status ``truncation``.
+
+Stability: Hill's method on the periodic pencil ``r_u(t) + (lambda + d/dt) r_udot(t) + (lambda + d/dt)^2
+r_uddot(t)`` in the same Fourier basis (a quadratic eigenvalue problem, linearised); of every family
+``lambda + i k omega`` the copy whose eigenvector is centred on ``k = 0`` is kept, ``2n`` exponents of the
+mechanical states ``(Q, Qdot)`` within the band the harmonics resolve (``|lambda| <= H omega / 2``), the
+smallest in modulus being the trivial one (the phase shift; returned as an accuracy check).  The pads' own
+modes (a pad whose rate enters its balance on the orbit has a first-order mode of rate ``~ G_L / G_Ldot``,
+``1e6``-``1e8`` 1/s on the paper's model, far outside that band) are not resolved and not judged.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import BrakesquealError, ParameterError
+
+__all__ = ["HarmonicPoint", "HarmonicBranch", "harmonic_branch"]
+
+
+
+@dataclass(frozen=True, eq=False)
+class HarmonicPoint:
+    """One periodic orbit of the implicit equations.
+
+    Attributes
+    ----------
+    p : float
+        Parameter value.
+    omega : float
+        Angular frequency [rad/s].
+    frequency_hz : float
+        ``omega / (2 pi)``.
+    amplitude : dict
+        First-harmonic amplitude ``sqrt(a_1^2 + b_1^2)`` of every coordinate ``Q`` and pad deformation ``L`` (SI).
+    tilt_amplitude : float or None
+        Largest first-harmonic amplitude of the tilts ``q1``, ``q2`` [rad] (``None`` without them).
+    F_n_min : tuple of float
+        Per pad, the smallest normal force over the period [N].
+    sliding_margin_min : float
+        The smallest, over pads and the period, sliding velocity component along the silent motion's [m/s].
+    residual : float
+        Largest residual at 10x more (off-grid) phases, relative to the linear terms' magnitude.
+    truncation_error : float
+        Largest of the two highest harmonics relative to the first (per coordinate, largest over coordinates).
+    harmonics : int
+        Number of harmonics ``H``.
+    coefficients : ndarray
+        ``(n + m, 2H + 1)``: ``c_0, a_1, b_1, ..., a_H, b_H`` per coordinate (``Q`` then ``L``).
+    floquet_exponents : ndarray or None
+        Non-trivial Floquet exponents by decreasing real part (Hill's method), ``None`` if not computed.
+    stable : bool or None
+        Every non-trivial exponent with negative real part; ``None`` if not computed.
+    trivial_exponent : float or None
+        The smallest ``|exponent|`` (the phase shift's zero exponent; an accuracy check).
+    """
+
+    p: float
+    omega: float
+    frequency_hz: float
+    amplitude: dict[str, float]
+    tilt_amplitude: float | None
+    F_n_min: tuple[float, ...]
+    sliding_margin_min: float
+    residual: float
+    truncation_error: float
+    harmonics: int
+    coefficients: np.ndarray = field(repr=False)
+    floquet_exponents: np.ndarray | None = field(default=None, repr=False)
+    stable: bool | None = None
+    trivial_exponent: float | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready fields (no coefficients)."""
+        return {"p": self.p, "omega": self.omega, "frequency_hz": self.frequency_hz, "amplitude": self.amplitude,
+                "tilt_amplitude": self.tilt_amplitude, "F_n_min": list(self.F_n_min),
+                "sliding_margin_min": self.sliding_margin_min, "residual": self.residual,
+                "truncation_error": self.truncation_error, "harmonics": self.harmonics,
+                "stable": self.stable, "trivial_exponent": self.trivial_exponent,
+                "floquet_exponents": None if self.floquet_exponents is None else
+                [[float(v.real), float(v.imag)] for v in self.floquet_exponents]}
+
+    def series(self, t: np.ndarray) -> np.ndarray:
+        """``u(t) = (Q, L)(t)`` at times ``t`` [s] (``t = 0``: the phase where ``b_1`` of the reference is 0).
+
+        Parameters
+        ----------
+        t : ndarray
+            Times [s].
+
+        Returns
+        -------
+        ndarray
+            Shape ``(len(t), n + m)``: ``Q`` then ``L``.
+        """
+        th = self.omega * np.asarray(t, dtype=float)
+        return _basis(th, (self.coefficients.shape[1] - 1) // 2, 0) @ self.coefficients.T
+
+
+@dataclass(frozen=True)
+class HarmonicBranch:
+    """Limit cycles of the implicit equations (exact Coulomb pads) from a Hopf point.
+
+    Attributes
+    ----------
+    parameter : str
+        The path parameter.
+    hopf : PadHopf
+        The exact normal form where the branch starts.
+    points : tuple of HarmonicPoint
+        The orbits, in continuation order.
+    status : str
+        ``"max_points"``, ``"range"``, ``"contact_loss"``, ``"sliding_reversal"``, ``"truncation"`` or
+        ``"step_underflow"``.
+    message : str
+        Why the branch ends.
+    contact_loss : float or None
+        Parameter value where a pad's smallest normal force over the period reaches 0 (located).
+    sliding_reversal : float or None
+        Parameter value where a pad's sliding velocity first reverses on the cycle (located): the end of the
+        model's validity (Coulomb friction would stick).
+    coords, pads : tuple of str
+        Names of ``(Q, L)`` and of the pads.
+    stability : str
+        ``"Hill's method"`` or ``"not computed"``.
+    """
+
+    parameter: str
+    hopf: Any
+    points: tuple[HarmonicPoint, ...]
+    status: str
+    message: str
+    contact_loss: float | None
+    sliding_reversal: float | None
+    coords: tuple[str, ...]
+    pads: tuple[str, ...]
+    stability: str = "not computed"
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary: Hopf point, status, events and every point."""
+        h = self.hopf.hopf
+        return {"parameter": self.parameter, "method": "harmonic balance on the implicit equations "
+                "(exact massless Coulomb pads, tangential rates kept)",
+                "hopf": {"p0": h.p0, "omega0": h.omega0, "frequency_hz": h.frequency0_hz, "l1": h.l1,
+                         "l1_error": h.l1_error, "criticality": h.criticality, "side": h.side},
+                "status": self.status, "message": self.message, "contact_loss": self.contact_loss,
+                "sliding_reversal": self.sliding_reversal, "stability": self.stability,
+                "coords": list(self.coords), "pads": list(self.pads),
+                "points": [pt.to_dict() for pt in self.points]}
+
+
+def _basis(theta: np.ndarray, H: int, order: int) -> np.ndarray:
+    """``d^order/dtheta^order`` of ``(1, cos theta, sin theta, ..., cos H theta, sin H theta)``: ``(len, 2H+1)``."""
+    th = np.asarray(theta, dtype=float)
+    E = np.zeros((th.size, 2 * H + 1))
+    E[:, 0] = 1.0 if order == 0 else 0.0
+    for k in range(1, H + 1):
+        c, s = np.cos(k * th), np.sin(k * th)
+        # derivatives of (cos, sin): (cos, sin) -> (-k sin, k cos) -> (-k^2 cos, -k^2 sin)
+        fc, fs = [(c, s), (-k * s, k * c), (-k * k * c, -k * k * s)][order]
+        E[:, 2 * k - 1], E[:, 2 * k] = fc, fs
+    return E
+
+
+class _Balance:
+    """The harmonic-balance equations of one model with ``H`` harmonics."""
+
+    def __init__(self, space: Any, name: str, cm: Any, H: int, ref: int, scale: np.ndarray) -> None:
+        self.space, self.name, self.cm = space, name, cm
+        self.n, self.m = cm.n, cm.m
+        self.N = self.n + self.m
+        self.ref, self.scale = ref, scale
+        self._pv: dict[float, list[float]] = {}
+        self.set_harmonics(H)
+
+    def set_harmonics(self, H: int) -> None:
+        self.H, self.K = H, 2 * H + 1
+        M = 4 * H + 4
+        th = 2 * np.pi * np.arange(M) / M
+        self.E = [_basis(th, H, k) for k in range(3)]
+        Pr = self.E[0].T * (2.0 / M)
+        Pr[0] *= 0.5
+        self.Pr = Pr
+
+    def pvec(self, p: float) -> list[float]:
+        if p not in self._pv:
+            from ..simulation import simulation_model
+
+            params = self.space.resolve({self.name: float(p)})
+            if not hasattr(self, "_sim"):
+                self._sim = simulation_model(params.model)
+            self._pv = {p: [float(v) for v in self._sim.parameter_vector(params)]}
+        return self._pv[p]
+
+    def states(self, C: np.ndarray, omega: float, E: list[np.ndarray]) -> list[np.ndarray]:
+        """The rows of ``x = (Q, Qdot, Qddot, L, Ldot)`` at the phases of ``E``."""
+        n = self.n
+        U, Ud, Udd = (E[0] @ C.T).T, omega * (E[1] @ C.T).T, omega * omega * (E[2] @ C.T).T
+        return [*U[:n], *Ud[:n], *Udd[:n], *U[n:], *Ud[n:]]
+
+    def residual_time(self, C: np.ndarray, omega: float, p: float, E: list[np.ndarray]) -> np.ndarray:
+        x = self.states(C, omega, E)
+        M = E[0].shape[0]
+        r = self.cm.vectorized.residuals(x, self.pvec(p))
+        return np.array([np.broadcast_to(np.asarray(v, dtype=float), (M,)) for v in r])
+
+    def jac_time(self, C: np.ndarray, omega: float, p: float, E: list[np.ndarray]) -> np.ndarray:
+        x = self.states(C, omega, E)
+        M = E[0].shape[0]
+        J = self.cm.vectorized.jacobians(x, self.pvec(p))
+        J = np.array([np.broadcast_to(np.asarray(v, dtype=float), (M,)) for v in J])
+        return J.reshape(self.N, self.cm.nx, M)
+
+    def F(self, y: np.ndarray) -> np.ndarray:
+        C, omega, p = self.unpack(y)
+        R = self.residual_time(C, omega, p, self.E) @ self.Pr.T
+        return np.concatenate([R.ravel(), [C[self.ref, 2] / self.scale[self.ref]]])
+
+    def unpack(self, y: np.ndarray) -> tuple[np.ndarray, float, float]:
+        NK = self.N * self.K
+        return y[:NK].reshape(self.N, self.K), float(y[NK]), float(y[NK + 1])
+
+    def jacobian(self, y: np.ndarray) -> np.ndarray:
+        """``dF/dy`` with ``y = (C, omega, p)`` (exact in ``C``, ``omega``; central difference in ``p``)."""
+        C, omega, p = self.unpack(y)
+        n, m, N, K = self.n, self.m, self.N, self.K
+        J = self.jac_time(C, omega, p, self.E)
+        JQ, JdQ, JddQ = J[:, :n], J[:, n:2 * n], J[:, 2 * n:3 * n]
+        JL, JdL = J[:, 3 * n:3 * n + m], J[:, 3 * n + m:]
+        K0 = np.concatenate([JQ, JL], axis=1)
+        K1 = omega * np.concatenate([JdQ, JdL], axis=1)
+        K2 = omega * omega * np.concatenate([JddQ, np.zeros_like(JL)], axis=1)
+        E0, E1, E2 = self.E
+        D = (np.einsum("aj,ikj,jb->iakb", self.Pr, K0, E0) + np.einsum("aj,ikj,jb->iakb", self.Pr, K1, E1)
+             + np.einsum("aj,ikj,jb->iakb", self.Pr, K2, E2)).reshape(N * K, N * K)
+        U1, U2 = (E1 @ C.T).T, (E2 @ C.T).T  # d/dtheta, d^2/dtheta^2
+        dw = (np.einsum("ikj,kj->ij", np.concatenate([JdQ, JdL], axis=1), U1)
+              + 2 * omega * np.einsum("ikj,kj->ij", JddQ, U2[:n]))
+        dw = (dw @ self.Pr.T).ravel()
+        hp = 1e-6 * max(abs(p), 1e-3)
+        try:
+            rp = self.residual_time(C, omega, p + hp, self.E) - self.residual_time(C, omega, p - hp, self.E)
+            dp = ((rp / (2 * hp)) @ self.Pr.T).ravel()
+        except ParameterError:  # at a bound of the parameter's range: one-sided
+            rp = self.residual_time(C, omega, p, self.E) - self.residual_time(C, omega, p - hp, self.E)
+            dp = ((rp / hp) @ self.Pr.T).ravel()
+        out = np.zeros((N * K + 1, N * K + 2))
+        out[:N * K, :N * K] = D
+        out[:N * K, N * K] = dw
+        out[:N * K, N * K + 1] = dp
+        out[N * K, self.ref * K + 2] = 1.0 / self.scale[self.ref]
+        return out
+
+
+class _Continuation:
+    """Newton and pseudo-arclength continuation in scaled unknowns."""
+
+    def __init__(self, bal: _Balance, omega0: float, p_scale: float, tol: float) -> None:
+        self.bal, self.omega0, self.p_scale, self.tol = bal, omega0, p_scale, tol
+
+    def yscale(self) -> np.ndarray:
+        b = self.bal
+        return np.concatenate([np.repeat(b.scale, b.K), [self.omega0, self.p_scale]])
+
+    def newton(self, y: np.ndarray, extra: Any, max_iter: int = 15) -> tuple[np.ndarray, int]:
+        """Solve ``F(y) = 0`` plus the one equation ``extra(y) -> (value, gradient)`` (unscaled gradient)."""
+        s = self.yscale()
+        for it in range(1, max_iter + 1):
+            J = self.bal.jacobian(y)
+            F = self.bal.F(y)
+            g, dg = extra(y)
+            A = np.vstack([J, dg]) * s[None, :]
+            b = np.concatenate([F, [g]])
+            rs = np.max(np.abs(A), axis=1)
+            rs[rs == 0] = 1.0
+            try:
+                dx = np.linalg.solve(A / rs[:, None], -b / rs)
+            except np.linalg.LinAlgError:
+                raise BrakesquealError("singular harmonic-balance Jacobian") from None
+            if not np.all(np.isfinite(dx)):
+                raise BrakesquealError("harmonic-balance Newton step is not finite")
+            step = float(np.max(np.abs(dx)))
+            if step > 0.5:  # trust region in the scaled unknowns
+                dx *= 0.5 / step
+            y = y + dx * s
+            if step <= self.tol:
+                return y, it
+        raise BrakesquealError(f"harmonic-balance Newton did not converge in {max_iter} iterations "
+                               f"(last scaled step {step:.3g})")
+
+    def tangent(self, y: np.ndarray, prev: np.ndarray | None) -> np.ndarray:
+        s = self.yscale()
+        A = self.bal.jacobian(y) * s[None, :]
+        rs = np.max(np.abs(A), axis=1)
+        rs[rs == 0] = 1.0
+        t = np.linalg.svd(A / rs[:, None])[2][-1]
+        if prev is not None and float(t @ prev) < 0:
+            t = -t
+        return t / np.linalg.norm(t)
+
+
+def _first_hopf(space: Any, axis: Any, use_cache: bool) -> Any:
+    from ..analysis.crossings import crossings
+    from .implicit import exact_lyapunov
+
+    r = crossings(space, axis)
+    errors = []
+    for value, _direction in r.crossings:  # type: ignore[attr-defined]
+        try:
+            ex = exact_lyapunov(space, axis.name, float(value), use_cache=use_cache)
+        except (BrakesquealError, np.linalg.LinAlgError) as exc:
+            errors.append(f"{value:.10g}: {exc}")
+            continue
+        if ex.hopf.side and axis.start <= ex.hopf.p0 <= axis.stop:
+            return ex
+    extra = f" (crossings without a cycle prediction: {'; '.join(errors)})" if errors else ""
+    raise ParameterError(f"no Hopf point with a limit-cycle prediction for {axis.name} in "
+                         f"({axis.start:g}, {axis.stop:g}){extra}; see brakesqueal hopf")
+
+
+def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics: int = 60,
+                    max_points: int = 40, harmonic_tol: float = 1e-6, tol: float = 1e-10,
+                    ds: float = 0.05, ds_max: float = 0.2, start_offset: float = 1e-4,
+                    stability: bool = True, use_cache: bool = True) -> HarmonicBranch:
+    """Limit cycles of the implicit equations (exact massless Coulomb pads) by harmonic balance.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides (any model).
+    axis : Axis
+        The path: the first Hopf point with a cycle prediction in ``[start, stop]`` is continued within it.
+    harmonics : int
+        Initial number of harmonics ``H`` (>= 1); raised while the truncation error exceeds ``harmonic_tol``.
+    max_harmonics : int
+        Largest number of harmonics (>= ``harmonics``).
+    max_points : int
+        Largest number of branch points (>= 2).
+    harmonic_tol : float
+        Largest accepted truncation error (relative size of the highest harmonics), in ``(0, 1)``.
+    tol : float
+        Newton tolerance on the scaled update, in ``(0, 1e-3]``.
+    ds, ds_max : float
+        Initial and largest pseudo-arclength step in scaled unknowns (coefficients over the amplitude
+        predicted at the first event or the end of the range, ``p`` over the distance to it).
+    start_offset : float
+        The first orbit has the first-harmonic amplitude predicted at ``start_offset`` times that distance
+        past the Hopf point, in ``(0, 0.5]``.
+    stability : bool
+        Compute Floquet exponents by Hill's method.
+    use_cache : bool
+        Use the on-disk code cache.
+
+    Returns
+    -------
+    HarmonicBranch
+
+    Raises
+    ------
+    ParameterError
+        A bad option (naming it), an axis outside the parameter's allowed range, or no Hopf point with a
+        cycle prediction on the path.
+    BrakesquealError
+        The first orbit cannot be found.
+    """
+    from ..simulation import simulation_model
+
+    for nm, v, lo in (("harmonics", harmonics, 1), ("max_points", max_points, 2)):
+        if not isinstance(v, (int, np.integer)) or isinstance(v, bool) or v < lo:
+            raise ParameterError(f"The option '{nm}' must be an integer >= {lo}; got {v!r}")
+    if not isinstance(max_harmonics, (int, np.integer)) or max_harmonics < harmonics:
+        raise ParameterError(f"The option 'max_harmonics' must be an integer >= harmonics = {harmonics}; "
+                             f"got {max_harmonics!r}")
+    for nm, fv, lo_, hi_ in (("harmonic_tol", harmonic_tol, 0.0, 1.0), ("tol", tol, 0.0, 1e-3),
+                             ("ds", ds, 0.0, 1.0), ("ds_max", ds_max, 0.0, 1.0),
+                             ("start_offset", start_offset, 0.0, 0.5)):
+        if not (isinstance(fv, (int, float)) and math.isfinite(fv) and lo_ < fv <= hi_):
+            raise ParameterError(f"The option '{nm}' must be in ({lo_:g}, {hi_:g}]; got {fv!r}")
+    if axis.name not in space.settable():
+        space.resolve({axis.name: axis.start})  # the one message for unknown or tied names
+    for bound in (axis.start, axis.stop):
+        space.resolve({axis.name: float(bound)})  # ParameterError naming the parameter and its range
+    ex = _first_hopf(space, axis, use_cache)
+    h = ex.hopf
+    from .implicit import _Point, _vectors
+
+    sim = simulation_model(space.resolve({}).model, use_cache=use_cache)
+    pt = _Point(space, sim, axis.name, h.p0)
+    cm = pt.cm
+    n = cm.n
+    phi, _psi, _q, _pv = _vectors(pt, h.omega0)
+    ratio = abs(h.dRe_lambda_dp / h.c1.real)
+    # the distance to the first predicted event (or the end of the range): the continuation's scales
+    ends = [v for v in (ex.contact_loss, ex.sliding_reversal) if v is not None]
+    far = axis.stop if h.side > 0 else axis.start
+    dist = min([abs(v - h.p0) for v in ends] + [abs(far - h.p0)])
+    if dist <= 0:
+        raise ParameterError(f"the Hopf point {axis.name} = {h.p0:.10g} is at the end of the range "
+                             f"({axis.start:g}, {axis.stop:g}); extend it past the onset")
+    z_far = math.sqrt(ratio * dist)
+    amp_far = 2 * np.abs(phi) * z_far
+    scale = np.maximum(amp_far, 1e-9 * float(np.max(amp_far)))
+    ref = int(np.argmax(np.abs(phi[:n]) / scale[:n]))
+    phi = phi * (abs(phi[ref]) / phi[ref])  # the reference's first harmonic a cosine: b_1 = 0
+    coords = tuple(cm.coords) + tuple(cm.algebraic)
+    pads = tuple(p.name for p in space.resolve({}).model.pads)
+    bal = _Balance(space, axis.name, cm, harmonics, ref, scale)
+    cont = _Continuation(bal, h.omega0, dist, tol)
+    K = bal.K
+
+    def pack(C: np.ndarray, omega: float, p: float) -> np.ndarray:
+        return np.concatenate([C.ravel(), [omega, p]])
+
+    def resized(y: np.ndarray, Hold: int, Hnew: int) -> np.ndarray:
+        C, w, p = y[:-2].reshape(bal.N, 2 * Hold + 1), y[-2], y[-1]
+        Cn = np.zeros((bal.N, 2 * Hnew + 1))
+        k = min(Hold, Hnew)
+        Cn[:, :2 * k + 1] = C[:, :2 * k + 1]
+        return pack(Cn, w, p)
+
+    # the first orbit: the normal form's prediction, corrected at its first-harmonic amplitude of `ref`
+    p1 = h.p0 + h.side * start_offset * dist
+    z1 = math.sqrt(ratio * abs(p1 - h.p0))
+    sm1 = _Point(space, sim, axis.name, p1).sm
+    C = np.zeros((bal.N, K))
+    C[:, 0] = np.concatenate([sm1.q0, sm1.l0])
+    C[:, 1], C[:, 2] = 2 * z1 * phi.real, -2 * z1 * phi.imag
+    omega1 = h.omega0 + h.frequency_slope * (p1 - h.p0)
+    A1 = float(C[ref, 1])
+
+    def amp_eq(y: np.ndarray) -> tuple[float, np.ndarray]:
+        g = np.zeros(y.size)
+        g[ref * bal.K + 1] = 1.0 / scale[ref]
+        return (y[ref * bal.K + 1] - A1) / scale[ref], g
+
+    y, _ = cont.newton(pack(C, omega1, p1), amp_eq)
+
+    def fixed_p(pv: float) -> Any:
+        def eq(yy: np.ndarray) -> tuple[float, np.ndarray]:
+            g = np.zeros(yy.size)
+            g[-1] = 1.0 / dist
+            return (yy[-1] - pv) / dist, g
+        return eq
+
+    def adapt(y: np.ndarray, extra: Any) -> tuple[np.ndarray, float]:
+        """Raise the harmonics until the truncation error is below ``harmonic_tol`` (re-solving)."""
+        while True:
+            err = _truncation(y[:-2].reshape(bal.N, bal.K), scale, bal.H)
+            if err <= harmonic_tol or bal.H >= max_harmonics:
+                return y, err
+            Hold, Hnew = bal.H, min(max_harmonics, max(bal.H + 2, int(1.5 * bal.H)))
+            bal.set_harmonics(Hnew)
+            y, _ = cont.newton(resized(y, Hold, Hnew), extra)
+
+    y, err = adapt(y, fixed_p(float(y[-1])))
+    stop_tol = min(1.0, 2 * harmonic_tol) if err > harmonic_tol else None
+
+    def point(y: np.ndarray, err: float) -> HarmonicPoint:
+        C, omega, p = bal.unpack(y)
+        return _make_point(bal, sim, C, omega, p, err, coords, stability)
+
+    points = [point(y, err)]
+    status, message = "max_points", f"reached max_points = {max_points}"
+    loss = rev = None
+    t_prev: np.ndarray | None = None
+    step = ds
+    lo_p, hi_p = axis.start, axis.stop
+
+    def indicators(P: HarmonicPoint) -> tuple[float, float]:
+        return min(P.F_n_min), P.sliding_margin_min
+
+    if stop_tol is not None:
+        status = "truncation"
+        message = (f"the truncation error {err:.3g} exceeds harmonic_tol = {harmonic_tol:g} with "
+                   f"max_harmonics = {max_harmonics} at the first orbit")
+    while status == "max_points" and len(points) < max_points:
+        t = cont.tangent(y, t_prev)
+        if t_prev is None and len(points) == 1 and t[ref * bal.K + 1] < 0:  # away from the Hopf point
+            t = -t
+        s = cont.yscale()
+        Hcur = bal.H
+        try:
+            y_pred = y + step * t * s
+
+            def arc(yy: np.ndarray, _yp: np.ndarray = y_pred, _t: np.ndarray = t) -> tuple[float, np.ndarray]:
+                return float(_t @ ((yy - _yp) / s)), _t / s
+
+            y_new, its = cont.newton(y_pred, arc)
+        except (BrakesquealError, ParameterError):
+            step /= 2
+            if step < 1e-6:
+                status, message = "step_underflow", f"the step fell below 1e-6 at {axis.name} = {y[-1]:.10g}"
+            continue
+        p_new = float(y_new[-1])
+        if not (lo_p <= p_new <= hi_p):  # the end of the range: the orbit there
+            pe = hi_p if p_new > hi_p else lo_p
+            frac = (pe - y[-1]) / (p_new - y[-1])
+            y_new, _ = cont.newton(y + frac * (y_new - y), fixed_p(pe))
+            y_new, err = adapt(y_new, fixed_p(pe))
+            P = point(y_new, err)
+            g_prev = indicators(points[-1])
+            if all(v > 0 for v in indicators(P)) or not all(v > 0 for v in g_prev):
+                points.append(P)
+                status, message = "range", f"reached the end of the range at {axis.name} = {pe:.10g}"
+                break
+        else:
+            y_new, err = adapt(y_new, fixed_p(p_new))
+            P = point(y_new, err)
+        g_prev, g_new = indicators(points[-1]), indicators(P)
+        events = [(i, nm) for i, nm in ((0, "contact_loss"), (1, "sliding_reversal"))
+                  if g_prev[i] > 0 >= g_new[i]]
+        if events:
+            # the first event along the branch: locate each by Illinois on p between the two orbits
+            found = []
+            for i, nm in events:
+                pv, Pe = _locate(bal, cont, sim, coords, points[-1], P, y, y_new, i, fixed_p, adapt, stability)
+                found.append((abs(pv - points[-1].p), pv, nm, Pe))
+            found.sort(key=lambda r: r[0])
+            _, pv, nm, Pe = found[0]
+            points.append(Pe)
+            if nm == "contact_loss":
+                loss = pv
+                message = (f"a pad loses contact at {axis.name} = {pv:.10g}: the bilateral equations do not "
+                           "hold beyond")
+            else:
+                rev = pv
+                message = (f"a pad's sliding velocity reverses at {axis.name} = {pv:.10g}: Coulomb friction "
+                           "would stick (end of the model's validity)")
+            status = nm
+            break
+        if bal.H == max_harmonics and err > harmonic_tol:
+            points.append(P)
+            status = "truncation"
+            message = (f"the truncation error {err:.3g} exceeds harmonic_tol = {harmonic_tol:g} with "
+                       f"max_harmonics = {max_harmonics} at {axis.name} = {P.p:.10g}; raise max_harmonics")
+            break
+        points.append(P)
+        t_prev = t if bal.H == Hcur else _resize_vec(t, bal.N, 2 * Hcur + 1, bal.K)
+        y = y_new
+        if its <= 3:
+            step = min(ds_max, 1.5 * step)
+    return HarmonicBranch(axis.name, ex, tuple(points), status, message, loss, rev, coords, pads,
+                          "Hill's method" if stability else "not computed")
+
+
+def _resize_vec(v: np.ndarray, N: int, Kold: int, Knew: int) -> np.ndarray:
+    """A vector ``(C, omega, p)`` with ``C`` cut or padded with zeros from ``Kold`` to ``Knew`` columns."""
+    C = v[:-2].reshape(N, Kold)
+    Cn = np.zeros((N, Knew))
+    k = min(Kold, Knew)
+    Cn[:, :k] = C[:, :k]
+    return np.concatenate([Cn.ravel(), v[-2:]])
+
+
+def _truncation(C: np.ndarray, scale: np.ndarray, H: int) -> float:
+    """Largest of the two highest harmonics relative to the first, per coordinate in its own scale."""
+    first = np.hypot(C[:, 1], C[:, 2])
+    hi = [np.hypot(C[:, 2 * k - 1], C[:, 2 * k]) for k in range(max(1, H - 1), H + 1)]
+    top = np.max(np.array(hi), axis=0)
+    den = np.maximum(first, 1e-3 * float(np.max(first / scale)) * scale)
+    if H == 1:  # no harmonic above the first: nothing to estimate from
+        return 1.0
+    return float(np.max(top / np.maximum(den, 1e-300)))
+
+
+def _make_point(bal: _Balance, sim: Any, C: np.ndarray, omega: float, p: float, err: float,
+                coords: tuple[str, ...], stability: bool) -> HarmonicPoint:
+    cm, n = bal.cm, bal.n
+    H = bal.H
+    # fine grid (16x the collocation grid) and its off-grid half-step shift for the residual check
+    Mf = 10 * (4 * H + 4)
+    thf = 2 * np.pi * (np.arange(Mf) + 0.5) / Mf
+    Ef = [_basis(thf, H, k) for k in range(3)]
+    r = bal.residual_time(C, omega, p, Ef)
+    x = bal.states(C, omega, Ef)
+    pv = bal.pvec(p)
+    J0 = bal.jac_time(C, omega, p, [e[:1] for e in Ef])[:, :, 0]
+    amp = np.hypot(C[:, 1], C[:, 2])
+    a = np.maximum(amp, 1e-6 * bal.scale)  # a coordinate that does not move (rigid pads: L = 0) keeps a scale
+    xs = np.concatenate([a[:n], omega * a[:n], omega * omega * a[:n], a[n:], omega * a[n:]])
+    rowscale = np.abs(J0) @ xs
+    rowscale[rowscale == 0] = 1.0
+    resid = float(np.max(np.abs(r) / rowscale[:, None]))
+    ct = cm.vectorized.contact(x, pv)
+    npad = len(ct) // 7
+    ct = np.array([np.broadcast_to(np.asarray(v, dtype=float), (Mf,)) for v in ct]).reshape(npad, 7, Mf)
+    # the silent motion's sliding velocity: the contact at the orbit's mean (Qdot = 0) is not it; take
+    # the silent motion at p
+    from ..analysis.equilibrium import silent_motion
+
+    sm = silent_motion(bal.space.resolve({bal.name: p}), model=cm)
+    x0 = np.asarray(sm.state(), dtype=float)
+    vr0 = cm.contact_table(x0, pv)[:, 1:4]
+    slide = np.einsum("pkt,pk->pt", ct[:, 1:4, :], vr0 / np.linalg.norm(vr0, axis=1)[:, None])
+    fmin = tuple(float(v) for v in _pmin(ct[:, 0, :]))
+    smin = float(np.min(_pmin(slide)))
+    tilts = [i for i, c in enumerate(coords[:n]) if c in ("q1", "q2")]
+    tilt = float(max(amp[i] for i in tilts)) if tilts else None
+    ampd = {c: float(a) for c, a in zip(coords, amp)}
+    fl = st = tr = None
+    if stability:
+        fl, st, tr = _hill(bal, C, omega, p)
+    return HarmonicPoint(float(p), float(omega), float(omega / (2 * np.pi)), ampd, tilt, fmin, smin, resid,
+                         float(err), H, C.copy(), fl, st, tr)
+
+
+def _pmin(v: np.ndarray) -> np.ndarray:
+    """Smallest value over the periodic last axis, refined by a parabola through the smallest sample."""
+    k = np.argmin(v, axis=-1)
+    rows = np.arange(v.shape[0])
+    Mv = v.shape[-1]
+    y0, ym, yp = v[rows, k], v[rows, (k - 1) % Mv], v[rows, (k + 1) % Mv]
+    curv = ym - 2 * y0 + yp
+    with np.errstate(divide="ignore", invalid="ignore"):
+        fine = y0 - (yp - ym) ** 2 / (8 * curv)
+    return np.where(curv > 0, np.minimum(fine, y0), y0)
+
+
+def _hill(bal: _Balance, C: np.ndarray, omega: float, p: float) -> tuple[np.ndarray, bool, float]:
+    """Floquet exponents by Hill's method: the quadratic eigenproblem of the periodic pencil in the Fourier basis."""
+    import scipy.linalg as sl
+
+    n, m, N, H = bal.n, bal.m, bal.N, bal.H
+    Mt = 4 * H + 4
+    th = 2 * np.pi * np.arange(Mt) / Mt
+    E = [_basis(th, H, k) for k in range(3)]
+    J = bal.jac_time(C, omega, p, E)
+    JQ, JdQ, JddQ = J[:, :n], J[:, n:2 * n], J[:, 2 * n:3 * n]
+    JL, JdL = J[:, 3 * n:3 * n + m], J[:, 3 * n + m:]
+    B0 = np.concatenate([JQ, JL], axis=1)
+    B1 = np.concatenate([JdQ, JdL], axis=1)
+    B2 = np.concatenate([JddQ, np.zeros_like(JL)], axis=1)
+    # complex exponential basis e^{i k theta}, k = -H..H; Galerkin projection
+    ks = np.arange(-H, H + 1)
+    Ec = np.exp(1j * np.outer(th, ks))          # (Mt, 2H+1)
+    Pc = Ec.conj().T / Mt
+    Dk = 1j * omega * ks
+
+    def op(B: np.ndarray, w: np.ndarray) -> np.ndarray:
+        # sum_t Pc[a, t] B[i, k, t] w[b] Ec[t, b]: (N, 2H+1, N, 2H+1)
+        return np.einsum("at,ikt,tb,b->iakb", Pc, B.astype(complex), Ec, w).reshape(N * ks.size, N * ks.size)
+
+    one = np.ones(ks.size)
+    A0 = op(B0, one) + op(B1, Dk) + op(B2, Dk * Dk)
+    A1 = op(B1, one) + 2 * op(B2, Dk)
+    A2 = op(B2, one)
+    S = N * ks.size
+    I = np.eye(S)
+    Z = np.zeros((S, S))
+    L = np.block([[Z, I], [-A0, -A1]])
+    R = np.block([[I, Z], [Z, A2]])
+    lam, V = sl.eig(L, R)
+    ok = np.isfinite(lam) & (np.abs(lam) < 1e3 * omega * H)
+    lam, V = lam[ok], V[:S, ok]
+    # one exponent per state (Q, Qdot) of the mechanical DOF: the copies with the most centred eigenvectors
+    Vr = V.reshape(N, ks.size, -1)
+    w = (np.abs(Vr) ** 2).sum(axis=0)
+    w /= w.sum(axis=0, keepdims=True)
+    centre = np.abs((ks[:, None] * w).sum(axis=0))  # |mean k| of the eigenvector: 0 for the centred copy
+    order = np.argsort(centre)
+    strip = lam - 1j * omega * np.round(lam.imag / omega)  # the exponent in the strip |Im| <= omega/2
+    # the mechanical states (Q, Qdot): exponents within the band the harmonics resolve (|lambda| <= H omega / 2);
+    # a pad whose rate enters its balance on the orbit adds a fast mode (rate ~ G_L / G_Ldot, far beyond it)
+    nstate = 2 * n
+    acc: list[int] = []
+    for j in order:
+        if abs(lam[j]) > 0.5 * H * omega:
+            continue
+        dup = False
+        for i in acc:  # a copy lambda + i k omega of an accepted exponent: the same eigenvector shifted by k
+            if abs(strip[j] - strip[i]) > 1e-6 * omega:
+                continue
+            s = int(round((lam[j] - lam[i]).imag / omega))
+            a, b = Vr[:, :, i], Vr[:, :, j]
+            if abs(s) < ks.size:
+                a = np.roll(a, -s, axis=1)
+            cos = abs(np.vdot(a, b)) / (np.linalg.norm(a) * np.linalg.norm(b))
+            if cos > 0.9:
+                dup = True
+                break
+        if not dup:
+            acc.append(int(j))
+        if len(acc) == nstate:
+            break
+    chosen = strip[acc]
+    j0 = int(np.argmin(np.abs(chosen)))
+    trivial = float(abs(chosen[j0]))
+    rest = np.delete(chosen, j0)
+    rest = rest[np.argsort(-rest.real)]
+    stable = bool(np.all(rest.real < 0))
+    return rest, stable, trivial
+
+
+def _locate(bal: _Balance, cont: _Continuation, sim: Any, coords: tuple[str, ...], Pa: HarmonicPoint,
+            Pb: HarmonicPoint, ya: np.ndarray, yb: np.ndarray, which: int, fixed_p: Any, adapt: Any,
+            stability: bool) -> tuple[float, HarmonicPoint]:
+    """Where indicator ``which`` (0: smallest F_n, 1: sliding margin) reaches 0 between two orbits (Illinois)."""
+    def g(P: HarmonicPoint) -> float:
+        return min(P.F_n_min) if which == 0 else P.sliding_margin_min
+
+    def resize(y: np.ndarray) -> np.ndarray:
+        K_old = (y.size - 2) // bal.N
+        if K_old == bal.K:
+            return y
+        C = y[:-2].reshape(bal.N, K_old)
+        Cn = np.zeros((bal.N, bal.K))
+        k = min(K_old, bal.K)
+        Cn[:, :k] = C[:, :k]
+        return np.concatenate([Cn.ravel(), y[-2:]])
+
+    pa, pb, ga, gb = Pa.p, Pb.p, g(Pa), g(Pb)
+    ya, yb = resize(ya), resize(yb)
+    side = 0
+    best = (pb, Pb)
+    for _ in range(60):
+        pc = pb - gb * (pb - pa) / (gb - ga) if gb != ga else 0.5 * (pa + pb)
+        fr = (pc - pa) / (pb - pa) if pb != pa else 0.5
+        yc, _ = cont.newton(resize(ya) + fr * (resize(yb) - resize(ya)), fixed_p(pc))
+        yc, err = adapt(yc, fixed_p(pc))
+        C, w, p = bal.unpack(yc)
+        Pc = _make_point(bal, sim, C, w, p, err, coords, stability)
+        gc = g(Pc)
+        best = (pc, Pc)
+        if abs(gc) <= 1e-10 * max(abs(ga), abs(gb)) or abs(pb - pa) <= 1e-11 * max(1.0, abs(pc)):
+            break
+        if (gc > 0) == (ga > 0):
+            pa, ga, ya = pc, gc, yc
+            if side == -1:
+                gb /= 2
+            side = -1
+        else:
+            pb, gb, yb = pc, gc, yc
+            if side == 1:
+                ga /= 2
+            side = 1
+    return best
