@@ -237,7 +237,7 @@ def cycles(
     stick_speed: StickSpeedOpt = None,
     exact_pads: Annotated[bool, typer.Option("--exact-pads", help="Harmonic balance on the implicit equations: the "
                                              "massless Coulomb pads exact (tangential rates kept, no "
-                                             "regularisation); bilateral, text or json output only.")] = False,
+                                             "regularisation); bilateral, to the located contact loss.")] = False,
     harmonics: Annotated[int, typer.Option("--harmonics", min=1, max=200, help="With --exact-pads: initial number "
                                            "of harmonics (raised while the truncation error exceeds 1e-6).")] = 6,
     max_harmonics: Annotated[int, typer.Option("--max-harmonics", min=1, max=400, help="With --exact-pads: largest "
@@ -303,17 +303,31 @@ def cycles(
 def _cycles_exact_pads(axis: Any, space: Any, *, fmt: OutFormat, max_points: int, harmonics: int,
                        max_harmonics: int, contact: str, pad_slope: float | None, stick_speed: float | None,
                        plot: str | None, out: str | None) -> None:
-    """``cycles --exact-pads``: the harmonic-balance branch of the implicit equations, as text or JSON."""
+    """``cycles --exact-pads``: the harmonic-balance branch of the implicit equations (text or JSON, ``--out``
+    NetCDF, ``--plot`` bifurcation diagram)."""
     from ..nonlinear.harmonic import harmonic_branch
 
+    from ..outputs import atomic_write, check_output
+
     for flag, bad in (("--contact unilateral", contact != "bilateral"), ("--pad-slope", pad_slope is not None),
-                      ("--stick-speed", stick_speed is not None), ("--plot", bool(plot)), ("--out", bool(out))):
+                      ("--stick-speed", stick_speed is not None)):
         if bad:
             raise ParameterError(f"The option '--exact-pads' cannot be combined with {flag} (the exact pads are "
-                                 "bilateral and unregularised; text or json output)")
+                                 "bilateral and unregularised)")
     if max_harmonics < harmonics:
         raise ParameterError(f"The option '--max-harmonics' must be >= --harmonics = {harmonics}; got {max_harmonics}")
+    if plot:
+        check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
+    if out:
+        check_output(out, what="--out", suffixes=(".nc",))
     b = harmonic_branch(space, axis, max_points=max_points, harmonics=harmonics, max_harmonics=max_harmonics)
+    if out:
+        ds = b.data
+        ds = ds.assign_coords(coord=ds["coord"].astype("S"), pad=ds["pad"].astype("S"))
+        with atomic_write(out, what="--out") as tmp:
+            ds.to_netcdf(str(tmp), engine="scipy")
+    if plot:
+        _write_plot(b.plot(), plot)
     if fmt == OutFormat.json:
         sys.stdout.write(json.dumps(b.to_dict(), indent=2, default=float) + "\n")
         return

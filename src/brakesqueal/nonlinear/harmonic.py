@@ -181,6 +181,101 @@ class HarmonicBranch:
                 "coords": list(self.coords), "pads": list(self.pads),
                 "points": [pt.to_dict() for pt in self.points]}
 
+    @property
+    def data(self) -> Any:
+        """The branch as an :class:`xarray.Dataset` (dimensions ``point``, ``coord``, ``pad``).
+
+        Variables ``p``, ``frequency`` [Hz], ``amplitude`` (first harmonic of every ``Q`` and ``L``),
+        ``tilt_amplitude`` [rad], ``F_n_min`` [N], ``sliding_margin_min`` [m/s], ``residual``,
+        ``truncation_error``, ``harmonics`` and ``stable`` (1 stable, 0 unstable, -1 not computed); the
+        attributes hold the parameter, the status and message, the located events and the Hopf point.
+        """
+        import xarray as xr
+
+        pts = self.points
+        nan = math.nan
+        stab = np.array([-1 if pt.stable is None else int(pt.stable) for pt in pts], dtype=np.int8)
+        amp = np.array([[pt.amplitude.get(c, nan) for c in self.coords] for pt in pts], dtype=float)
+        h = self.hopf.hopf
+        return xr.Dataset(
+            {"p": ("point", np.array([pt.p for pt in pts], dtype=float), {"long_name": self.parameter}),
+             "frequency": ("point", np.array([pt.frequency_hz for pt in pts], dtype=float), {"units": "Hz"}),
+             "amplitude": (("point", "coord"), amp.reshape(len(pts), len(self.coords)),
+                           {"long_name": "first-harmonic amplitude"}),
+             "tilt_amplitude": ("point", np.array([nan if pt.tilt_amplitude is None else pt.tilt_amplitude
+                                                   for pt in pts], dtype=float), {"units": "rad"}),
+             "F_n_min": (("point", "pad"), np.array([pt.F_n_min for pt in pts], dtype=float).reshape(
+                 len(pts), len(self.pads)), {"units": "N", "long_name": "smallest normal force over the period"}),
+             "sliding_margin_min": ("point", np.array([pt.sliding_margin_min for pt in pts], dtype=float),
+                                    {"units": "m/s"}),
+             "residual": ("point", np.array([pt.residual for pt in pts], dtype=float)),
+             "truncation_error": ("point", np.array([pt.truncation_error for pt in pts], dtype=float)),
+             "harmonics": ("point", np.array([pt.harmonics for pt in pts], dtype=np.int32)),
+             "stable": ("point", stab, {"flag_values": [-1, 0, 1],
+                                        "flag_meanings": "not_computed unstable stable"})},
+            coords={"coord": list(self.coords), "pad": list(self.pads)},
+            attrs={"parameter": self.parameter, "status": self.status, "message": self.message,
+                   "method": "harmonic balance on the implicit equations (exact massless Coulomb pads)",
+                   "stability": self.stability,
+                   "contact_loss": nan if self.contact_loss is None else self.contact_loss,
+                   "sliding_reversal": nan if self.sliding_reversal is None else self.sliding_reversal,
+                   "hopf_p0": h.p0, "hopf_frequency_hz": h.frequency0_hz, "hopf_l1": h.l1,
+                   "criticality": h.criticality})
+
+    def plot(self, coord: str | None = None) -> Any:
+        """Bifurcation diagram: first-harmonic amplitude and frequency against the parameter.
+
+        Stable orbits solid, unstable dashed, not judged grey; the Hopf point and a located contact loss or
+        sliding reversal are marked.
+
+        Parameters
+        ----------
+        coord : str, optional
+            Coordinate whose amplitude is drawn (default: the first tilt, else the first coordinate).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        from ..plotting import new_figure
+
+        names = list(self.coords)
+        if coord is None:
+            coord = "q1" if "q1" in names else names[0]
+        if coord not in names:
+            raise ParameterError(f"The option 'coord' must be one of {names}; got {coord!r}")
+        fig, a0 = new_figure(size=(6.4, 6.4))
+        a0.remove()
+        axes = fig.subplots(2, 1, sharex=True)
+        h = self.hopf.hopf
+        p = np.array([h.p0] + [pt.p for pt in self.points])
+        amp = np.array([0.0] + [pt.amplitude.get(coord, math.nan) for pt in self.points])
+        fr = np.array([h.frequency0_hz] + [pt.frequency_hz for pt in self.points])
+        st = [None] + [pt.stable for pt in self.points]
+        style = {True: ("-", "C0"), False: ("--", "C3"), None: (":", "0.5")}
+        for a, yv in ((axes[0], amp), (axes[1], fr)):
+            for i in range(1, len(p)):
+                ls, col = style[st[i]]
+                a.plot(p[i - 1:i + 1], yv[i - 1:i + 1], ls, color=col, lw=1.5)
+        axes[0].plot([h.p0], [0.0], "s", color="k", ms=7, label="Hopf point", zorder=5)
+        for at, lab, col in ((self.contact_loss, "contact loss", "C6"), (self.sliding_reversal, "sliding reversal",
+                                                                          "C5")):
+            if at is not None:
+                for a in axes:
+                    a.axvline(at, color=col, ls="-.", lw=1, label=lab if a is axes[0] else None)
+        present = set(st[1:])
+        for key, lab in ((True, "stable"), (False, "unstable"), (None, "stability not computed")):
+            if key in present:
+                axes[0].plot([], [], style[key][0], color=style[key][1], label=lab)
+        axes[0].legend(loc="best", fontsize="small")
+        axes[0].set_ylabel(f"first-harmonic amplitude of {coord}")
+        axes[1].set_ylabel("frequency [Hz]")
+        axes[1].set_xlabel(self.parameter)
+        axes[0].set_title(f"limit cycles, exact Coulomb pads (harmonic balance): {self.status}")
+        for a in axes:
+            a.ticklabel_format(axis="y", useOffset=False)
+        return fig
+
 
 def _basis(theta: np.ndarray, H: int, order: int) -> np.ndarray:
     """``d^order/dtheta^order`` of ``(1, cos theta, sin theta, ..., cos H theta, sin H theta)``: ``(len, 2H+1)``."""

@@ -1,0 +1,66 @@
+"""Outputs of the exact-pads branch (``HarmonicBranch.data``, ``.plot``, ``cycles --exact-pads --out/--plot``).
+
+The Dataset and the NetCDF file written by the CLI must hold exactly the numbers of the branch's points (read
+back with xarray), and the figure must draw them (its line data are compared with the points).
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from brakesqueal.analysis.maps import Axis
+from brakesqueal.cli import main
+from brakesqueal.model.options import resolve_space
+from brakesqueal.nonlinear.harmonic import harmonic_branch
+
+SETS = ["mu1=0.5", "mu2=0.5", "k_ip1=1e6", "k_ip2=1e6"]
+
+
+@pytest.fixture(scope="module")
+def branch():
+    return harmonic_branch(resolve_space(preset="paper-fig3", sets=SETS), Axis("Omega", 60.0, 70.0), max_points=5)
+
+
+def test_dataset_holds_the_points(branch):
+    ds = branch.data
+    pts = branch.points
+    assert ds.sizes["point"] == len(pts) >= 3
+    np.testing.assert_array_equal(ds["p"].values, [pt.p for pt in pts])
+    np.testing.assert_array_equal(ds["frequency"].values, [pt.frequency_hz for pt in pts])
+    np.testing.assert_array_equal(ds["amplitude"].sel(coord="q1").values, [pt.amplitude["q1"] for pt in pts])
+    np.testing.assert_array_equal(ds["F_n_min"].values, [pt.F_n_min for pt in pts])
+    assert ds["stable"].values.tolist() == [-1 if pt.stable is None else int(pt.stable) for pt in pts]
+    assert ds.attrs["status"] == branch.status and ds.attrs["hopf_p0"] == branch.hopf.hopf.p0
+    assert list(ds["coord"].values) == list(branch.coords) and list(ds["pad"].values) == list(branch.pads)
+
+
+def test_figure_draws_the_points(branch):
+    fig = branch.plot()
+    amp_ax, fr_ax = fig.axes[:2]
+    xs = np.concatenate([ln.get_xdata() for ln in amp_ax.lines if len(ln.get_xdata()) == 2])
+    ys = np.concatenate([ln.get_ydata() for ln in amp_ax.lines if len(ln.get_xdata()) == 2])
+    for pt in branch.points:  # every point is a segment end
+        assert np.any(np.isclose(xs, pt.p, rtol=0, atol=0) & np.isclose(ys, pt.amplitude["q1"], rtol=1e-15))
+    assert "Hopf point" in [t.get_text() for t in amp_ax.get_legend().get_texts()]
+    assert fr_ax.get_ylabel() == "frequency [Hz]"
+    with pytest.raises(Exception, match="'coord' must be one of"):
+        branch.plot("nope")
+
+
+def test_cli_writes_netcdf_and_plot(tmp_path, capsys, branch):
+    out, png = tmp_path / "b.nc", tmp_path / "b.png"
+    assert main(["cycles", "--preset", "paper-fig3", *[a for s in SETS for a in ("--set", s)], "--along",
+                 "Omega=60:70", "--exact-pads", "--max-points", "5", "--out", str(out), "--plot", str(png),
+                 "--format", "json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    with xr.open_dataset(out) as ds:
+        np.testing.assert_allclose(ds["p"].values, [pt["p"] for pt in d["points"]], rtol=0)
+        np.testing.assert_allclose(ds["p"].values, branch.data["p"].values, rtol=1e-12)
+        assert ds.attrs["parameter"] == "Omega"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert main(["cycles", "--along", "Omega=60:70", "--exact-pads", "--out", str(tmp_path / "x.txt")]) == 2
+    assert "--out" in capsys.readouterr().err
