@@ -189,8 +189,8 @@ def _hopf_text(points: list) -> str:  # type: ignore[type-arg]
             lines.append(f"      cycles for {hp.parameter} {'>' if h.side > 0 else '<'} {h.p0:.12g}; first-harmonic "
                          f"amplitudes A_j ~ a_j sqrt(|{hp.parameter} - p0|), a_j = {amp}")
         for what, at, tilt in (("a pad lifts off", hp.contact_loss, hp.tilt_at_contact_loss),
-                               ("a pad's sliding reverses (end of validity)", hp.sliding_reversal,
-                                hp.tilt_at_sliding_reversal)):
+                               ("a pad's sliding reverses (quasi-static pads: end of validity; often later on "
+                                "the cycles)", hp.sliding_reversal, hp.tilt_at_sliding_reversal)):
             if at is not None:
                 lines.append(f"      predicted (leading order): {what} at {hp.parameter} = {at:.8g}"
                              + (f", tilt amplitude {tilt:.3g} rad" if tilt is not None else ""))
