@@ -64,3 +64,19 @@ def test_cli_writes_netcdf_and_plot(tmp_path, capsys, branch):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert main(["cycles", "--along", "Omega=60:70", "--exact-pads", "--out", str(tmp_path / "x.txt")]) == 2
     assert "--out" in capsys.readouterr().err
+
+
+def test_pad_modes_enter_the_stability_verdict(branch):
+    """The pads' fast modes: -G_L/G_Ldot averaged over the phases where the rate enters (a synthetic Jacobian
+    with known entries), negative for the Coulomb pads of the branch (whose verdicts are therefore the band's)."""
+    from brakesqueal.nonlinear.harmonic import pad_mode_rates
+
+    n, m, M = 2, 2, 4
+    J = np.zeros((n + m, 3 * n + 2 * m, M))
+    J[n, 3 * n, :] = 1.0
+    J[n, 3 * n + m, :] = [1e-6, 2e-6, 0.0, 4e-6]  # pad 1: rates -1e6, -5e5, (none), -2.5e5
+    J[n + 1, 3 * n + 1, :] = 1.0
+    J[n + 1, 3 * n + m + 1, :] = -1e-3  # pad 2: a falling law's unstable mode, +1e3 1/s
+    np.testing.assert_allclose(pad_mode_rates(J, n, m), [np.mean([-1e6, -5e5, -2.5e5]), 1e3])
+    assert any(pt.stable is not None for pt in branch.points)
+    assert all(pt.stable in (True, None) for pt in branch.points[:3])  # supercritical onset: stable cycles

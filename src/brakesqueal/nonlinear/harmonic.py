@@ -48,7 +48,7 @@ import numpy as np
 
 from ..errors import BrakesquealError, ParameterError
 
-__all__ = ["HarmonicPoint", "HarmonicBranch", "harmonic_branch"]
+__all__ = ["HarmonicPoint", "HarmonicBranch", "harmonic_branch", "pad_mode_rates"]
 
 
 
@@ -83,7 +83,9 @@ class HarmonicPoint:
     floquet_exponents : ndarray or None
         Non-trivial Floquet exponents by decreasing real part (Hill's method), ``None`` if not computed.
     stable : bool or None
-        Every non-trivial exponent with negative real part; ``None`` if not computed.
+        Every non-trivial exponent in the resolved band with negative real part and no pad's own fast mode
+        unstable (:func:`pad_mode_rates`); ``None`` if not computed or if fewer than ``2n`` exponents lie in
+        the band (no verdict).
     trivial_exponent : float or None
         The smallest ``|exponent|`` (the phase shift's zero exponent; an accuracy check).
     """
@@ -744,7 +746,35 @@ def _pmin(v: np.ndarray) -> np.ndarray:
     return np.where(curv > 0, np.minimum(fine, y0), y0)
 
 
-def _hill(bal: _Balance, C: np.ndarray, omega: float, p: float) -> tuple[np.ndarray, bool, float]:
+def pad_mode_rates(J: np.ndarray, n: int, m: int) -> np.ndarray:
+    """Floquet exponent of every pad's own first-order mode, from the frozen coefficients (a fast scalar mode).
+
+    Where a pad's rate enters its balance, ``G_L l + G_Ldot ldot + ... = 0`` gives the mode ``ldot = a(t) l``,
+    ``a = -G_L / G_Ldot``, much faster than the orbit; the exponent of ``x' = a(t) x`` over a period is the mean
+    of ``a``.  Phases where ``G_Ldot = 0`` (the rate does not enter: no mode there) are left out.
+
+    Parameters
+    ----------
+    J : ndarray, shape (n + m, 3 n + 2 m, phases)
+        Jacobian of the residuals ``(R, G)`` in ``(Q, Qdot, Qddot, L, Ldot)`` at equally spaced phases.
+    n, m : int
+        Numbers of coordinates and of pad unknowns.
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        Mean ``-G_L / G_Ldot`` per pad (0 where the rate never enters).
+    """
+    out = np.zeros(m)
+    for j in range(m):
+        GL, GdL = J[n + j, 3 * n + j, :], J[n + j, 3 * n + m + j, :]
+        live = GdL != 0.0
+        if live.any():
+            out[j] = float(np.mean(-GL[live] / GdL[live]))
+    return out
+
+
+def _hill(bal: _Balance, C: np.ndarray, omega: float, p: float) -> tuple[np.ndarray, bool | None, float]:
     """Floquet exponents by Hill's method: the quadratic eigenproblem of the periodic pencil in the Fourier basis."""
     import scipy.linalg as sl
 
@@ -815,6 +845,17 @@ def _hill(bal: _Balance, C: np.ndarray, omega: float, p: float) -> tuple[np.ndar
     trivial = float(abs(chosen[j0]))
     rest = np.delete(chosen, j0)
     rest = rest[np.argsort(-rest.real)]
+    # the pads' own fast modes are outside the band: an unstable one (e.g. falling friction) makes the orbit
+    # unstable whatever the band says; too few exponents in the band: no verdict.  Only pads with a
+    # rate-dependent law are judged: a Coulomb pad's dG/dldot = c dF/dldot >= 0 (the friction force is monotone
+    # in the sliding velocity), its mode is stable, and near w = 0 its dG/dldot is at rounding level (any sign)
+    from ..simulation import simulation_model
+
+    judged = np.array([k == "dynamic" for k in simulation_model(bal.space.resolve({}).model).pad_kinds], dtype=bool)
+    if judged.size == m and np.any(pad_mode_rates(J, n, m)[judged] > 0):
+        return rest, False, trivial
+    if len(acc) < nstate:
+        return rest, None, trivial
     stable = bool(np.all(rest.real < 0))
     return rest, stable, trivial
 
