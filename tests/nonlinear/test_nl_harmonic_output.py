@@ -80,3 +80,50 @@ def test_pad_modes_enter_the_stability_verdict(branch):
     np.testing.assert_allclose(pad_mode_rates(J, n, m), [np.mean([-1e6, -5e5, -2.5e5]), 1e3])
     assert any(pt.stable is not None for pt in branch.points)
     assert all(pt.stable in (True, None) for pt in branch.points[:3])  # supercritical onset: stable cycles
+
+
+@pytest.mark.parametrize("name", ["paper", "minimal", "in-plane-pad", "four-pad"])
+def test_no_unstable_verdict_next_to_a_supercritical_onset(name):
+    """Every built-in model whose first path crosses supercritically: the first orbits past the onset are stable
+    (Hopf theorem).  Hill's radial exponent there, -2 mu' (p - p0), is below the method's accuracy
+    (``hill_accuracy``); such orbits take the normal form's verdict instead of a sign of rounding (they were
+    reported unstable, or without a verdict, at some of these points)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from test_pad_limit_and_api_matrix import PATHS
+
+    from brakesqueal.model import ParameterSpace
+
+    pname, a, b, log = PATHS[name][0]
+    br = harmonic_branch(ParameterSpace.from_preset(name), Axis(pname, a, b, 2, log), max_points=6)
+    assert br.hopf.hopf.criticality == "supercritical"
+    verdicts = [pt.stable for pt in br.points]
+    assert verdicts[0] is True and all(v is True for v in verdicts), verdicts
+
+
+@pytest.mark.parametrize("name", ["six-dof", "eight-dof"])
+def test_subcritical_onsets_of_the_larger_models_agree_with_shooting(name):
+    """The 6- and 8-DOF models (pads with mass: no pad unknowns, so harmonic balance and shooting solve the same
+    equations): the harmonic-balance Newton converges (it stalled at a scaled step of 1e-7 against a 1e-10
+    tolerance, at the noise floor of these larger systems) and its verdicts equal the shooting branch's
+    Floquet verdicts (subcritical onsets: unstable cycles)."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from test_pad_limit_and_api_matrix import PATHS
+
+    from brakesqueal.model import ParameterSpace
+    from brakesqueal.nonlinear.models import squeal_branch
+
+    pname, a, b, log = PATHS[name][0]
+    space = ParameterSpace.from_preset(name)
+    hb = harmonic_branch(space, Axis(pname, a, b, 2, log), max_points=4)
+    sb = squeal_branch(space, Axis(pname, a, b, 2, log), max_points=4)
+    assert hb.hopf.hopf.criticality == sb.hopf.branch_start.criticality == "subcritical"
+    assert hb.hopf.hopf.p0 == pytest.approx(sb.hopf.branch_start.p0, rel=1e-7)
+    assert [pt.stable for pt in hb.points] == [False] * len(hb.points)
+    assert not sb.data["stable"].values.any()
+    assert max(pt.residual for pt in hb.points) < 1e-9

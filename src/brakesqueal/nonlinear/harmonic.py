@@ -48,7 +48,7 @@ import numpy as np
 
 from ..errors import BrakesquealError, ParameterError
 
-__all__ = ["HarmonicPoint", "HarmonicBranch", "harmonic_branch", "pad_mode_rates"]
+__all__ = ["HarmonicPoint", "HarmonicBranch", "harmonic_branch", "pad_mode_rates", "hill_accuracy"]
 
 
 
@@ -395,6 +395,7 @@ class _Continuation:
     def newton(self, y: np.ndarray, extra: Any, max_iter: int = 15) -> tuple[np.ndarray, int]:
         """Solve ``F(y) = 0`` plus the one equation ``extra(y) -> (value, gradient)`` (unscaled gradient)."""
         s = self.yscale()
+        prev = math.inf
         for it in range(1, max_iter + 1):
             J = self.bal.jacobian(y)
             F = self.bal.F(y)
@@ -415,6 +416,9 @@ class _Continuation:
             y = y + dx * s
             if step <= self.tol:
                 return y, it
+            if step <= 1e-6 and step > 0.5 * prev:  # no longer contracting: at the noise floor of the residual
+                return y, it  # (the larger models stall at 1e-8..1e-7; each point reports its off-grid residual)
+            prev = step
         raise BrakesquealError(f"harmonic-balance Newton did not converge in {max_iter} iterations "
                                f"(last scaled step {step:.3g})")
 
@@ -669,8 +673,34 @@ def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics:
         y = y_new
         if its <= 3:
             step = min(ds_max, 1.5 * step)
+    if stability:
+        points = _near_onset_verdicts(points, ex.hopf, coords)
     return HarmonicBranch(axis.name, ex, tuple(points), status, message, loss, rev, coords, pads,
                           "Hill's method" if stability else "not computed")
+
+
+def _near_onset_verdicts(points: list[HarmonicPoint], h: Any, coords: tuple[str, ...]) -> list[HarmonicPoint]:
+    """Orbits whose Hill exponent near 0 has no reliable sign (:func:`hill_accuracy`) take the normal form's
+    verdict where they are in its regime: the tilt amplitude within 5 % of ``a_j sqrt(|p - p0|)``.  There the
+    radial exponent is ``-2 mu' (p - p0)`` with the sign of the criticality (supercritical: stable cycles) and
+    the other exponents are those of the remaining modes, decided by Hill's method (all clearly negative)."""
+    from dataclasses import replace
+
+    names = list(h.state_names)
+    ref = next((c for c in ("q1", "q2", *coords) if c in names and c in coords), None)
+    if ref is None or h.criticality not in ("supercritical", "subcritical"):
+        return points
+    a = float(h.amplitude_coefficients[names.index(ref)])
+    out = []
+    for pt in points:
+        if pt.stable is None and pt.floquet_exponents is not None and pt.trivial_exponent is not None and a > 0:
+            pred = a * math.sqrt(abs(pt.p - h.p0))
+            others = pt.floquet_exponents.real
+            others = others[np.abs(others) > hill_accuracy(pt.omega, pt.trivial_exponent)]
+            if pred > 0 and abs(pt.amplitude[ref] / pred - 1.0) <= 0.05 and np.all(others < 0):
+                pt = replace(pt, stable=h.criticality == "supercritical")
+        out.append(pt)
+    return out
 
 
 def _resize_vec(v: np.ndarray, N: int, Kold: int, Knew: int) -> np.ndarray:
@@ -854,10 +884,21 @@ def _hill(bal: _Balance, C: np.ndarray, omega: float, p: float) -> tuple[np.ndar
     judged = np.array([k == "dynamic" for k in simulation_model(bal.space.resolve({}).model).pad_kinds], dtype=bool)
     if judged.size == m and np.any(pad_mode_rates(J, n, m)[judged] > 0):
         return rest, False, trivial
-    if len(acc) < nstate:
-        return rest, None, trivial
-    stable = bool(np.all(rest.real < 0))
-    return rest, stable, trivial
+    if np.any(rest.real > hill_accuracy(omega, trivial)):
+        return rest, False, trivial  # an exponent clearly in the right half-plane
+    if len(acc) < nstate or np.any(np.abs(rest.real) <= hill_accuracy(omega, trivial)):
+        return rest, None, trivial  # an exponent missing or within the method's accuracy of 0: no verdict here
+    return rest, True, trivial
+
+
+def hill_accuracy(omega: float, trivial: float) -> float:
+    """Below this ``|Re lambda|`` an exponent of Hill's method has no reliable sign.
+
+    ``max(1e3 |trivial|, 1e-6 omega)``: the trivial exponent (exactly 0) as computed measures the rounding, and
+    the small exponents of a truncated Hill matrix carry errors of about ``1e-7..1e-6 omega`` (seen as imaginary
+    parts of real exponents near a Hopf point, where the radial exponent ``-2 mu' (p - p0)`` is that small).
+    """
+    return max(1e3 * abs(trivial), 1e-6 * abs(omega))
 
 
 def _locate(bal: _Balance, cont: _Continuation, sim: Any, coords: tuple[str, ...], Pa: HarmonicPoint,
