@@ -884,9 +884,10 @@ def _hill(bal: _Balance, C: np.ndarray, omega: float, p: float) -> tuple[np.ndar
     judged = np.array([k == "dynamic" for k in simulation_model(bal.space.resolve({}).model).pad_kinds], dtype=bool)
     if judged.size == m and np.any(pad_mode_rates(J, n, m)[judged] > 0):
         return rest, False, trivial
-    if np.any(rest.real > hill_accuracy(omega, trivial)):
+    delta = hill_accuracy(omega, trivial)
+    if np.any(rest.real > delta):
         return rest, False, trivial  # an exponent clearly in the right half-plane
-    if len(acc) < nstate or np.any(np.abs(rest.real) <= hill_accuracy(omega, trivial)):
+    if len(acc) < nstate or np.any(np.abs(rest.real) <= delta):
         return rest, None, trivial  # an exponent missing or within the method's accuracy of 0: no verdict here
     return rest, True, trivial
 
