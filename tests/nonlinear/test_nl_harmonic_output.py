@@ -101,6 +101,10 @@ def test_no_unstable_verdict_next_to_a_supercritical_onset(name):
     assert br.hopf.hopf.criticality == "supercritical"
     verdicts = [pt.stable for pt in br.points]
     assert verdicts[0] is True and all(v is True for v in verdicts), verdicts
+    for pt in br.points:  # no contradiction: a positive exponent beside "stable" is one without a reliable sign
+        d = pt.to_dict()
+        worst = max(e[0] for e in d["floquet_exponents"])
+        assert worst < 0 or (d["stability_from"] == "normal form" and worst <= d["hill_accuracy"]), d
 
 
 @pytest.mark.parametrize("name", ["six-dof", "eight-dof"])

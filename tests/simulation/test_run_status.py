@@ -39,3 +39,26 @@ def test_run_status_prints_as_its_value(status):
 def test_cli_json_status(capsys):
     assert main(["simulate", "--t-end", "0.002", "--format", "json"]) == 0
     assert json.loads(capsys.readouterr().out)["status"] == "finished"
+
+
+@pytest.mark.parametrize("method, kernel, after", [("DOP853-jit", "dop853", 0), ("RK45", "rhs", 3)])
+def test_a_division_by_zero_in_compiled_code_is_a_failed_run(monkeypatch, method, kernel, after):
+    """numba raises ZeroDivisionError for ``0.0 ** -1`` under any error model (a Coulomb friction direction at
+    exactly zero sliding speed): the run ends ``failed`` with a message saying so, never with a traceback."""
+    from brakesqueal.simulation import simulation_model
+
+    params = resolve_parameters(None, "paper-fig2", None, [])
+    sim = simulation_model(params.model)
+    real = getattr(sim.kernels, kernel)
+    calls = {"n": 0}
+
+    def flaky(*args):
+        calls["n"] += 1
+        if calls["n"] > after:
+            raise ZeroDivisionError("division by zero")
+        return real(*args)
+
+    monkeypatch.setattr(sim.kernels, kernel, flaky)
+    tr = simulate(sim, params, 0.002, method=method)
+    assert tr.status is RunStatus.FAILED and "divided by zero" in tr.message, tr.message
+    assert calls["n"] > after

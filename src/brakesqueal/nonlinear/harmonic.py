@@ -88,6 +88,10 @@ class HarmonicPoint:
         the band (no verdict).
     trivial_exponent : float or None
         The smallest ``|exponent|`` (the phase shift's zero exponent; an accuracy check).
+    stability_from : str or None
+        What decided ``stable``: ``"Hill's method"``, or ``"normal form"`` where an exponent lies within
+        :func:`hill_accuracy` of 0 (its printed sign is then not meaningful, e.g. a tiny positive radial
+        exponent of a stable cycle next to a supercritical onset); ``None`` without a verdict.
     """
 
     p: float
@@ -104,6 +108,7 @@ class HarmonicPoint:
     floquet_exponents: np.ndarray | None = field(default=None, repr=False)
     stable: bool | None = None
     trivial_exponent: float | None = None
+    stability_from: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready fields (no coefficients)."""
@@ -112,6 +117,9 @@ class HarmonicPoint:
                 "sliding_margin_min": self.sliding_margin_min, "residual": self.residual,
                 "truncation_error": self.truncation_error, "harmonics": self.harmonics,
                 "stable": self.stable, "trivial_exponent": self.trivial_exponent,
+                "stability_from": self.stability_from,
+                "hill_accuracy": None if self.trivial_exponent is None else hill_accuracy(self.omega,
+                                                                                          self.trivial_exponent),
                 "floquet_exponents": None if self.floquet_exponents is None else
                 [[float(v.real), float(v.imag)] for v in self.floquet_exponents]}
 
@@ -698,7 +706,7 @@ def _near_onset_verdicts(points: list[HarmonicPoint], h: Any, coords: tuple[str,
             others = pt.floquet_exponents.real
             others = others[np.abs(others) > hill_accuracy(pt.omega, pt.trivial_exponent)]
             if pred > 0 and abs(pt.amplitude[ref] / pred - 1.0) <= 0.05 and np.all(others < 0):
-                pt = replace(pt, stable=h.criticality == "supercritical")
+                pt = replace(pt, stable=h.criticality == "supercritical", stability_from="normal form")
         out.append(pt)
     return out
 
@@ -761,7 +769,7 @@ def _make_point(bal: _Balance, sim: Any, C: np.ndarray, omega: float, p: float, 
     if stability:
         fl, st, tr = _hill(bal, C, omega, p)
     return HarmonicPoint(float(p), float(omega), float(omega / (2 * np.pi)), ampd, tilt, fmin, smin, resid,
-                         float(err), H, C.copy(), fl, st, tr)
+                         float(err), H, C.copy(), fl, st, tr, None if st is None else "Hill's method")
 
 
 def _pmin(v: np.ndarray) -> np.ndarray:
