@@ -168,3 +168,20 @@ def test_with_stick_slip_events_stop_only_at_contact_loss(method):
     # which is recorded and passed
     rev = [t for k, v in tr.event_times.items() if k.startswith("sliding-reversal") for t in v]
     assert all(t < tr.t_event for t in rev) and (rev or method != "DOP853-jit")
+
+
+def test_reversal_is_ordinary_motion_only_when_every_pad_has_regularised_stick_slip():
+    """One rule for the simulation and the branches (``stick_slip_everywhere``): a model with one stick-law pad
+    and one Coulomb pad keeps the end of validity at a reversal (the Coulomb pad would stick)."""
+    from dataclasses import replace
+
+    from brakesqueal.model.components import FrictionLaw
+    from brakesqueal.model.options import stick_slip_everywhere
+
+    space = resolve_space(preset="paper-fig3", sets=SETS)
+    assert not stick_slip_everywhere(space.resolve({}).model)
+    stick = regularised_pads(space, SLOPE, 1e-3).resolve({}).model
+    assert stick_slip_everywhere(stick)
+    mixed = replace(stick, pads=(stick.pads[0], replace(stick.pads[1], friction=FrictionLaw("coulomb", "mu2"))))
+    assert not stick_slip_everywhere(mixed)
+    assert not stick_slip_everywhere(regularised_pads(space, SLOPE).resolve({}).model)

@@ -9,8 +9,8 @@ from typing import Any
 from ..errors import ParameterError
 from .parameters import ParameterSpace, Parameters, parse_sets
 
-__all__ = ["resolve_space", "resolve_parameters", "regularised_pads", "DEFAULT_PRESET", "MAX_PAD_SLOPE",
-           "MAX_STICK_SPEED"]
+__all__ = ["resolve_space", "resolve_parameters", "regularised_pads", "stick_slip_everywhere", "DEFAULT_PRESET",
+           "MAX_PAD_SLOPE", "MAX_STICK_SPEED"]
 
 #: The preset used when neither a model, a preset nor a parameter file is given.
 DEFAULT_PRESET = "paper-fig2"
@@ -126,6 +126,25 @@ def _in_range(option: str, value: Any, high: float, unit: str) -> float:
     if not (0 < x <= high):
         raise ParameterError(f"The option '{option}' must be in (0, {high:g}] {unit}; got {value!r}")
     return x
+
+
+def stick_slip_everywhere(spec: Any) -> bool:
+    """Whether every pad of ``spec`` has regularised stick-slip (the law ``stick``).
+
+    Only then is a sliding reversal ordinary motion for the simulation (``events="stop"`` stops at contact
+    loss only) and for limit-cycle branches (no end of validity); a Coulomb pad anywhere else (rigid, or with
+    its own DOF) would stick there.
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model.
+
+    Returns
+    -------
+    bool
+    """
+    return bool(spec.pads) and all(pad.friction.law == "stick" for pad in spec.pads)
 
 
 def regularised_pads(space: Any, slope: float, stick_speed: float | None = None) -> Any:

@@ -730,7 +730,9 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
         space = regularised_pads(space, pad_slope, stick_speed)
     elif stick_speed is not None:
         raise ParameterError("stick_speed regularises the pads of pad_slope; give pad_slope too")
-    stick = any(pad.friction.law == "stick" for pad in space.resolve({}).model.pads)
+    from ..model.options import stick_slip_everywhere
+
+    stick = stick_slip_everywhere(space.resolve({}).model)  # the simulation's rule
     pts = [hp for hp in hopf_points(space, axis, use_cache=use_cache)
            if hp.branch_start is not None and hp.branch_start.side]
     if not pts:

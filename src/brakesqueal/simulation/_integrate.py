@@ -11,6 +11,7 @@ from typing import Any, Callable, Literal, Sequence
 import numpy as np
 
 from ..errors import BrakesquealError, ParameterError, SilentMotionError
+from ..model.options import stick_slip_everywhere
 from ..status import RunStatus
 from .estimate import LinearModes, linear_modes
 from .trajectory import EstimationRecord, Trajectory
@@ -945,7 +946,7 @@ class _Run:
         self.npad = len(model.pads)
         self.engaged = engaged
         #: every pad has regularised stick-slip (law ``stick``): ``events="stop"`` stops at contact loss only
-        self.stick = bool(model.spec.pads) and all(pad.friction.law == "stick" for pad in model.spec.pads)
+        self.stick = stick_slip_everywhere(model.spec)
 
     def _event_name(self, k: int) -> tuple[str, str]:
         pad = self.model.pads[k % self.npad]
