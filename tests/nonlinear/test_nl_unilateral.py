@@ -23,6 +23,8 @@ from brakesqueal.nonlinear import find_periodic_orbit
 from brakesqueal.nonlinear.models import _duty_cycle, hopf_points, model_piecewise_system, model_system
 from brakesqueal.simulation import simulate
 
+from _disk_energy import disk_work
+
 P_LIFT = 36.045  # Omega [rad/s]: 0.44 rad/s past the Fig. 3 onset, the pads lift off for ~5 % of the period
 
 
@@ -78,40 +80,13 @@ def test_energy_balance_over_one_period(lifting_orbit):
     constraint, eq. 40), the contact points and the contact forces f_p = F_n (s z3 + mu v_r/|v_r|) are written here
     from the trajectory's outputs (acting F_n, v_r, h).  d/dt (T - Omega L_z0) = w . m with w = omega - Omega z0.
     """
-    from scipy.integrate import trapezoid
-
     space, pw, o = lifting_orbit
     params = space.resolve({"Omega": P_LIFT})
-    spec = params.model
     N = 20000
     tr = simulate(None, params, o.period, x0=o.x[0], rtol=1e-12, events="continue", contact="unilateral",
                   sample_rate=N / o.period * (1 + 1e-12))
     assert tr.t.size == N + 1 and tr.engaged is not None and not tr.engaged.all()  # the pads lift off
-    t, (q1, q2, dq1, dq2) = tr.t, tr.y.T
-    Om, kt, dt = float(params["Omega"]), float(params[spec.disk.k_t]), float(params[spec.disk.d_t])
-    e_z = np.array([0.0, 0.0, 1.0])
-    x0 = np.array([1.0, 0.0, 0.0])
-    y1 = np.column_stack([np.zeros_like(q1), np.cos(q1), np.sin(q1)])
-    z3 = np.column_stack([np.sin(q2), -np.sin(q1) * np.cos(q2), np.cos(q1) * np.cos(q2)])
-    dq3 = (Om - dq2 * np.sin(q1)) / (np.cos(q1) * np.cos(q2))  # the spin constraint z0 . omega = Omega (eq. 40)
-    w = dq1[:, None] * x0 + dq2[:, None] * y1 + dq3[:, None] * z3 - Om * e_z
-    m_support = -kt * (q1[:, None] * x0 + q2[:, None] * y1)
-    m_damper = -dt * (dq1[:, None] * x0 + dq2[:, None] * y1)
-    m_contact = np.zeros_like(w)
-    for j, pad in enumerate(spec.pads):
-        s = 1 if pad.face == "upper" else -1
-        r = float(params[pad.radius])
-        h0 = float(params[spec.disk.h_upper if s == 1 else spec.disk.h_lower])
-        a = math.radians(pad.angle_deg)
-        base = np.array([r * math.sin(a), -r * math.cos(a), 0.0])
-        e_t = np.array([math.cos(a), math.sin(a), 0.0])
-        p = base + tr.contact[:, j, 6][:, None] * e_t + (-s * h0 + tr.contact[:, j, 4])[:, None] * e_z
-        vr = tr.sliding_velocities[:, j]
-        f = tr.normal_forces[:, j][:, None] * (s * z3 + float(params[f"mu{j + 1}"]) * vr
-                                                / np.linalg.norm(vr, axis=1)[:, None])
-        m_contact += np.cross(p, f)
-    work = {k: trapezoid(np.einsum("ij,ij->i", w, m), t)
-            for k, m in (("support", m_support), ("damper", m_damper), ("contact", m_contact))}
+    work = disk_work(params, tr)
     assert work["contact"] > 0 and work["damper"] < 0  # friction feeds the squeal, the damper takes it out
     assert abs(sum(work.values())) < 1e-6 * work["contact"], work  # measured 4e-8 (trapezoid rule across kinks)
     # a wrong sign of the contact moment would not balance (the check can fail)

@@ -20,5 +20,5 @@ def test_piecewise_system_refuses_dynamic_pads():
     space = resolve_space(preset="paper-fig3", sets=SETS)
     pw = model_piecewise_system(space, "Omega")  # coulomb pads: quasi-static, accepted
     assert len(pw.modes) == 4
-    with pytest.raises(ParameterError, match=r"rate-dependent friction \(l1, l2\)"):
+    with pytest.raises(ParameterError, match=r"needs a tangential damper d_ip > 0 .*\(l1, l2, rate-dependent friction\)"):
         model_piecewise_system(regularised_pads(space, 1e-4), "Omega")

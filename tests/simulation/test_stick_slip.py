@@ -165,9 +165,11 @@ def test_with_stick_slip_events_stop_only_at_contact_loss(method):
     tr = simulate(None, regularised_pads(space, SLOPE, 1e-3).resolve({}), t_end, perturbation=lift, method=method)
     assert tr.status == "contact-loss" and tr.t_event == pytest.approx(t_loss, rel=1e-5)
     # as F_n -> 0 the friction can no longer hold the pad's spring: it slips forward (a true reversal),
-    # which is recorded and passed
+    # which is recorded and passed (a second turn located at the contact loss itself, where F_n = 0 leaves the pad
+    # no friction, may be recorded too: rounding decides)
     rev = [t for k, v in tr.event_times.items() if k.startswith("sliding-reversal") for t in v]
-    assert all(t < tr.t_event for t in rev) and (rev or method != "DOP853-jit")
+    assert all(t <= tr.t_event for t in rev) and (rev or method != "DOP853-jit")
+    assert not rev or min(rev) < tr.t_event
 
 
 def test_reversal_is_ordinary_motion_only_when_every_pad_has_regularised_stick_slip():

@@ -43,7 +43,7 @@ def case():
 
 def test_unilateral_contact_refuses_dynamic_pads_and_names_them(case):
     sim, params, st, x0, _tr = case
-    with pytest.raises(ParameterError, match=r"rate-dependent friction \(l1, l2\).*dG/dldot"):
+    with pytest.raises(ParameterError, match=r"needs a tangential damper d_ip > 0 .*\(l1, l2, rate-dependent friction\).*dG/dldot"):
         simulate(sim, params, 1e-3, x0=x0, contact="unilateral", events="continue")
 
 

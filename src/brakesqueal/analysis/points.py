@@ -24,7 +24,7 @@ Routes, chosen per point by what the model allows:
     <brakesqueal.codegen.compiled.CompiledModel.zero_linear>`) and certified
     eigenvalue verdicts (:func:`~.robust.eigen_verdicts`; for two
     coordinates first the interval quartic, :func:`~.robust.matrix_verdicts`);
-  - with pads that keep first-order dynamics (rate-dependent friction),
+  - with pads that keep first-order dynamics (rate-dependent friction or a tangential damper),
     batched descriptor blocks at the zero state and the verdict of every
     eigenvalue of ``E^-1 A`` (:func:`~.robust.descriptor_verdicts`).
 

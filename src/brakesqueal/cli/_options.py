@@ -41,6 +41,10 @@ PadSlopeOpt = Annotated[Optional[float], typer.Option(
 StickSpeedOpt = Annotated[Optional[float], typer.Option(
     "--stick-speed", help="With --pad-slope: regularise stick-slip too, mu v / sqrt(v^2 + V^2) + S v (V in (0, 1] m/s; "
                           "a sticking pad creeps at speeds of order V; error O(V), e.g. 1e-3).")]
+PadDampingOpt = Annotated[Optional[float], typer.Option(
+    "--pad-damping", help="Give every massless pad a tangential damper d_ip beside its spring (N s/m, in (0, 1e6]; "
+                          "not in the paper): the pads' rates are kept as states, also through lift-off and "
+                          "re-contact (--contact unilateral). Default: none.")]
 ProgressOpt = Annotated[Optional[bool], typer.Option(
     "--progress/--no-progress", help="Progress on stderr (default: a bar on a terminal, periodic lines otherwise).")]
 
@@ -50,12 +54,18 @@ def note(message: str) -> None:
     print(f"brakesqueal: note: {message}", file=sys.stderr)
 
 
-def pads_option(space: Any, pad_slope: float | None, stick_speed: float | None) -> Any:
-    """``space`` with the pads of ``--pad-slope`` and ``--stick-speed``.
+def pads_option(space: Any, pad_slope: float | None, stick_speed: float | None,
+                pad_damping: float | None = None) -> Any:
+    """``space`` with the pads of ``--pad-slope``, ``--stick-speed`` and ``--pad-damping``.
 
-    See :func:`brakesqueal.model.options.regularised_pads`.
+    See :func:`brakesqueal.model.options.regularised_pads` and :func:`~brakesqueal.model.options.damped_pads`.
     """
     from ..errors import ParameterError
+
+    if pad_damping is not None:
+        from ..model.options import damped_pads
+
+        space = damped_pads(space, pad_damping)
 
     if pad_slope is None:
         if stick_speed is not None:

@@ -13,7 +13,7 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ..errors import ParameterError
-from ._options import (ModelOpt, PadSlopeOpt, ParamsOpt, PresetOpt, SetOpt, StickSpeedOpt, pads_option,
+from ._options import (ModelOpt, PadDampingOpt, PadSlopeOpt, ParamsOpt, PresetOpt, SetOpt, StickSpeedOpt, pads_option,
                        space_from)
 
 __all__ = ["register"]
@@ -85,6 +85,7 @@ def _simulate_cmd(
     ] = "bilateral",
     pad_slope: PadSlopeOpt = None,
     stick_speed: StickSpeedOpt = None,
+    pad_damping: PadDampingOpt = None,
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Output samples per second [Hz].")] = 44100.0,
     out: Annotated[Optional[str], typer.Option("--out", help="Write the trajectory to this NetCDF file.")] = None,
     plot: Annotated[Optional[str], typer.Option("--plot", help="Write the plot (time history, phase, spectrum).")] = (
@@ -121,7 +122,7 @@ def _simulate_cmd(
         init["perturbation"] = _floats(q0, "--q0")
     _check_outputs(out, plot, wav)
     from ..interrupts import interrupt_guard
-    p = pads_option(space_from(model, preset, params, set_), pad_slope, stick_speed).resolve({})
+    p = pads_option(space_from(model, preset, params, set_), pad_slope, stick_speed, pad_damping).resolve({})
     with interrupt_guard():  # nested in the program's guard (brakesqueal.cli.main), which ends a stuck run
         tr = _run(p, t_end, method, rtol, atol, events, sample_rate, progress, no_cache, {**init, "contact": contact})
         if wav and tr.t.size < 2:

@@ -17,8 +17,8 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ..errors import ParameterError
-from ._options import (FormatOpt, ModelOpt, OutFormat, PadSlopeOpt, ParamsOpt, PresetOpt, ProgressOpt, SetOpt,
-                       StickSpeedOpt, pads_option, space_from)
+from ._options import (FormatOpt, ModelOpt, OutFormat, PadDampingOpt, PadSlopeOpt, ParamsOpt, PresetOpt,
+                       ProgressOpt, SetOpt, StickSpeedOpt, pads_option, space_from)
 
 __all__ = ["register"]
 
@@ -235,6 +235,7 @@ def cycles(
                                          "(F_n = max(0, .), slower).")] = "bilateral",
     pad_slope: PadSlopeOpt = None,
     stick_speed: StickSpeedOpt = None,
+    pad_damping: PadDampingOpt = None,
     exact_pads: Annotated[bool, typer.Option("--exact-pads", help="Harmonic balance on the implicit equations: the "
                                              "massless Coulomb pads exact (tangential rates kept, no "
                                              "regularisation); bilateral, to the located contact loss.")] = False,
@@ -254,14 +255,14 @@ def cycles(
     if exact_pads:
         _cycles_exact_pads(axis, space_from(model, preset, params, set_), fmt=fmt, max_points=max_points,
                            harmonics=harmonics, max_harmonics=max_harmonics, contact=contact, pad_slope=pad_slope,
-                           stick_speed=stick_speed, plot=plot, out=out)
+                           stick_speed=stick_speed, pad_damping=pad_damping, plot=plot, out=out)
         return
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     if out:
         check_output(out, what="--out", suffixes=(".nc",))
     space = space_from(model, preset, params, set_)
-    space = pads_option(space, pad_slope, stick_speed)  # checked before anything is computed
+    space = pads_option(space, pad_slope, stick_speed, pad_damping)  # checked before anything is computed
     b = squeal_branch(space, axis, max_points=max_points, contact=contact)
     if out:
         ds = b.data.copy()
@@ -302,7 +303,7 @@ def cycles(
 
 def _cycles_exact_pads(axis: Any, space: Any, *, fmt: OutFormat, max_points: int, harmonics: int,
                        max_harmonics: int, contact: str, pad_slope: float | None, stick_speed: float | None,
-                       plot: str | None, out: str | None) -> None:
+                       pad_damping: float | None, plot: str | None, out: str | None) -> None:
     """``cycles --exact-pads``: the harmonic-balance branch of the implicit equations (text or JSON, ``--out``
     NetCDF, ``--plot`` bifurcation diagram)."""
     from ..nonlinear.harmonic import harmonic_branch
@@ -314,6 +315,7 @@ def _cycles_exact_pads(axis: Any, space: Any, *, fmt: OutFormat, max_points: int
         if bad:
             raise ParameterError(f"The option '--exact-pads' cannot be combined with {flag} (the exact pads are "
                                  "bilateral and unregularised)")
+    space = pads_option(space, None, None, pad_damping)  # a damper is part of the model: balanced exactly too
     if max_harmonics < harmonics:
         raise ParameterError(f"The option '--max-harmonics' must be >= --harmonics = {harmonics}; got {max_harmonics}")
     if plot:

@@ -520,8 +520,8 @@ def _linear_functions(spec: Any) -> tuple[tuple[ExportFunction, ...], dict[str, 
     doc = ("closed-form M, D, K (row-major n x n) about the zero state Q = 0, L = 0 (eqs. 47-48 with the "
            "quasi-static pads eliminated; valid where the zero state is the silent motion, e.g. eq. 49)")
     if k:
-        doc += (f"; the pads {', '.join(kept)} keep first-order dynamics (rate-dependent friction) and their "
-                "blocks R_L, R_dL, G_Q, G_dQ, G_L, G_dL follow")
+        doc += (f"; the pads {', '.join(kept)} keep first-order dynamics (rate-dependent friction or a tangential "
+                "damper) and their blocks R_L, R_dL, G_Q, G_dQ, G_L, G_dL follow")
     fn = _function("linear_matrices", doc, (("p", S.names(S.p)),), tuple(outputs), exprs, avoid)
     return (fn,), {"kept": kept, "pad_jacobian": "diagonal", "symbols": S, "coords": eq.coords,
                    "algebraic": eq.algebraic}
@@ -547,9 +547,10 @@ def _nonlinear_notes(kept: tuple[str, ...], algebraic: tuple[str, ...]) -> tuple
         notes.append(f"Quasi-static pads ({', '.join(quasi)}): ldot = 0 in the sliding velocities, l follows "
                      "(Q, Qdot) through G = 0 (rate-independent friction; docs/theory.md).")
     if kept:
-        notes.append(f"Pads with first-order dynamics ({', '.join(kept)}, rate-dependent friction): l is part of "
-                     "the state y, its rate ldot is the pad unknown solved from G = 0 (needs dG/dldot != 0: a finite "
-                     "tangential stiffness and a friction law whose slope is not 0).")
+        notes.append(f"Pads with first-order dynamics ({', '.join(kept)}, rate-dependent friction or a tangential "
+                     "damper): l is part of the state y, its rate ldot is the pad unknown solved from G = 0 (needs "
+                     "dG/dldot != 0: a finite tangential stiffness and a friction law whose slope is not 0, or a "
+                     "damper d_ip > 0).")
     return tuple(notes)
 
 

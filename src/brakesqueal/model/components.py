@@ -305,7 +305,9 @@ class Pad:
     k_ip: Value = param(math.inf, "N/m", "tangential support stiffness of {owner} (inf = rigid)", _POS_INF,
                         " Default 'inf' (rigid); a tangential DOF needs a finite k_ip.")
     d_ip: Value = param(0.0, "N s/m", "tangential support damping of {owner}", _NONNEG,
-                        " Must be 0 unless the pad has a tangential DOF.")
+                        " In parallel with the tangential spring; needs a finite k_ip. On a massless pad it makes "
+                        "the pad's tangential rate a state that stays determined through lift-off (not in the "
+                        "paper; default 0).")
     mass: Value | None = param(None, "kg", "mass of {owner}", _POS,
                                " Needs at least one entry in dofs; absent = massless pad.")
     dofs: tuple[str, ...] = attribute({
@@ -343,8 +345,9 @@ class Pad:
             raise ParameterError(f"{c}: a normal DOF needs a contact stiffness k_c")
         if "tangential" in self.dofs and isinstance(self.k_ip, float) and math.isinf(self.k_ip):
             raise ParameterError(f"{c}: a tangential DOF without stiffness (k_ip = inf): give a finite k_ip")
-        if "tangential" not in self.dofs and self.d_ip != 0.0:
-            raise ParameterError(f"{c}: a tangential damper d_ip needs a pad mass with a tangential DOF")
+        if self.d_ip != 0.0 and isinstance(self.k_ip, float) and math.isinf(self.k_ip):
+            raise ParameterError(f"{c}: a tangential damper d_ip needs a finite tangential stiffness k_ip (a "
+                                 "damper beside a rigid support does nothing)")
         self.friction.validate(c)
 
 
@@ -424,6 +427,9 @@ class Kind:
     rules: tuple[dict[str, Any], ...] = ()
 
 
+#: Schema of a finite stiffness (not 'inf', not a number at the float limit).
+_FINITE_K = {"not": {"anyOf": [{"const": "inf"}, {"type": "number", "minimum": _MAX_FLOAT}]}}
+
 #: Every kind of component, by role prefix, in the order of model files (register a new kind here).
 COMPONENTS: dict[str, Kind] = {kind.key: kind for kind in (
     Kind(Disk, "disk", "disk", False, lambda d: "the disk", "the disk",
@@ -439,9 +445,9 @@ COMPONENTS: dict[str, Kind] = {kind.key: kind for kind in (
              {"if": {"required": ["mass"]}, "then": {"required": ["dofs"], "properties": {"dofs": {"minItems": 1}}}},
              {"if": _has_dof("normal"), "then": {"required": ["k_c"]}},
              {"if": _has_dof("tangential"),
-              "then": {"required": ["k_ip"], "properties": {"k_ip": {"not": {"anyOf": [
-                  {"const": "inf"}, {"type": "number", "minimum": _MAX_FLOAT}]}}}},
-              "else": {"properties": {"d_ip": {"const": 0}}}})),
+              "then": {"required": ["k_ip"], "properties": {"k_ip": _FINITE_K}}},
+             {"if": {"required": ["d_ip"], "properties": {"d_ip": {"not": {"const": 0}}}},
+              "then": {"required": ["k_ip"], "properties": {"k_ip": _FINITE_K}}})),
     Kind(Caliper, "caliper", "calipers", True, lambda c: f"caliper '{c.name}'", "the caliper",
          "Optional caliper masses ([[calipers]] tables).",
          "A rigid caliper (mounting) mass on springs to ground, coupling the supports of the pads mounted on it "

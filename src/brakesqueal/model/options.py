@@ -9,8 +9,8 @@ from typing import Any
 from ..errors import ParameterError
 from .parameters import ParameterSpace, Parameters, parse_sets
 
-__all__ = ["resolve_space", "resolve_parameters", "regularised_pads", "stick_slip_everywhere", "DEFAULT_PRESET",
-           "MAX_PAD_SLOPE", "MAX_STICK_SPEED"]
+__all__ = ["resolve_space", "resolve_parameters", "regularised_pads", "damped_pads", "stick_slip_everywhere",
+           "DEFAULT_PRESET", "MAX_PAD_SLOPE", "MAX_STICK_SPEED", "MAX_PAD_DAMPING"]
 
 #: The preset used when neither a model, a preset nor a parameter file is given.
 DEFAULT_PRESET = "paper-fig2"
@@ -115,6 +115,8 @@ def resolve_parameters(model: Any = None, preset: str | None = None, params: str
 MAX_PAD_SLOPE = 1e-2
 #: Largest stick-slip regularisation speed accepted by :func:`regularised_pads` [m/s].
 MAX_STICK_SPEED = 1.0
+#: Largest tangential pad damping of :func:`damped_pads` [N s/m].
+MAX_PAD_DAMPING = 1e6
 
 
 def _in_range(option: str, value: Any, high: float, unit: str) -> float:
@@ -204,4 +206,53 @@ def regularised_pads(space: Any, slope: float, stick_speed: float | None = None)
     if not changed:
         return space
     new = replace(spec, name=f"{spec.name}+{'rising-pads' if v_reg is None else 'stick-slip-pads'}", pads=tuple(pads))
+    return type(space)(space.preset.bind(new), dict(space.values))
+
+
+def damped_pads(space: Any, d_ip: float) -> Any:
+    """``space`` with a tangential damper ``d_ip`` beside the spring of every massless pad (not in the paper).
+
+    A massless pad with a finite tangential stiffness then balances ``k_ip (l - u_m) + d_ip (ldot - u_mdot) =
+    -(f_t + mu* N0)`` (``brakesqueal.symbolic.contact``): its rate is a state whose balance has the slope
+    ``dG/dldot >= d_ip / k_ip > 0`` at every normal force, so the simulation and the limit-cycle branches keep
+    the pads' true tangential dynamics through lift-off and re-contact (a lifted pad relaxes with the time
+    constant ``d_ip / k_ip``).  Without it the rate of such a pad is not determined near lift-off
+    (``docs/simulation.md``, unilateral contact).  The damper changes the model: the linearization gains the
+    pads' first-order modes (rate ``~ -k_ip / d_ip``) and the onset moves by ``O(d_ip)``.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    d_ip : float
+        Tangential damping [N s/m], in ``(0, MAX_PAD_DAMPING]``.
+
+    Returns
+    -------
+    ParameterSpace
+        The same preset and overrides on the modified model (named ``<model>+damped-pads``); ``space`` itself
+        when no pad needs it (pads that are rigid tangentially at ``space``'s values, have their own
+        tangential DOF or a damper).
+
+    Raises
+    ------
+    ParameterError
+        ``d_ip`` out of range.
+    """
+    from dataclasses import replace
+
+    value = _in_range("pad_damping", d_ip, MAX_PAD_DAMPING, "N s/m")
+    params = space.resolve({})
+    spec = params.model
+    pads, changed = [], False
+    for pad in spec.pads:
+        massless = "tangential" not in pad.dofs
+        finite = math.isfinite(float(params[pad.k_ip]) if isinstance(pad.k_ip, str) else float(pad.k_ip))
+        if massless and finite and not isinstance(pad.d_ip, str) and pad.d_ip == 0.0:
+            pad = replace(pad, d_ip=value)
+            changed = True
+        pads.append(pad)
+    if not changed:
+        return space
+    new = replace(spec, name=f"{spec.name}+damped-pads", pads=tuple(pads))
     return type(space)(space.preset.bind(new), dict(space.values))

@@ -117,8 +117,9 @@ def model_piecewise_system(space: Any, name: str, *, use_cache: bool = True) -> 
     Parameters
     ----------
     space : ParameterSpace
-        The model, preset and overrides (pads with coulomb friction, or with
-        their own degrees of freedom; rate-dependent friction is refused).
+        The model, preset and overrides (pads with coulomb friction, with
+        their own degrees of freedom, or with a tangential damper ``d_ip``;
+        rate-dependent friction without a damper is refused).
     name : str
         The continuation parameter.
     use_cache : bool
@@ -133,15 +134,16 @@ def model_piecewise_system(space: Any, name: str, *, use_cache: bool = True) -> 
     Raises
     ------
     ParameterError
-        ``name`` not settable, or a pad with rate-dependent friction.
+        ``name`` not settable, or a pad with rate-dependent friction and no damper.
     """
     from ..errors import ParameterError
 
     smooth = model_system(space, name, use_cache=use_cache)
     sim = smooth.simulation_model  # type: ignore[attr-defined]
-    if sim.dynamic:
-        raise ParameterError(f"unilateral contact is not available for pads with rate-dependent friction "
-                             f"({', '.join(sim.dynamic)})")
+    if undamped := sim.undamped(space.resolve({})):
+        raise ParameterError(f"unilateral contact needs a tangential damper d_ip > 0 on every pad whose rate is a "
+                             f"state ({', '.join(undamped)}, rate-dependent friction): without one the pad's rate is "
+                             "not determined down to lift-off (docs/simulation.md, unilateral contact)")
     pads = sim.pads
     npad = len(pads)
     cache: dict[tuple[float, int], Any] = {}
@@ -165,10 +167,13 @@ def model_piecewise_system(space: Any, name: str, *, use_cache: bool = True) -> 
             cache[key] = sim.vector_field(params, st, engaged=[not (mode >> j) & 1 for j in range(npad)])
         return cache[key]
 
-    def normal_force(j: int) -> Any:
+    def normal_force(j: int, mode: int) -> Any:
+        # the bilateral normal force of pad j with the pads' rates of `mode` (a lifted pad with a damper relaxes)
+        engaged = [not (mode >> i) & 1 for i in range(npad)]
+
         def h(x: np.ndarray, p: float) -> float:
             params, st = state(p)
-            return float(sim.contact_at(params, x, st)[j, 0])
+            return float(sim.contact_at(params, x, st, engaged=engaged)[j, 0])
 
         return h
 
@@ -177,7 +182,6 @@ def model_piecewise_system(space: Any, name: str, *, use_cache: bool = True) -> 
         F = sim.contact_at(params, x, st)[:, 0]
         return int(sum(1 << j for j in range(npad) if not F[j] > 0))
 
-    guards = [normal_force(j) for j in range(npad)]
     modes, transitions, names = [], [], []
     for m in range(2 ** npad):
         if m == 0:
@@ -194,9 +198,9 @@ def model_piecewise_system(space: Any, name: str, *, use_cache: bool = True) -> 
         tr = []
         for j in range(npad):
             if (m >> j) & 1:
-                tr.append(Transition(guards[j], m & ~(1 << j), +1, name=f"re-contact-pad-{pads[j]}"))
+                tr.append(Transition(normal_force(j, m), m & ~(1 << j), +1, name=f"re-contact-pad-{pads[j]}"))
             else:
-                tr.append(Transition(guards[j], m | (1 << j), -1, name=f"contact-loss-pad-{pads[j]}"))
+                tr.append(Transition(normal_force(j, m), m | (1 << j), -1, name=f"contact-loss-pad-{pads[j]}"))
         transitions.append(tuple(tr))
         lifted = [pads[j] for j in range(npad) if (m >> j) & 1]
         names.append("lifted " + ",".join(lifted) if lifted else "pressed")

@@ -111,8 +111,22 @@ class SimulationModel:
 
     @property
     def dynamic(self) -> tuple[str, ...]:
-        """Pad deformations that are states (rate-dependent friction)."""
+        """Pad deformations that are states (rate-dependent friction or a tangential damper)."""
         return tuple(n for n, k in zip(self.pad_unknowns, self.pad_kinds) if k == "dynamic")
+
+    def undamped(self, params: Any) -> tuple[str, ...]:
+        """The :attr:`dynamic` pad deformations without a tangential damper (``d_ip = 0`` at ``params``).
+
+        Their rate is not determined through lift-off (``docs/simulation.md``, unilateral contact).
+        """
+        by_pad = {p.name: p for p in self.spec.pads}
+        out = []
+        for name, pad in zip(self.pad_unknowns, self.unknown_pads):
+            d = by_pad[pad].d_ip
+            value = float(params[d]) if isinstance(d, str) else float(d)
+            if name in self.dynamic and not value > 0.0:
+                out.append(name)
+        return tuple(out)
 
     @property
     def pads(self) -> tuple[str, ...]:
@@ -191,7 +205,7 @@ class SimulationModel:
                 if not (math.isfinite(d) and d != 0.0):
                     raise ParameterError(
                         f"{pad}: the tangential balance does not determine the pad's "
-                        f"{'deformation' if kind == 'quasi-static' else 'rate (a zero friction slope dmu/dv)'} "
+                        f"{'deformation' if kind == 'quasi-static' else _NO_RATE} "
                         "at the silent motion; give the pad a rate-dependent friction law with a nonzero slope "
                         "or a coulomb law")  # fmt: skip
                 if kind == "dynamic" and abs(G_l / G_dl) > 1e9:
@@ -238,17 +252,21 @@ class SimulationModel:
         except (BrakesquealError, np.linalg.LinAlgError):
             return None
 
-    def contact_at(self, params: Any, y: Sequence[float], silent: SilentState | None = None) -> np.ndarray:
+    def contact_at(self, params: Any, y: Sequence[float], silent: SilentState | None = None,
+                   engaged: Sequence[bool] | None = None) -> np.ndarray:
         """Contact quantities at an integrator state ``y`` (pad unknowns solved), shape ``(n_pads, 7)``.
 
-        Columns are :data:`~brakesqueal.codegen.compiled.CONTACT_FIELDS`.
+        Columns are :data:`~brakesqueal.codegen.compiled.CONTACT_FIELDS`.  With ``engaged`` (one entry per
+        pad, default all pressed) the pad unknowns of lifted pads solve their balance without friction; the
+        columns are still the bilateral quantities (``F_n`` is the force the pad would carry if pressed).
         """
         st = silent or self.silent(params)
         p = self.parameter_vector(params)
         yy = np.ascontiguousarray(y, dtype=float)
         l, dl = st.l.copy(), st.dl.copy()
         g = np.empty(2 * len(l) + 1)
-        if not self.kernels.solve_pads(yy, l, dl, p, st.ztol, g):
+        eng = np.ones(len(self.pads), dtype=np.int64) if engaged is None else np.asarray(engaged, dtype=np.int64)
+        if not self.kernels.solve_pads_e(yy, l, dl, p, st.ztol, g, eng):
             raise ParameterError("the pad equations cannot be solved at this state")
         cb = np.empty(7 * len(self.pads))
         self.kernels.contact(yy, l, dl, p, cb)
@@ -554,6 +572,38 @@ def _start_vector(model: SimulationModel, modes: LinearModes, scales: np.ndarray
     return START_AMPLITUDE * v / (s if s > 0 else 1.0)
 
 
+def _pads_at_rest(model: SimulationModel, params: Any, p: np.ndarray, y0: np.ndarray, st: SilentState) -> str:
+    """Start every damped pad (a :attr:`~SimulationModel.dynamic` pad with ``d_ip > 0``) at rest on its support.
+
+    When the initial state leaves the pad states out, the damped pads' deformations ``l`` are set (in ``y0``,
+    in place) to the root of their balance with ``ldot = 0``: the spring carries the friction at the initial
+    tilt.  Kept at the silent motion's value instead, a tilted start would put the whole change of the friction
+    force on the damper (``ldot ~ dF / d_ip``, often faster than the sliding speed: a spurious reversal).
+    Returns a note for the trajectory's ``start`` ("" when no pad is changed).
+    """
+    undamped = set(model.undamped(params))
+    dyn = [j for j, k in enumerate(model.pad_kinds) if k == "dynamic"]
+    damped = [(i, j) for i, j in enumerate(dyn) if model.pad_unknowns[j] not in undamped]
+    if not damped:
+        return ""
+    n, m = model.n, len(model.pad_kinds)
+    l, dl, g = st.l.copy(), np.zeros(m), np.empty(2 * m + 1)
+    for i, j in damped:
+        l[j] = y0[2 * n + i]
+    for _ in range(60):  # G is l + O(c_ip) in l (eqs. 33-34): a secant-free fixed point converges at once
+        model.kernels.pad_balance(y0, l, dl, p, g)
+        step = max(abs(float(g[j])) for _i, j in damped)
+        for i, j in damped:
+            l[j] -= g[j]
+        if not step > 1e-15 * (1.0 + max(abs(float(l[j])) for _i, j in damped)):
+            break
+    if not all(math.isfinite(float(l[j])) for _i, j in damped):
+        return ""
+    for i, j in damped:
+        y0[2 * n + i] = l[j]
+    return "; damped pads at rest on their supports (ldot = 0)"
+
+
 def _initial_state(model: SimulationModel, x0: Any, perturbation: Any, y_s: np.ndarray,
                    modes: LinearModes | None, scales: np.ndarray) -> tuple[np.ndarray, str]:
     """Initial state and a description of it (``start`` of the trajectory)."""
@@ -786,13 +836,13 @@ def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sampl
     params = model.parameters(params)
     p = model.parameter_vector(params)
     unilateral = contact == "unilateral"
-    if unilateral and model.dynamic:
-        raise ParameterError(f"contact='unilateral' is not available for pads with rate-dependent friction "
-                             f"({', '.join(model.dynamic)}): their rate ldot solves the friction balance G(Q, Qdot, l, "
-                             "ldot) = 0, whose slope dG/dldot shrinks with F_n (to the support damper's share at "
-                             "F_n = 0) and can change sign before F_n = 0, so the pad mode diverges before the "
-                             "pad lifts off (docs/simulation.md, unilateral contact); use coulomb friction or "
-                             "contact='bilateral'")
+    if unilateral and (undamped := model.undamped(params)):
+        raise ParameterError(f"contact='unilateral' needs a tangential damper d_ip > 0 on every pad whose rate is a "
+                             f"state ({', '.join(undamped)}, rate-dependent friction): without one its rate ldot "
+                             "solves the friction balance G(Q, Qdot, l, ldot) = 0, whose slope dG/dldot shrinks "
+                             "with F_n and can change sign before F_n = 0, so the pad mode diverges before the "
+                             "pad lifts off (docs/simulation.md, unilateral contact); give the pads a d_ip, use "
+                             "coulomb friction or contact='bilateral'")
     try:
         st = model.silent(params)
     except SilentMotionError as exc:
@@ -800,6 +850,9 @@ def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sampl
     modes = model.linear_modes(params)
     check_interrupt()
     y0, start = _initial_state(model, x0, perturbation, st.y, modes, _scales(model, params))
+    given = np.asarray(x0 if x0 is not None else perturbation if perturbation is not None else [], dtype=float)
+    if (x0 is not None or perturbation is not None) and given.size < y0.size:
+        start += _pads_at_rest(model, params, p, y0, st)
     atol_v = _check_tolerances(rtol, atol, _default_atol(model, params, rtol, modes))
     k = model.kernels
     npad = len(model.pads)
@@ -837,13 +890,15 @@ def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sampl
     L, dL = np.full((n, m), np.nan), np.full((n, m), np.nan)
     C, E = np.full((n, 7 * npad), np.nan), np.full((n, 5), np.nan)
     lw, dlw = st.l.copy(), st.dl.copy()  # warm starts carried from block to block
-    for a in range(0, n, _POST_BLOCK):  # blocks of bounded wall time: Ctrl-C acts between them
-        b = min(a + _POST_BLOCK, n)
-        k.post_process(Y[a:b], b - a, lw, dlw, p, st.ztol, L[a:b], dL[a:b], C[a:b], E[a:b])
-        check_interrupt()
     engaged = None
     if unilateral:
         engaged = engagement_at(t_out[:n], eng0.astype(bool), res.get("switch_times", [[] for _ in range(npad)]))
+    ENG = (np.ones((n, npad), dtype=np.int64) if engaged is None else engaged.astype(np.int64))
+    for a in range(0, n, _POST_BLOCK):  # blocks of bounded wall time: Ctrl-C acts between them
+        b = min(a + _POST_BLOCK, n)
+        k.post_process(Y[a:b], b - a, lw, dlw, p, st.ztol, ENG[a:b], L[a:b], dL[a:b], C[a:b], E[a:b])
+        check_interrupt()
+    if engaged is not None:
         C[:, 0::7] = np.where(engaged, C[:, 0::7], 0.0)  # the acting normal force max(0, F_n)
     message = res["message"]
     if res["status"] == RunStatus.FAILED and model.dynamic and n:
@@ -863,6 +918,9 @@ def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sampl
         tilting=model.tilting, y_silent=st.y.copy(), l_rates=dL, event_pad=res.get("event_pad"),
         contact_law=contact, engaged=engaged,
     )  # fmt: skip
+
+
+_NO_RATE = "rate (a zero friction slope dmu/dv and no tangential damper d_ip)"
 
 
 def engagement_at(t: np.ndarray, engaged0: np.ndarray, switch_times: Sequence[Sequence[float]]) -> np.ndarray:

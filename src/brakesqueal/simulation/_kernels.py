@@ -28,7 +28,7 @@ and ``dl`` the pad deformations ``L`` and their rates, ``p``
 massless pad with a finite tangential stiffness and rate-independent
 (``coulomb``) friction is *quasi-static*: ``ldot := 0`` is substituted in all
 its expressions and ``l`` solves ``G(Q, Qdot, l, 0) = 0``.  With rate-dependent
-friction (``linear``, ``stribeck``) it is *dynamic*: ``l`` is a state and
+friction (``linear``, ``stribeck``, ``stick``) or a tangential damper ``d_ip`` it is *dynamic*: ``l`` is a state and
 ``ldot`` solves ``G(Q, Qdot, l, ldot) = 0``.  Each pad's ``G_j`` depends on its
 own unknown only (checked), so both are scalar Newton iterations per pad,
 warm-started from the previous value.
@@ -77,16 +77,18 @@ def pad_treatment(spec: Any) -> tuple[str, ...]:
     tuple of str
         One entry per massless pad with a finite tangential stiffness (the
         order of ``Equations.algebraic``): ``"quasi-static"`` for
-        rate-independent (``coulomb``) friction, ``"dynamic"`` for
-        rate-dependent friction (``linear``, ``stribeck``).  Decided from the
-        friction law, never from parameter values.
+        rate-independent (``coulomb``) friction without a tangential damper,
+        ``"dynamic"`` for rate-dependent friction (``linear``, ``stribeck``,
+        ``stick``) or a tangential damper ``d_ip`` (a parameter name or a
+        nonzero number).  Decided from the model, never from parameter values.
     """
     out = []
     for pad in spec.pads:
         rigid = not isinstance(pad.k_ip, str) and math.isinf(pad.k_ip)
         if "tangential" in pad.dofs or rigid:
             continue
-        out.append("quasi-static" if pad.friction.law == "coulomb" else "dynamic")
+        damped = isinstance(pad.d_ip, str) or pad.d_ip != 0.0
+        out.append("quasi-static" if pad.friction.law == "coulomb" and not damped else "dynamic")
     return tuple(out)
 
 
@@ -138,10 +140,14 @@ def _expressions(spec: Any) -> dict[str, Any]:
             _check_free(f"dR/dQddot[{i}, {j}]", e, ddQ)  # R is linear in Qddot
             Mx.append(e)
         f.append(R[i].subs(zero_dd))
-    # pad balances: each G_j depends on its own unknown only
+    # unilateral contact: the engagement chi_j (1 pressed, 0 lifted) factors pad j's contact force f_p
+    chi = [se.Symbol(f"chi__{j}") for j in range(len(spec.pads))]
+    eq_u = build_equations(spec, engagement={pad.name: c for pad, c in zip(spec.pads, chi)})
+    # pad balances with the engagement (a lifted pad's G_j has no friction term): each G_j depends on its own
+    # unknown only
     bal, dbal = [], []
     for j in range(m):
-        g = qs(eq.G[j])
+        g = qs(eq_u.G[j])
         others = {eq.L[k] for k in range(m) if k != j} | {eq.dL[k] for k in range(m) if k != j}
         _check_free(f"G[{j}]", g, others | ddQ)
         bal.append(g)
@@ -151,9 +157,7 @@ def _expressions(spec: Any) -> dict[str, Any]:
     for c, l in zip(eq.pads, eq.tangential):
         contact += [qs(c.F_n), qs(c.v_r[0]), qs(c.v_r[1]), qs(c.v_r[2]), qs(c.h), qs(c.hdot), qs(l)]
     energy = _energy(se, eq)
-    # unilateral contact: R = R(chi = 0) + sum_j chi_j D_j with chi_j the factor of pad j's contact force f_p
-    chi = [se.Symbol(f"chi__{j}") for j in range(len(spec.pads))]
-    eq_u = build_equations(spec, engagement={pad.name: c for pad, c in zip(spec.pads, chi)})
+    # unilateral contact: R = R(chi = 0) + sum_j chi_j D_j
     release = []
     for j in range(len(spec.pads)):
         for i in range(n):
@@ -161,7 +165,7 @@ def _expressions(spec: Any) -> dict[str, Any]:
             e = r.diff(chi[j]) if chi[j] in r.free_symbols else se.Integer(0)
             _check_free(f"dR[{i}]/dchi[{j}]", e, ddQ | set(chi))  # the contact force is linear in chi, free of Qddot
             release.append(e)
-    return {"eq": eq, "kinds": kinds, "mass_force": Mx + f, "pad_balance": bal + dbal, "contact": contact,
+    return {"eq": eq, "chi": chi, "kinds": kinds, "mass_force": Mx + f, "pad_balance": bal + dbal, "contact": contact,
             "energy": [qs(e) for e in energy], "pad_scale": scale, "release": release}
 
 
@@ -234,9 +238,14 @@ def _energy(se: Any, eq: Any) -> list[Any]:
             T2 += half * val(pad.mass) * dQ[_state_name("u", pad.name)] ** 2
             V_pads += half * val(pad.k_ip) * (u - u_m) ** 2 + c.mu_star * N0 * u
         elif not (not isinstance(pad.k_ip, str) and math.isinf(pad.k_ip)):
-            # massless pad on its balance g = 0 (eqs. 33-34): k_ip (l - u_m)^2 / 2 = -(l - u_m)(f_t + mu* N0) / 2,
-            # finite also for a rigid support given as k_ip = inf (compliance 0)
-            V_pads += -half * (l - u_m) * (c.f_t + c.mu_star * N0) + c.mu_star * N0 * l
+            # massless pad on its balance g = 0 (eqs. 33-34): k_ip (l - u_m)^2 / 2 = -(l - u_m)(f_t + mu* N0
+            # + d_ip (ldot - u_mdot)) / 2, finite also for a rigid support given as k_ip = inf (compliance 0)
+            F = c.f_t + c.mu_star * N0
+            if isinstance(pad.d_ip, str) or pad.d_ip != 0.0:
+                j = list(eq.L).index(l)
+                u_dot = dQ[_state_name("uc", mount.name)] * ca if mount and "tangential" in mount.dofs else 0
+                F = F + val(pad.d_ip) * (eq.dL[j] - u_dot)
+            V_pads += -half * (l - u_m) * F + c.mu_star * N0 * l
     return [T2, T1, T0, V_support, V_pads]
 
 
@@ -249,11 +258,12 @@ from numba import njit
 _N = {n}  # coordinates Q
 _M = {m}  # pad deformations L
 _NPAD = {npad}  # pads
-_NDYN = {ndyn}  # pad deformations that are states (rate-dependent friction)
+_NDYN = {ndyn}  # pad deformations that are states (rate-dependent friction or a tangential damper)
 _NY = {ny}  # integrator state (Q, Qdot, L_dynamic)
 _NEV = {nev}  # event functions: contact loss and sliding reversal of every pad
 _KIND = np.array({kind}, dtype=np.int64)  # per L: 0 quasi-static (unknown l, ldot = 0), 1 dynamic (unknown ldot)
 _DYN = np.array({dyn}, dtype=np.int64)  # index into L of the i-th state y[2 N + i]
+_PRESSED = np.ones(max(_NPAD, 1), dtype=np.int64)  # engagement of every pad in bilateral contact
 '''
 
 _DECORATOR = '@njit(cache=True, error_model="numpy")'
@@ -262,10 +272,23 @@ _DECORATOR = '@njit(cache=True, error_model="numpy")'
 _TEMPLATE = r'''
 
 @njit(cache=True, error_model="numpy")
+def pad_balance(y, l, dl, p, out):
+    """G_j and dG_j/dz_j of every pad unknown with every pad pressed (bilateral contact)."""
+    pad_balance_e(y, l, dl, p, _PRESSED, out)
+
+
+@njit(cache=True, error_model="numpy")
 def solve_pads(y, l, dl, p, ztol, g):
+    """solve_pads_e with every pad pressed (bilateral contact)."""
+    return solve_pads_e(y, l, dl, p, ztol, g, _PRESSED)
+
+
+@njit(cache=True, error_model="numpy")
+def solve_pads_e(y, l, dl, p, ztol, g, eng):
     """Newton iterations for G = 0 per pad, in place from the current l, dl (warm start).
 
     Quasi-static pads: unknown l_j (ldot_j = 0); dynamic pads: l_j = y[2N + i] and unknown ldot_j.
+    eng: per pad 1 pressed, 0 lifted off (its balance without the friction force: a lifted pad relaxes).
     Converged when every step is below 1e-13 |z_j| + ztol_j (ztol: the rounding level of G_j / dG_j).
     """
     for i in range(_NDYN):
@@ -273,12 +296,12 @@ def solve_pads(y, l, dl, p, ztol, g):
     if _M == 0:
         return True
     for _ in range(40):
-        pad_balance(y, l, dl, p, g)
+        pad_balance_e(y, l, dl, p, eng, g)
         done = True
         for j in range(_M):
             den = g[_M + j]
             if den == 0.0 or not abs(g[j]) < 1e300 * abs(den):  # (python's error model: no division by 0)
-                return _solve_pads_bracketed(y, l, dl, p, ztol, g)
+                return _solve_pads_bracketed(y, l, dl, p, ztol, g, eng)
             d = g[j] / den
             if _KIND[j] == 0:
                 l[j] -= d
@@ -290,22 +313,22 @@ def solve_pads(y, l, dl, p, ztol, g):
                 done = False
         if done:
             return True
-    return _solve_pads_bracketed(y, l, dl, p, ztol, g)
+    return _solve_pads_bracketed(y, l, dl, p, ztol, g, eng)
 
 
 @njit(cache=True, error_model="numpy")
-def _pad_value(y, l, dl, p, g, j, z):
+def _pad_value(y, l, dl, p, g, j, z, eng):
     """G_j and dG_j/dz_j with pad j's unknown set to z (the other pads' entries are not used)."""
     if _KIND[j] == 0:
         l[j] = z
     else:
         dl[j] = z
-    pad_balance(y, l, dl, p, g)
+    pad_balance_e(y, l, dl, p, eng, g)
     return g[j], g[_M + j]
 
 
 @njit(cache=True, error_model="numpy")
-def _solve_pads_bracketed(y, l, dl, p, ztol, g):
+def _solve_pads_bracketed(y, l, dl, p, ztol, g, eng):
     """The fallback of solve_pads when Newton from the warm start fails: per pad, a sign change of G_j is
     bracketed by steps doubling away from 0 (the silent motion's value) in the descent direction, then the
     root is found by Newton steps kept inside the bracket (bisection otherwise).  Needed where G_j is nearly
@@ -314,7 +337,7 @@ def _solve_pads_bracketed(y, l, dl, p, ztol, g):
     """
     for j in range(_M):
         a = 0.0
-        ga, da = _pad_value(y, l, dl, p, g, j, a)
+        ga, da = _pad_value(y, l, dl, p, g, j, a, eng)
         if not abs(ga) < 1e300:
             return False
         if ga == 0.0:
@@ -325,7 +348,7 @@ def _solve_pads_bracketed(y, l, dl, p, ztol, g):
         b, gb = a, ga
         for _ in range(400):
             b = a + sgn * h
-            gb, db = _pad_value(y, l, dl, p, g, j, b)
+            gb, db = _pad_value(y, l, dl, p, g, j, b, eng)
             if not abs(gb) < 1e300:
                 return False
             if (gb > 0.0) != (ga > 0.0) or gb == 0.0:
@@ -352,7 +375,7 @@ def _solve_pads_bracketed(y, l, dl, p, ztol, g):
                 ok = True
                 break
             z = zn
-            gz, dz = _pad_value(y, l, dl, p, g, j, z)
+            gz, dz = _pad_value(y, l, dl, p, g, j, z, eng)
             if not abs(gz) < 1e300:
                 return False
             if gz == 0.0:
@@ -368,7 +391,7 @@ def _solve_pads_bracketed(y, l, dl, p, ztol, g):
             l[j] = z
         else:
             dl[j] = z
-    pad_balance(y, l, dl, p, g)
+    pad_balance_e(y, l, dl, p, eng, g)
     return True
 
 
@@ -390,7 +413,7 @@ def rhs_u(y, l, dl, p, ztol, g, mw, eng, D, out):
 
     f = f0 + sum_j chi_j D_j (the generated ``release``); D: scratch of NPAD * N entries.
     """
-    ok = solve_pads(y, l, dl, p, ztol, g)
+    ok = solve_pads_e(y, l, dl, p, ztol, g, eng)
     mass_force(y, l, dl, p, mw)
     off = False
     for j in range(_NPAD):
@@ -489,10 +512,11 @@ def dense_eval(F, y_old, x, out):
 
 
 @njit(cache=True, error_model="numpy")
-def post_process(Y, count, l, dl, p, ztol, L_out, dL_out, C_out, E_out):
+def post_process(Y, count, l, dl, p, ztol, ENG, L_out, dL_out, C_out, E_out):
     """Pad unknowns, contact quantities and energy terms at the first ``count`` rows of Y (in place).
 
-    l, dl: start values (the silent motion's), updated as warm starts from sample to sample.
+    l, dl: start values (the silent motion's), updated as warm starts from sample to sample; ENG[i]: the
+    pads' engagement at row i (1 pressed, 0 lifted off).
     """
     g = np.empty(2 * _M + 1)
     cb = np.empty(7 * _NPAD)
@@ -504,7 +528,7 @@ def post_process(Y, count, l, dl, p, ztol, L_out, dL_out, C_out, E_out):
             if not abs(y[j]) < 1e300:
                 finite = False
         if finite:
-            finite = solve_pads(y, l, dl, p, ztol, g)
+            finite = solve_pads_e(y, l, dl, p, ztol, g, ENG[i])
         if not finite:
             L_out[i, :] = math.nan
             dL_out[i, :] = math.nan
@@ -544,7 +568,7 @@ def _error_norm(K, E5, E3, h, scale):
 def _event_at(k, x, F, y, l, dl, p, ztol, vr0, g, cb, ev, yint, eng):
     """Event function k at normalized time x of the step (pad unknowns solved from l, dl, updated)."""
     dense_eval(F, y, x, yint)
-    solve_pads(yint, l, dl, p, ztol, g)
+    solve_pads_e(yint, l, dl, p, ztol, g, eng)
     event_values_u(yint, l, dl, p, vr0, cb, eng, ev)
     return ev[k]
 
@@ -756,7 +780,7 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
                     dLs[sub, :] = dlsave
                 else:
                     dense_eval(F, y, sub / NSUB, yint)
-                    solve_pads(yint, lint, dlint, p, ztol, g)
+                    solve_pads_e(yint, lint, dlint, p, ztol, g, eng)
                     event_values_u(yint, lint, dlint, p, vr0, cb, eng, ev_new)
                     Ls[sub, :] = lint
                     dLs[sub, :] = dlint
@@ -909,8 +933,9 @@ def kernel_source(spec: Any) -> str:
     ll, dl, pp = ("l_", eq.L), ("dl_", eq.dL), ("p_", eq.params)
     args = (y, ll, dl, pp)
     specs = [
-        FunctionSpec("pad_balance", args, ex["pad_balance"],
-                     "G_j, then dG_j/dz_j (z_j = l_j quasi-static, ldot_j dynamic), eqs. (33)-(34) generalized."),
+        FunctionSpec("pad_balance_e", (y, ll, dl, pp, ("e_", ex["chi"])), ex["pad_balance"],
+                     "G_j, then dG_j/dz_j (z_j = l_j quasi-static, ldot_j dynamic), eqs. (33)-(34) generalized; "
+                     "e: per pad 1 pressed, 0 lifted off (no friction on the pad)."),
         FunctionSpec("mass_force", args, ex["mass_force"],
                      "M = dR/dQddot (n x n, row-major), then f = R(Qddot = 0): M Qddot + f = 0 (eq. 44 generalized)."),
         FunctionSpec("contact", args, ex["contact"],

@@ -259,6 +259,7 @@ def build_equations(spec: Any, backend: Backend = "symengine", *, kronecker: boo
             normal_dof=Q[_name("w", pad.name)] if normal else None, k_c=val(pad.k_c) if normal else None,
             d_c=val(pad.d_c) if normal else None, u_m=u_m, compliance=val.compliance(pad.k_ip) if quasi else None,
             engaged=engagement.get(pad.name) if engagement else None,
+            damping_t=val(pad.d_ip) if quasi else None,
         )  # fmt: skip
         if normal:
             n = _name("w", pad.name)

@@ -23,9 +23,13 @@ disk (``s = +1`` upper face, ``s = -1`` lower face, eqs. 17-18).
   ``delta = s (w - h)``.
 * Contact force on the disk ``f_p = s F_n z3 + mu F_n t_p`` (eqs. 27-28, 31-32).
 * Tangential balance of a massless pad (eqs. 33-34) as the residual
-  ``g = (l - u_m) + c_ip (e_t . f_p + mu* N0)`` with the compliance
-  ``c_ip = 1/k_ip`` (0 = rigid) and the preload friction ``mu* = mu(Omega r)``
-  at the nominal sliding speed, so that ``l`` is measured from the silent motion.
+  ``g = (l - u_m) + c_ip (e_t . f_p + mu* N0 + d_ip (ldot - u_mdot))`` with the
+  compliance ``c_ip = 1/k_ip`` (0 = rigid), the preload friction
+  ``mu* = mu(Omega r)`` at the nominal sliding speed, so that ``l`` is measured
+  from the silent motion, and an optional tangential damper ``d_ip`` in parallel
+  with the spring (not in the paper; 0 there).  The damper makes ``dg/dldot >=
+  c_ip d_ip > 0`` for any normal force, so the pad's rate stays determined down
+  to and through lift-off (``docs/simulation.md``, unilateral contact).
 """
 
 from __future__ import annotations
@@ -71,8 +75,9 @@ class PadContact:
         Force of the pad's normal support on the pad (``F_s``; equals the
         contact force's ``z0`` component for a massless normal direction).
     g : expression or None
-        Residual of the quasi-static tangential balance (eqs. 33-34), for a
-        massless pad with a finite tangential stiffness.
+        Residual of the tangential balance (eqs. 33-34, plus the damper
+        ``d_ip`` when given), for a massless pad with a finite tangential
+        stiffness.
     mu_star : expression
         Friction coefficient at the nominal sliding speed ``Omega r`` (preload).
     """
@@ -131,6 +136,7 @@ def pad_contact(
     u_m: Any = None,
     compliance: Any = None,
     engaged: Any = None,
+    damping_t: Any = None,
 ) -> PadContact:
     """Build the contact quantities of one pad.
 
@@ -172,6 +178,9 @@ def pad_contact(
     engaged : expression, optional
         Factor of the contact force ``f_p`` (a symbol ``chi`` for unilateral
         contact: 1 pressed, 0 lifted off); ``None`` (default) is 1.
+    damping_t : expression, optional
+        Tangential damping ``d_ip`` of a massless pad, in parallel with its
+        spring (enters ``g``; ``None`` or 0: the paper's pad).
 
     Returns
     -------
@@ -204,7 +213,10 @@ def pad_contact(
         F_s = f_p[2]  # massless: the support carries the contact force
     g = None
     if compliance is not None:
-        g = (l - (u_m if u_m is not None else 0)) + compliance * (f_t + mu_star * N0)  # eqs. (33)-(34)
+        rel = l - (u_m if u_m is not None else 0)
+        g = rel + compliance * (f_t + mu_star * N0)  # eqs. (33)-(34)
+        if damping_t is not None and damping_t != 0:
+            g = g + compliance * damping_t * rate(rel)  # the tangential damper (not in the paper)
     return PadContact(p=p, h=h, hdot=hdot, v_r=v_r, speed=speed, t_p=t_p, mu=mu, F_n=F_n, f_p=f_p,
                       moment=tilde(sm, p) * f_p, f_t=f_t, support_normal=F_s, g=g, mu_star=mu_star)
 

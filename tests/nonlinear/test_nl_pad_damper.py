@@ -1,0 +1,87 @@
+"""Limit cycles of pads with a tangential damper (``d_ip``): the pads' true rates kept, through lift-off.
+
+``damped_pads`` gives the paper-fig3 pads (``mu = 0.5``, ``k_ip = 1e6``) a damper ``d_ip = 10 N s/m``; their
+rates are then states of the explicit equations, determined at every normal force.  Two independent routes
+compute the same branch of the same model:
+
+* shooting with the compiled integrator and pseudo-arclength continuation (``squeal_branch``), which locates
+  the contact loss as the ``GR`` point where the orbit's smallest ``F_n`` reaches 0;
+* harmonic balance on the implicit equations with the exact generated Jacobian (``harmonic_branch``).
+
+They must agree on the Hopf point and on the contact loss (measured 2026-11-27: 127.0314249 and 127.0314234
+rad/s, 1.2e-8 relative).  With ``contact="unilateral"`` the shooting branch continues through lift-off; an orbit
+past it reproduces itself in a simulation of the integrator's own event-driven unilateral contact.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from brakesqueal.analysis.maps import Axis
+from brakesqueal.model.options import damped_pads, resolve_space
+from brakesqueal.nonlinear.harmonic import harmonic_branch
+from brakesqueal.nonlinear.models import squeal_branch
+from brakesqueal.simulation import simulate
+
+from _disk_energy import disk_work
+
+SETS = ["mu1=0.5", "mu2=0.5", "k_ip=1e6"]
+AXIS = Axis("Omega", 30.0, 140.0)
+
+
+@pytest.fixture(scope="module")
+def space():
+    return damped_pads(resolve_space(preset="paper-fig3", sets=SETS), 10.0)
+
+
+@pytest.fixture(scope="module")
+def unilateral(space):
+    return squeal_branch(space, AXIS, max_points=30, contact="unilateral")
+
+
+def test_shooting_and_harmonic_balance_agree_on_the_contact_loss(space, unilateral):
+    hb = harmonic_branch(space, AXIS, max_points=60)
+    assert hb.status == "contact_loss", hb.message
+    assert unilateral.hopf.branch_start is not None
+    assert abs(hb.hopf.hopf.p0 - unilateral.hopf.branch_start.p0) < 1e-9 * hb.hopf.hopf.p0
+    assert unilateral.contact_loss is not None and hb.contact_loss is not None
+    assert abs(unilateral.contact_loss - hb.contact_loss) < 1e-6 * hb.contact_loss, (unilateral.contact_loss,
+                                                                                     hb.contact_loss)
+    assert unilateral.hopf.branch_start.criticality == "supercritical"
+
+
+def test_the_unilateral_branch_continues_past_lift_off_and_an_orbit_reproduces_itself(space, unilateral):
+    ds = unilateral.data
+    p = ds["p"].values
+    assert unilateral.contact_loss is not None and p.max() > unilateral.contact_loss + 1.0
+    i = int(np.argmax(p))
+    assert np.all(ds["duty_cycle"].values[i] < 0.99)  # both pads lift off for part of the period
+    orbit = unilateral.branch.orbits[i]
+    assert orbit.events  # the orbit's own lift-off and re-contact events
+    params = space.resolve({"Omega": float(p[i])})
+    tr = simulate(None, params, 5 * orbit.period, x0=orbit.x[0], rtol=1e-11, events="continue",
+                  contact="unilateral", sample_rate=8 / orbit.period)
+    assert tr.status == "finished", tr.message
+    for pad in ("1", "2"):  # one lift-off and one re-contact per period and pad
+        assert len(tr.event_times[f"contact-loss-pad-{pad}"]) == len(tr.event_times[f"re-contact-pad-{pad}"]) == 5
+    y_end = tr.y[-1]
+    scale = np.abs(orbit.x).max(axis=0)
+    assert np.all(np.abs(y_end - orbit.x[0]) < 1e-5 * scale + 1e-12), (y_end, orbit.x[0])
+
+
+def test_energy_balance_over_one_period_past_lift_off(space, unilateral):
+    """Over one period of the orbit past lift-off the works of the supports, the support dampers and the pads'
+    contact forces on the disk sum to zero (the disk's T - Omega L_z0 returns; kinematics and forces written in
+    ``_disk_energy.py`` from the trajectory's outputs, the damped pads' deformations l included)."""
+    p = unilateral.data["p"].values
+    i = int(np.argmax(p))
+    orbit = unilateral.branch.orbits[i]
+    params = space.resolve({"Omega": float(p[i])})
+    N = 20000
+    tr = simulate(None, params, orbit.period, x0=orbit.x[0], rtol=1e-12, events="continue", contact="unilateral",
+                  sample_rate=N / orbit.period * (1 + 1e-12))
+    assert tr.t.size == N + 1 and tr.engaged is not None and not tr.engaged.all()  # the pads lift off
+    work = disk_work(params, tr)
+    assert work["contact"] > 0 and work["damper"] < 0, work
+    assert abs(sum(work.values())) < 1e-5 * work["contact"], work
