@@ -73,8 +73,11 @@ def test_damped_pads_names_its_option_and_range(bad: Any) -> None:
 
 def test_damped_pads_changes_only_massless_pads_with_a_finite_spring() -> None:
     space = resolve_space(preset="paper-fig3", sets=SETS)
-    spec = damped_pads(space, 3.0).resolve({}).model
-    assert [p.d_ip for p in spec.pads] == [3.0, 3.0] and spec.name.endswith("+damped-pads")
+    damped = damped_pads(space, 3.0)
+    spec = damped.resolve({}).model
+    # one parameter for every pad, fixed at the value given and settable: one compiled model for every damping
+    assert [p.d_ip for p in spec.pads] == ["d_ip", "d_ip"] and spec.name.endswith("+damped-pads")
+    assert damped.resolve({})["d_ip"] == 3.0 and damped.resolve({"d_ip": 0.5})["d_ip"] == 0.5
     assert simulation_model(spec).pad_kinds == ("dynamic", "dynamic")
     rigid = resolve_space(preset="minimal-model")  # k_ip = inf: nothing to damp
     assert damped_pads(rigid, 3.0) is rigid
@@ -181,3 +184,24 @@ def test_the_command_line_option(capsys: Any) -> None:
     out = json.loads(capsys.readouterr().out)
     assert out["status"] == "finished" and out["model"] == "paper+damped-pads"
     assert all(0.5 < v < 0.99 for v in out["duty_cycle"].values())  # both pads lift off and come back
+
+
+def test_hopf_with_a_damper_is_the_damped_models(capsys: Any) -> None:
+    """`hopf --pad-damping D` analyses the damped model: its first crossing is where the damped model's leading
+    eigenvalue crosses (bracketed here by its linearization), not the undamped model's."""
+    import json
+
+    from brakesqueal.cli import main
+
+    sets = ["--preset", "paper-fig3", "--set", "k_ip=1e6", "--set", "mu1=0.5", "--set", "mu2=0.5"]
+    assert main(["hopf", *sets, "--along", "Omega=30:100", "--pad-damping", "10", "--format", "json"]) == 0
+    h = json.loads(capsys.readouterr().out)["crossings"][0]["hopf"]
+    assert main(["hopf", *sets, "--along", "Omega=30:100", "--format", "json"]) == 0
+    h0 = json.loads(capsys.readouterr().out)["crossings"][0]["hopf"]
+    assert abs(h["p0"] - h0["p0"]) > 0.5  # the damper of 10 N s/m moves the onset (63.84 against 64.81 rad/s)
+    space = damped_pads(resolve_space(preset="paper-fig3", sets=SETS), 10.0)
+    sim = simulation_model(space.resolve({}).model)
+    lead = [np.linalg.eigvals(sim.linear_matrix(space.resolve({"Omega": w}))[0]).real.max()
+            for w in (h["p0"] - 1e-3, h["p0"] + 1e-3)]
+    assert lead[0] < 0 < lead[1], lead
+    assert h["criticality"] == "supercritical"

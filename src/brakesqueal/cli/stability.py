@@ -203,7 +203,7 @@ def _hopf_text(points: list) -> str:  # type: ignore[type-arg]
 def hopf(
     along: Annotated[str, typer.Option("--along", help="NAME=START:STOP[:log] path to search.")] = "Omega=1:1e5:log",
     model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
-    fmt: FormatOpt = OutFormat.text,
+    fmt: FormatOpt = OutFormat.text, pad_damping: PadDampingOpt = None,
 ) -> None:
     """Hopf criticality at every stability crossing on a path: l1, sub/supercritical, predicted cycle amplitude."""
     from ..analysis.crossings import crossings as _crossings
@@ -211,7 +211,7 @@ def hopf(
     from ..nonlinear.models import hopf_points
 
     axis = parse_axis(along, with_num=False)
-    space = space_from(model, preset, params, set_)
+    space = pads_option(space_from(model, preset, params, set_), None, None, pad_damping)
     r = _crossings(space, axis)
     pts = hopf_points(space, axis, result=r)
     if fmt == OutFormat.json:

@@ -230,9 +230,11 @@ def damped_pads(space: Any, d_ip: float) -> Any:
     Returns
     -------
     ParameterSpace
-        The same preset and overrides on the modified model (named ``<model>+damped-pads``); ``space`` itself
-        when no pad needs it (pads that are rigid tangentially at ``space``'s values, have their own
-        tangential DOF or a damper).
+        The same preset and overrides on the modified model (named ``<model>+damped-pads``), whose pads share
+        the new parameter ``d_ip`` (``d_ip_pads`` if that name is taken), fixed at ``d_ip`` in every preset and
+        settable like any other, so that one compiled model serves every damping; ``space`` itself when no
+        pad needs it (pads that are rigid tangentially at ``space``'s values, have their own tangential DOF
+        or a damper).
 
     Raises
     ------
@@ -244,15 +246,24 @@ def damped_pads(space: Any, d_ip: float) -> Any:
     value = _in_range("pad_damping", d_ip, MAX_PAD_DAMPING, "N s/m")
     params = space.resolve({})
     spec = params.model
+    taken = set(spec.parameters) | set(space.preset.all_names())
+    name = next((n for n in ("d_ip", "d_ip_pads") if n not in taken), None)
     pads, changed = [], False
     for pad in spec.pads:
         massless = "tangential" not in pad.dofs
         finite = math.isfinite(float(params[pad.k_ip]) if isinstance(pad.k_ip, str) else float(pad.k_ip))
         if massless and finite and not isinstance(pad.d_ip, str) and pad.d_ip == 0.0:
-            pad = replace(pad, d_ip=value)
+            pad = replace(pad, d_ip=name if name else value)
             changed = True
         pads.append(pad)
     if not changed:
         return space
-    new = replace(spec, name=f"{spec.name}+damped-pads", pads=tuple(pads))
-    return type(space)(space.preset.bind(new), dict(space.values))
+    if name is None:  # both names taken: the value itself (a new compiled model per value)
+        new = replace(spec, name=f"{spec.name}+damped-pads", pads=tuple(pads))
+        return type(space)(space.preset.bind(new), dict(space.values))
+    # a parameter (fixed in every preset): one compiled model serves every damping, settable by --set NAME=...
+    presets = tuple(replace(pr, fixed={**pr.fixed, name: value}, model=None) for pr in spec.presets)
+    new = replace(spec, name=f"{spec.name}+damped-pads", pads=tuple(pads), parameters={**spec.parameters, name: value},
+                  presets=presets)
+    preset = replace(space.preset, fixed={**space.preset.fixed, name: value}, model=None).bind(new)
+    return type(space)(preset, dict(space.values))

@@ -351,7 +351,9 @@ def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = 
                 simulated = first_lyapunov(system, y0, h.p0, refine=True, omega=h.omega0)
                 if soft:
                     note = (f"the simulation and limit-cycle branches use quasi-static pads (ldot := 0; exact only "
-                            f"to first order): l1 = {simulated.l1:.6g} ({simulated.criticality}) there")
+                            f"to first order): l1 = {simulated.l1:.6g} ({simulated.criticality}) there; the pads' "
+                            "rates are kept by cycles --exact-pads (bilateral), --pad-damping D (through lift-off; "
+                            "a damper d_ip) or --pad-slope S")
             except (BrakesquealError, np.linalg.LinAlgError) as exc:
                 note = f"no normal form of the simulated equations: {exc}"
             if simulated is not None and simulated.criticality != h.criticality:
