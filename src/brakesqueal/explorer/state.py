@@ -697,4 +697,7 @@ def cycles_view(space: Any, along: str, rng: SliderRange) -> CyclesView:
                    if s.squeal_range else "no squeal range")
         text = (f"limit cycles from the Hopf point at {along} = {s.onset:.6g} ({s.criticality}): {rng_txt}; "
                 + (f"a pad loses contact at {along} = {loss:.6g}" if loss is not None else "the pads stay in contact"))
+        if br.hopf.simulated is not None:  # soft massless Coulomb pads integrated quasi-statically
+            text += ("; quasi-static pads (ldot := 0, exact to first order): brakesqueal cycles --exact-pads or "
+                     "--pad-damping keep the pads' rates")
     return CyclesView(p, amp, stable, None if loss is None else float(loss), text)

@@ -6,9 +6,11 @@ once into numba source by the package's one printer
 (:func:`brakesqueal.codegen.printer.generate_module`, common subexpressions
 eliminated):
 
-* ``pad_balance(y, l, dl, p, out)`` — per pad unknown ``j``: ``G_j`` and its
+* ``pad_balance_e(y, l, dl, p, e, out)`` — per pad unknown ``j``: ``G_j`` and its
   derivative with respect to the pad's unknown (``l_j`` of a quasi-static pad,
-  ``ldot_j`` of a pad with rate-dependent friction);
+  ``ldot_j`` of a dynamic pad), with the pads' engagement ``e`` (1 pressed, 0
+  lifted off: the balance without the friction force; the template's
+  ``pad_balance(y, l, dl, p, out)`` is every pad pressed);
 * ``mass_force(y, l, dl, p, out)`` — the mass matrix ``M(Q) = dR/dQddot``
   (``n x n``, row-major) and the forcing ``f = R(Qddot = 0)``, so that
   ``M Qddot + f = 0`` (``R`` is linear in ``Qddot``: checked when generating);
