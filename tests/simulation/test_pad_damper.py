@@ -205,3 +205,43 @@ def test_hopf_with_a_damper_is_the_damped_models(capsys: Any) -> None:
             for w in (h["p0"] - 1e-3, h["p0"] + 1e-3)]
     assert lead[0] < 0 < lead[1], lead
     assert h["criticality"] == "supercritical"
+
+
+def test_the_kernels_with_lifted_damped_pads_match_the_equations(damped_space: Any) -> None:
+    """rhs_u (any combination of lifted pads) = the symbolic equations with those pads' engagement 0, evaluated
+    independently: SymPy's lambdify of R and G, each pad's rate bracketed by SciPy's brentq (G_j is monotone in
+    ldot_j with a damper), the accelerations from R's mass matrix and forcing (random states)."""
+    from scipy.optimize import brentq
+
+    params = damped_space.resolve({"Omega": 120.0, "d_ip": 10.0})
+    spec = params.model
+    sim = simulation_model(spec)
+    k, st, p = sim.kernels, sim.silent(params), sim.parameter_vector(params)
+    chi = sp.symbols("chi1 chi2")
+    eq = build_equations(spec, "sympy", engagement={pad.name: c for pad, c in zip(spec.pads, chi)})
+    args = [*eq.Q, *eq.dQ, *eq.ddQ, *eq.L, *eq.dL, *eq.params, *chi]
+    R = sp.lambdify(args, list(eq.R), "numpy")
+    G = sp.lambdify(args, list(eq.G), "numpy")
+    rng = np.random.default_rng(7)
+    for _ in range(4):
+        y = st.y + np.concatenate([rng.uniform(-3e-3, 3e-3, 2), rng.uniform(-30, 30, 2), rng.uniform(-3e-4, 3e-4, 2)])
+        for eng in ([1, 1], [0, 1], [1, 0], [0, 0]):
+            out = np.empty(6)
+            l, dl = st.l.copy(), st.dl.copy()
+            k.rhs_u(y, l, dl, p, st.ztol, np.empty(5), np.empty(6), np.array(eng, dtype=np.int64), np.empty(5), out)
+
+            def g(j: int, v: float, dls: list[float]) -> float:
+                d = list(dls)
+                d[j] = v
+                return float(G(*y[:4], 0.0, 0.0, *y[4:6], *d, *p, *eng)[j])
+
+            rates = [0.0, 0.0]
+            for j in range(2):  # G_j depends on its own rate only
+                rates[j] = brentq(lambda v, j=j: g(j, v, rates), -1e4, 1e4, xtol=1e-14, rtol=1e-14)
+            f0 = np.array(R(*y[:4], 0.0, 0.0, *y[4:6], *rates, *p, *eng), dtype=float)
+            M = np.column_stack([np.array(R(*y[:4], *e, *y[4:6], *rates, *p, *eng), dtype=float) - f0
+                                 for e in ((1.0, 0.0), (0.0, 1.0))])
+            want = np.concatenate([y[2:4], np.linalg.solve(M, -f0), rates])
+            assert np.allclose(out, want, rtol=1e-8, atol=1e-9 * np.abs(want).max()), (eng, out, want)
+        # a lifted pad relaxes: its rate is -(l - l_r) k_ip / d_ip, not the pressed pad's
+        assert abs(out[4] - (-(y[4] + 0.5 * 3000.0 / 1e6) * 1e6 / 10.0)) < 1e-6 * abs(out[4])
