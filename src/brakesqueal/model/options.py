@@ -214,7 +214,10 @@ def damped_pads(space: Any, d_ip: float) -> Any:
 
     A massless pad with a finite tangential stiffness then balances ``k_ip (l - u_m) + d_ip (ldot - u_mdot) =
     -(f_t + mu* N0)`` (``brakesqueal.symbolic.contact``): its rate is a state whose balance has the slope
-    ``dG/dldot >= d_ip / k_ip > 0`` at every normal force, so the simulation and the limit-cycle branches keep
+    ``dG/dldot = (d_ip + df_t/dldot) / k_ip``, where ``df_t/dldot`` is the friction's monotone part (>= 0) plus a
+    coupling through the normal force of either sign and small size (the support damper acting on the contact
+    height: about ``mu d |tilt|``, 0.012 N s/m on paper-fig3 at 5 mrad), so the simulation and the limit-cycle
+    branches keep
     the pads' true tangential dynamics through lift-off and re-contact (a lifted pad relaxes with the time
     constant ``d_ip / k_ip``).  Without it the rate of such a pad is not determined near lift-off
     (``docs/simulation.md``, unilateral contact).  The damper changes the model: the linearization gains the

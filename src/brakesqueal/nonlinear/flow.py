@@ -266,7 +266,7 @@ class ScipyFlow:
         while True:
             msys = pw.modes[mode]
             trans = pw.transitions[mode]
-            rhs = _augmented_rhs(msys, p, n) if sens else (lambda _t, yy, _m=msys: _m.rhs(yy, p))
+            rhs = _rejecting(_augmented_rhs(msys, p, n) if sens else (lambda _t, yy, _m=msys: _m.rhs(yy, p)))
             evs = []
             dirs = [float(start_dirs.get(i, tr.direction)) for i, tr in enumerate(trans)]
             # a guard that is zero at the segment start (just after an event) would report a root there:
@@ -468,6 +468,21 @@ def _start_directions(pw: PiecewiseSystem, mode: int, x: np.ndarray, p: float, s
         if tr.direction == 0 and d != 0:
             out[j] = -float(np.sign(d))
     return out
+
+
+def _rejecting(rhs: Any) -> Any:
+    """``rhs`` returning NaN where the vector field cannot be evaluated (a ``ParameterError``, e.g. a pad
+    equation without a solution at a trial stage of a too large step): SciPy's step control then rejects the
+    step and retries a smaller one, and an accepted state that cannot be evaluated ends in a failed
+    integration (``FlowError``), never in a wrong number."""
+
+    def safe(t: float, y: np.ndarray) -> np.ndarray:
+        try:
+            return rhs(t, y)
+        except ParameterError:
+            return np.full(np.shape(y), np.nan)
+
+    return safe
 
 
 def _augmented_rhs(msys: SmoothSystem, p: float, n: int) -> Any:

@@ -27,9 +27,11 @@ disk (``s = +1`` upper face, ``s = -1`` lower face, eqs. 17-18).
   compliance ``c_ip = 1/k_ip`` (0 = rigid), the preload friction
   ``mu* = mu(Omega r)`` at the nominal sliding speed, so that ``l`` is measured
   from the silent motion, and an optional tangential damper ``d_ip`` in parallel
-  with the spring (not in the paper; 0 there).  The damper makes ``dg/dldot >=
-  c_ip d_ip > 0`` for any normal force, so the pad's rate stays determined down
-  to and through lift-off (``docs/simulation.md``, unilateral contact).
+  with the spring (not in the paper; 0 there).  The damper adds ``c_ip d_ip`` to
+  ``dg/dldot``, whose other terms shrink with the normal force (to the support
+  damper's share, of either sign, at lift-off), so the pad's rate stays
+  determined down to and through lift-off (``docs/simulation.md``, unilateral
+  contact).
 """
 
 from __future__ import annotations
