@@ -326,6 +326,11 @@ class Pad:
                                   None)
 
     @property
+    def tangentially_damped(self) -> bool:
+        """Whether the pad has a tangential damper (``d_ip`` a parameter name or a nonzero number)."""
+        return isinstance(self.d_ip, str) or self.d_ip != 0.0
+
+    @property
     def label(self) -> str:
         """``pad 'name'`` for messages."""
         return f"pad '{self.name}'"

@@ -256,7 +256,7 @@ def damped_pads(space: Any, d_ip: float) -> Any:
     for pad in spec.pads:
         massless = "tangential" not in pad.dofs
         finite = math.isfinite(float(params[pad.k_ip]) if isinstance(pad.k_ip, str) else float(pad.k_ip))
-        if massless and finite and not isinstance(pad.d_ip, str) and pad.d_ip == 0.0:
+        if massless and finite and not pad.tangentially_damped:
             pad = replace(pad, d_ip=name if name else value)
             changed = True
         pads.append(pad)

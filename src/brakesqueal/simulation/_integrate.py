@@ -252,6 +252,13 @@ class SimulationModel:
         except (BrakesquealError, np.linalg.LinAlgError):
             return None
 
+    def _engagement(self, engaged: Sequence[bool] | None) -> np.ndarray:
+        """Per pad 1 pressed, 0 lifted off (int64, the kernels' type); default every pad pressed."""
+        eng = np.ones(len(self.pads), dtype=np.int64) if engaged is None else np.asarray(engaged, dtype=np.int64)
+        if eng.shape != (len(self.pads),):
+            raise ParameterError(f"'engaged' must have one entry per pad ({len(self.pads)}); got {eng.size}")
+        return eng
+
     def contact_at(self, params: Any, y: Sequence[float], silent: SilentState | None = None,
                    engaged: Sequence[bool] | None = None) -> np.ndarray:
         """Contact quantities at an integrator state ``y`` (pad unknowns solved), shape ``(n_pads, 7)``.
@@ -265,7 +272,7 @@ class SimulationModel:
         yy = np.ascontiguousarray(y, dtype=float)
         l, dl = st.l.copy(), st.dl.copy()
         g = np.empty(2 * len(l) + 1)
-        eng = np.ones(len(self.pads), dtype=np.int64) if engaged is None else np.asarray(engaged, dtype=np.int64)
+        eng = self._engagement(engaged)
         if not self.kernels.solve_pads_e(yy, l, dl, p, st.ztol, g, eng):
             raise ParameterError("the pad equations cannot be solved at this state")
         cb = np.empty(7 * len(self.pads))
@@ -309,9 +316,7 @@ class SimulationModel:
         l, dl = st.l.copy(), st.dl.copy()
         g, mw = np.empty(2 * len(l) + 1), np.empty(n * n + n)
         ny = st.y.size
-        eng = np.ones(len(self.pads), dtype=np.int64) if engaged is None else np.asarray(engaged, dtype=np.int64)
-        if eng.shape != (len(self.pads),):
-            raise ParameterError(f"'engaged' must have one entry per pad ({len(self.pads)}); got {eng.size}")
+        eng = self._engagement(engaged)
         D = np.empty(len(self.pads) * n + 1)
 
         def f(y: np.ndarray) -> np.ndarray:

@@ -89,8 +89,7 @@ def pad_treatment(spec: Any) -> tuple[str, ...]:
         rigid = not isinstance(pad.k_ip, str) and math.isinf(pad.k_ip)
         if "tangential" in pad.dofs or rigid:
             continue
-        damped = isinstance(pad.d_ip, str) or pad.d_ip != 0.0
-        out.append("quasi-static" if pad.friction.law == "coulomb" and not damped else "dynamic")
+        out.append("quasi-static" if pad.friction.law == "coulomb" and not pad.tangentially_damped else "dynamic")
     return tuple(out)
 
 
@@ -242,11 +241,8 @@ def _energy(se: Any, eq: Any) -> list[Any]:
         elif not (not isinstance(pad.k_ip, str) and math.isinf(pad.k_ip)):
             # massless pad on its balance g = 0 (eqs. 33-34): k_ip (l - u_m)^2 / 2 = -(l - u_m)(f_t + mu* N0
             # + d_ip (ldot - u_mdot)) / 2, finite also for a rigid support given as k_ip = inf (compliance 0)
-            F = c.f_t + c.mu_star * N0
-            if isinstance(pad.d_ip, str) or pad.d_ip != 0.0:
-                j = list(eq.L).index(l)
-                u_dot = dQ[_state_name("uc", mount.name)] * ca if mount and "tangential" in mount.dofs else 0
-                F = F + val(pad.d_ip) * (eq.dL[j] - u_dot)
+            u_dot = dQ[_state_name("uc", mount.name)] * ca if mount and "tangential" in mount.dofs else 0
+            F = c.f_t + c.mu_star * N0 + val(pad.d_ip) * (eq.dL[list(eq.L).index(l)] - u_dot)  # d_ip = 0: no term
             V_pads += -half * (l - u_m) * F + c.mu_star * N0 * l
     return [T2, T1, T0, V_support, V_pads]
 
