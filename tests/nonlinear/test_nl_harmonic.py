@@ -234,4 +234,4 @@ def test_cli_exact_pads(capsys):
     out = capsys.readouterr().out
     assert "harmonic balance" in out and "Fn min 1" in out and out.count("yes") == 4
     assert main([*args, "--pad-slope", "1e-4"]) != 0
-    assert "--exact-pads" in capsys.readouterr().err
+    assert "--pads exact" in capsys.readouterr().err

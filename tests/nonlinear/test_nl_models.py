@@ -134,7 +134,7 @@ def test_squeal_branch_finds_contact_loss(tmp_path, capsys):
     # the command line
     out = tmp_path / "b.nc"
     assert main(["cycles", "--preset", "paper-fig3", "--set", "mu1=0.5", "--set", "mu2=0.5", "--along",
-                 "Omega=30:40", "--max-points", "25", "--format", "json", "--out", str(out)]) == 0
+                 "Omega=30:40", "--max-points", "25", "--format", "json", "--out", str(out), "--pads", "quasi-static"]) == 0
     d = json.loads(capsys.readouterr().out)
     assert d["contact_loss"] and d["hopf"]["hopf"]["criticality"] == "supercritical"
     import xarray as xr
@@ -163,7 +163,7 @@ def test_squeal_branch_finds_contact_loss(tmp_path, capsys):
         else:
             assert row["duty_cycle"] == [None, None]
     assert main(["cycles", "--preset", "paper-fig3", "--set", "mu1=0.5", "--set", "mu2=0.5", "--along",
-                 "Omega=30:40", "--max-points", "6"]) == 0
+                 "Omega=30:40", "--max-points", "6", "--pads", "quasi-static"]) == 0
     text = capsys.readouterr().out
     assert "squeal onset (linear): Omega = 35.740780" in text and "stable squeal" in text and "duty" in text
     assert main(["cycles", "--along", "Omega=30:40", "--contact", "sometimes"]) == 2

@@ -236,9 +236,16 @@ def cycles(
     pad_slope: PadSlopeOpt = None,
     stick_speed: StickSpeedOpt = None,
     pad_damping: PadDampingOpt = None,
-    exact_pads: Annotated[bool, typer.Option("--exact-pads", help="Harmonic balance on the implicit equations: the "
-                                             "massless Coulomb pads exact (tangential rates kept, no "
-                                             "regularisation); bilateral, to the located contact loss.")] = False,
+    pads: Annotated[str, typer.Option("--pads", help="auto: every pad's tangential rate kept, by shooting where "
+                                      "the simulated equations keep it, by harmonic balance where massless Coulomb "
+                                      "pads with a finite k_ip would be quasi-static (bilateral; with --contact "
+                                      "unilateral choose --pad-damping D or --pads quasi-static); exact: harmonic "
+                                      "balance; quasi-static: shooting with ldot := 0 for those pads (exact to "
+                                      "first order at the onset).")] = "auto",
+    exact_pads: Annotated[bool, typer.Option("--exact-pads", help="Same as --pads exact: harmonic balance on the "
+                                             "implicit equations, the massless Coulomb pads exact (tangential rates "
+                                             "kept, no regularisation); bilateral, to the located contact "
+                                             "loss.")] = False,
     harmonics: Annotated[int, typer.Option("--harmonics", min=1, max=200, help="With --exact-pads: initial number "
                                            "of harmonics (raised while the truncation error exceeds 1e-6).")] = 6,
     max_harmonics: Annotated[int, typer.Option("--max-harmonics", min=1, max=400, help="With --exact-pads: largest "
@@ -246,23 +253,29 @@ def cycles(
 ) -> None:
     """Limit cycles from the first Hopf point on a path: amplitude, frequency, stability, where a pad lifts off."""
     from ..analysis.maps import parse_axis
-    from ..nonlinear.models import squeal_branch
+    from ..nonlinear.models import PAD_TREATMENTS, cycle_route, squeal_branch
     from ..outputs import atomic_write, check_output
 
     axis = parse_axis(along, with_num=False)
     if contact not in ("bilateral", "unilateral"):
         raise ParameterError(f"The option '--contact' must be bilateral or unilateral; got {contact!r}")
+    if pads not in PAD_TREATMENTS:
+        raise ParameterError(f"The option '--pads' must be one of {', '.join(PAD_TREATMENTS)}; got {pads!r}")
     if exact_pads:
-        _cycles_exact_pads(axis, space_from(model, preset, params, set_), fmt=fmt, max_points=max_points,
-                           harmonics=harmonics, max_harmonics=max_harmonics, contact=contact, pad_slope=pad_slope,
+        if pads == "quasi-static":
+            raise ParameterError("The option '--exact-pads' cannot be combined with --pads quasi-static")
+        pads = "exact"
+    base = space_from(model, preset, params, set_)
+    space = pads_option(base, pad_slope, stick_speed, pad_damping)  # checked before anything is computed
+    if cycle_route(space, axis, contact=contact, pads=pads) == "harmonic balance":
+        _cycles_exact_pads(axis, base, fmt=fmt, max_points=max_points, harmonics=harmonics,
+                           max_harmonics=max_harmonics, contact=contact, pad_slope=pad_slope,
                            stick_speed=stick_speed, pad_damping=pad_damping, plot=plot, out=out)
         return
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     if out:
         check_output(out, what="--out", suffixes=(".nc",))
-    space = space_from(model, preset, params, set_)
-    space = pads_option(space, pad_slope, stick_speed, pad_damping)  # checked before anything is computed
     b = squeal_branch(space, axis, max_points=max_points, contact=contact)
     if out:
         ds = b.data.copy()
@@ -313,7 +326,7 @@ def _cycles_exact_pads(axis: Any, space: Any, *, fmt: OutFormat, max_points: int
     for flag, bad in (("--contact unilateral", contact != "bilateral"), ("--pad-slope", pad_slope is not None),
                       ("--stick-speed", stick_speed is not None)):
         if bad:
-            raise ParameterError(f"The option '--exact-pads' cannot be combined with {flag} (the exact pads are "
+            raise ParameterError(f"The option '--pads exact' cannot be combined with {flag} (the exact pads are "
                                  "bilateral and unregularised)")
     space = pads_option(space, None, None, pad_damping)  # a damper is part of the model: balanced exactly too
     if max_harmonics < harmonics:
@@ -338,6 +351,7 @@ def _cycles_exact_pads(axis: Any, space: Any, *, fmt: OutFormat, max_points: int
              f"{h.frequency0_hz:.6g} Hz (exact pads: tangential rates kept)",
              f"{len(b.points)} branch points by harmonic balance ({b.status}: {b.message})",
              f"stability: {b.stability}"]
+    lines += b.summary.text(rows=0).splitlines()
     head = (f"{axis.name:>12} {'f [Hz]':>10} {'tilt [rad]':>11} " + " ".join(f"{'Fn min ' + p:>10}" for p in b.pads)
             + f" {'slide min':>10} {'H':>3} {'trunc':>8} {'resid':>8}  stable")
     lines.append(head)

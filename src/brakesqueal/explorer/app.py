@@ -746,9 +746,10 @@ class Explorer:
             lifted = np.zeros(cv.p.size, dtype=bool)
             if cv.contact_loss is not None and cv.p.size:  # the branch starts at the Hopf point
                 lifted = np.abs(cv.p - cv.p[0]) > abs(cv.contact_loss - cv.p[0])
+            judged = cv.judged if cv.judged is not None else np.ones(cv.p.size, dtype=bool)
             self.src_cycles.data = {"p": cv.p, "a": cv.amplitude,
-                                    "color": ["#bbbbbb" if off else "#4c72b0" if st else "#dd8452"
-                                              for st, off in zip(cv.stable, lifted)]}
+                                    "color": ["#bbbbbb" if off or not ok else "#4c72b0" if st else "#dd8452"
+                                              for st, off, ok in zip(cv.stable, lifted, judged)]}
             self.span_loss.location = cv.contact_loss
             self.fig_cycles.xaxis.axis_label = _label(self.origin.space_of(state), state.along)
             self.cycles_text.object = html.escape(cv.summary)

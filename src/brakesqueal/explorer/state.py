@@ -662,7 +662,9 @@ class CyclesView:
     contact_loss : float or None
         Where a pad first loses contact along the branch.
     summary : str
-        One line: onset, criticality, squeal range, contact loss.
+        One line: onset, criticality, squeal range, contact loss, route.
+    judged : ndarray of bool or None
+        Whether each cycle has a stability verdict (``None``: all have one).
     """
 
     p: np.ndarray
@@ -670,10 +672,16 @@ class CyclesView:
     stable: np.ndarray
     contact_loss: float | None
     summary: str
+    judged: np.ndarray | None = None
 
 
 def cycles_view(space: Any, along: str, rng: SliderRange) -> CyclesView:
-    """Continue the limit cycles along the path (:func:`~brakesqueal.nonlinear.models.squeal_branch`).
+    """Continue the limit cycles along the path with the pads' true tangential dynamics.
+
+    The route is :func:`~brakesqueal.nonlinear.models.cycle_route`'s (bilateral): shooting
+    (:func:`~brakesqueal.nonlinear.models.squeal_branch`) where the simulated equations keep every pad's rate,
+    harmonic balance (:func:`~brakesqueal.nonlinear.harmonic.harmonic_branch`) where massless Coulomb pads
+    with a finite ``k_ip`` would be quasi-static.
 
     Raises
     ------
@@ -681,14 +689,22 @@ def cycles_view(space: Any, along: str, rng: SliderRange) -> CyclesView:
         No Hopf point with a cycle prediction on the path.
     """
     from ..analysis.maps import Axis
-    from ..nonlinear.models import squeal_branch
+    from ..nonlinear.models import cycle_route, squeal_branch
 
-    br: Any = squeal_branch(space, Axis(along, rng.low, rng.high, 2, rng.log))
+    axis = Axis(along, rng.low, rng.high, 2, rng.log)
+    harmonic = cycle_route(space, axis) == "harmonic balance"
+    if harmonic:
+        from ..nonlinear.harmonic import harmonic_branch
+
+        br: Any = harmonic_branch(space, axis)
+    else:
+        br = squeal_branch(space, axis)
     s = br.summary
     rows = list(s.table) if s is not None else []
     p = np.array([float(r["p"]) for r in rows])
     amp = np.array([float(r["tilt_amplitude"]) if r.get("tilt_amplitude") is not None else math.nan for r in rows])
     stable = np.array([bool(r.get("stable")) for r in rows], dtype=bool)
+    judged = np.array([r.get("stable") is not None for r in rows], dtype=bool)
     loss = br.contact_loss
     if s is None:
         text = f"limit cycles along {along}: no summary"
@@ -697,7 +713,6 @@ def cycles_view(space: Any, along: str, rng: SliderRange) -> CyclesView:
                    if s.squeal_range else "no squeal range")
         text = (f"limit cycles from the Hopf point at {along} = {s.onset:.6g} ({s.criticality}): {rng_txt}; "
                 + (f"a pad loses contact at {along} = {loss:.6g}" if loss is not None else "the pads stay in contact"))
-        if br.hopf.simulated is not None:  # soft massless Coulomb pads integrated quasi-statically
-            text += ("; quasi-static pads (ldot := 0, exact to first order): brakesqueal cycles --exact-pads or "
-                     "--pad-damping keep the pads' rates")
-    return CyclesView(p, amp, stable, None if loss is None else float(loss), text)
+        if harmonic:  # soft massless Coulomb pads: their rates kept exactly
+            text += "; exact pads (tangential rates kept): harmonic balance"
+    return CyclesView(p, amp, stable, None if loss is None else float(loss), text, judged)

@@ -70,6 +70,8 @@ class HarmonicPoint:
         Largest first-harmonic amplitude of the tilts ``q1``, ``q2`` [rad] (``None`` without them).
     F_n_min : tuple of float
         Per pad, the smallest normal force over the period [N].
+    F_n_max : tuple of float
+        Per pad, the largest normal force over the period [N].
     sliding_margin_min : float
         The smallest, over pads and the period, sliding velocity component along the silent motion's [m/s].
     residual : float
@@ -109,11 +111,12 @@ class HarmonicPoint:
     stable: bool | None = None
     trivial_exponent: float | None = None
     stability_from: str | None = None
+    F_n_max: tuple[float, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready fields (no coefficients)."""
         return {"p": self.p, "omega": self.omega, "frequency_hz": self.frequency_hz, "amplitude": self.amplitude,
-                "tilt_amplitude": self.tilt_amplitude, "F_n_min": list(self.F_n_min),
+                "tilt_amplitude": self.tilt_amplitude, "F_n_min": list(self.F_n_min), "F_n_max": list(self.F_n_max),
                 "sliding_margin_min": self.sliding_margin_min, "residual": self.residual,
                 "truncation_error": self.truncation_error, "harmonics": self.harmonics,
                 "stable": self.stable, "trivial_exponent": self.trivial_exponent,
@@ -188,8 +191,50 @@ class HarmonicBranch:
                          "l1_error": h.l1_error, "criticality": h.criticality, "side": h.side},
                 "status": self.status, "message": self.message, "contact_loss": self.contact_loss,
                 "sliding_reversal": self.sliding_reversal, "stability": self.stability,
-                "coords": list(self.coords), "pads": list(self.pads),
-                "points": [pt.to_dict() for pt in self.points]}
+                "coords": list(self.coords), "pads": list(self.pads), "folds": self.folds,
+                "summary": self.summary.to_dict(), "points": [pt.to_dict() for pt in self.points]}
+
+    @property
+    def folds(self) -> list[float]:
+        """Folds of cycles (``LPC``): where the branch turns back in the parameter.
+
+        Located to the step: the vertex of the parabola through the three branch points around each turn
+        (:func:`turning_points`); harmonic balance has no located fold test.
+        """
+        return turning_points([self.hopf.hopf.p0] + [pt.p for pt in self.points])
+
+    @property
+    def summary(self) -> Any:
+        """The engineer's summary (:class:`~.models.SquealSummary`) of the branch, as for shooting.
+
+        The squeal range spans the stable orbits with every pad pressed (the located contact-loss orbit
+        included); points without a stability verdict count as neither.  The hysteresis range, as for
+        shooting, lies between a subcritical Hopf point and the first fold (:attr:`folds`) where the unstable
+        cycles turn into stable ones, here only if the pads are pressed up to there.
+        """
+        from .models import SquealSummary
+
+        h = self.hopf.hopf
+        pts = self.points
+        fmax = max((max(pt.F_n_max) for pt in pts if pt.F_n_max), default=1.0)
+        valid = [min(pt.F_n_min) >= -1e-6 * fmax for pt in pts]
+        ok = [pt.p for pt, v in zip(pts, valid) if v and pt.stable]
+        rng = (min(ok), max(ok)) if ok else None
+        folds = self.folds
+        hyst = None
+        pv = np.array([h.p0] + [pt.p for pt in pts])
+        turns = [i for i in range(1, pv.size - 1) if (pv[i] - pv[i - 1]) * (pv[i + 1] - pv[i]) < 0]
+        if h.criticality == "subcritical" and turns:  # unstable cycles turning into stable ones (as shooting)
+            after = turns[0]  # the orbit after the first turn is points[turns[0]]
+            if after < len(pts) and pts[after].stable and all(valid[:after + 1]):
+                hyst = (min(folds[0], h.p0), max(folds[0], h.p0))
+        table = [{"p": pt.p, "frequency_hz": pt.frequency_hz,
+                  "tilt_amplitude": math.nan if pt.tilt_amplitude is None else pt.tilt_amplitude,
+                  "F_n_max": list(pt.F_n_max), "F_n_min": list(pt.F_n_min),
+                  "duty_cycle": [1.0 if v else None] * len(self.pads), "stable": pt.stable,
+                  "sliding_reversal": pt.sliding_margin_min <= 0} for pt, v in zip(pts, valid)]
+        return SquealSummary(self.parameter, float(h.p0), h.criticality, rng, hyst, folds, "bilateral",
+                             self.contact_loss, self.sliding_reversal, table, self.pads)
 
     @property
     def data(self) -> Any:
@@ -285,6 +330,34 @@ class HarmonicBranch:
         for a in axes:
             a.ticklabel_format(axis="y", useOffset=False)
         return fig
+
+
+def turning_points(p: Any) -> list[float]:
+    """Where a sequence of branch points turns back in the parameter: one value per turn.
+
+    At an interior extreme ``p[i]`` (``p[i] - p[i-1]`` and ``p[i+1] - p[i]`` of opposite signs) the vertex of the
+    parabola through ``p[i-1], p[i], p[i+1]`` against the point index, kept within one step of them (exact for
+    a branch whose parameter is quadratic in the index near the fold; otherwise accurate to the step).
+
+    Parameters
+    ----------
+    p : sequence of float
+        Parameter values along the branch, in continuation order.
+
+    Returns
+    -------
+    list of float
+    """
+    v = np.asarray(p, dtype=float)
+    out = []
+    for i in range(1, v.size - 1):
+        a, b = v[i] - v[i - 1], v[i + 1] - v[i]
+        if a * b < 0:
+            curv = v[i + 1] - 2 * v[i] + v[i - 1]
+            top = v[i] - (v[i + 1] - v[i - 1]) ** 2 / (8 * curv) if curv != 0 else v[i]
+            lo, hi = min(v[i - 1:i + 2]), max(v[i - 1:i + 2])
+            out.append(float(min(max(top, lo - (hi - lo)), hi + (hi - lo))))
+    return out
 
 
 def _basis(theta: np.ndarray, H: int, order: int) -> np.ndarray:
@@ -463,7 +536,8 @@ def _first_hopf(space: Any, axis: Any, use_cache: bool) -> Any:
 def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics: int = 60,
                     max_points: int = 40, harmonic_tol: float = 1e-6, tol: float = 1e-10,
                     ds: float = 0.05, ds_max: float = 0.2, start_offset: float = 1e-4,
-                    stability: bool = True, use_cache: bool = True) -> HarmonicBranch:
+                    stability: bool = True, use_cache: bool = True,
+                    stop_at_contact_loss: bool = True) -> HarmonicBranch:
     """Limit cycles of the implicit equations (exact massless Coulomb pads) by harmonic balance.
 
     Parameters
@@ -492,6 +566,10 @@ def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics:
         Compute Floquet exponents by Hill's method.
     use_cache : bool
         Use the on-disk code cache.
+    stop_at_contact_loss : bool
+        ``True`` (default): the branch ends at the located contact loss, where the bilateral equations stop
+        describing the brake.  ``False``: the contact loss is located and recorded, and the continuation goes on
+        along the bilateral equations (a study of the smooth model, as shooting's bilateral branches do).
 
     Returns
     -------
@@ -658,18 +736,26 @@ def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics:
                 pv, Pe = _locate(bal, cont, sim, coords, points[-1], P, y, y_new, i, fixed_p, adapt, stability)
                 found.append((abs(pv - points[-1].p), pv, nm, Pe))
             found.sort(key=lambda r: r[0])
-            _, pv, nm, Pe = found[0]
-            points.append(Pe)
-            if nm == "contact_loss":
-                loss = pv
-                message = (f"a pad loses contact at {axis.name} = {pv:.10g}: the bilateral equations do not "
-                           "hold beyond")
-            else:
-                rev = pv
-                message = (f"a pad's sliding velocity reverses at {axis.name} = {pv:.10g}: Coulomb friction "
-                           "would stick (end of the model's validity)")
-            status = nm
-            break
+            ended = False
+            for _, pv, nm, Pe in found:
+                points.append(Pe)
+                if nm == "contact_loss":
+                    loss = pv
+                    if not stop_at_contact_loss:
+                        continue  # recorded; the bilateral equations are continued
+                    message = (f"a pad loses contact at {axis.name} = {pv:.10g}: the bilateral equations do not "
+                               "hold beyond")
+                else:
+                    rev = pv
+                    message = (f"a pad's sliding velocity reverses at {axis.name} = {pv:.10g}: Coulomb friction "
+                               "would stick (end of the model's validity)")
+                status, ended = nm, True
+                break
+            if ended:
+                break
+            K_new = (y_new.size - 2) // bal.N
+            if K_new != bal.K:  # the location raised the harmonics: carry the new orbit over
+                y_new = resized(y_new, (K_new - 1) // 2, bal.H)
         if bal.H == max_harmonics and err > harmonic_tol:
             points.append(P)
             status = "truncation"
@@ -761,6 +847,7 @@ def _make_point(bal: _Balance, sim: Any, C: np.ndarray, omega: float, p: float, 
     vr0 = cm.contact_table(x0, pv)[:, 1:4]
     slide = np.einsum("pkt,pk->pt", ct[:, 1:4, :], vr0 / np.linalg.norm(vr0, axis=1)[:, None])
     fmin = tuple(float(v) for v in _pmin(ct[:, 0, :]))
+    fmax = tuple(float(-v) for v in _pmin(-ct[:, 0, :]))
     smin = float(np.min(_pmin(slide)))
     tilts = [i for i, c in enumerate(coords[:n]) if c in ("q1", "q2")]
     tilt = float(max(amp[i] for i in tilts)) if tilts else None
@@ -769,7 +856,7 @@ def _make_point(bal: _Balance, sim: Any, C: np.ndarray, omega: float, p: float, 
     if stability:
         fl, st, tr = _hill(bal, C, omega, p)
     return HarmonicPoint(float(p), float(omega), float(omega / (2 * np.pi)), ampd, tilt, fmin, smin, resid,
-                         float(err), H, C.copy(), fl, st, tr, None if st is None else "Hill's method")
+                         float(err), H, C.copy(), fl, st, tr, None if st is None else "Hill's method", fmax)
 
 
 def _pmin(v: np.ndarray) -> np.ndarray:

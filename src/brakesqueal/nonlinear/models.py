@@ -43,7 +43,11 @@ from .hopf import HopfResult, first_lyapunov
 from .system import PiecewiseSystem, SmoothSystem, Transition
 
 __all__ = ["model_system", "model_piecewise_system", "hopf_points", "HopfPoint",
-           "squeal_branch", "SquealBranch", "SquealSummary", "squeal_summary"]
+           "squeal_branch", "SquealBranch", "SquealSummary", "squeal_summary",
+           "PAD_TREATMENTS", "soft_quasi_static_pads", "cycle_route"]
+
+#: Pad treatments a limit-cycle computation can be asked for (:func:`cycle_route`).
+PAD_TREATMENTS: tuple[str, ...] = ("auto", "exact", "quasi-static")
 
 
 def model_system(space: Any, name: str, *, use_cache: bool = True) -> SmoothSystem:
@@ -280,15 +284,112 @@ class HopfPoint:
 
 def _soft_quasi_static(sim: Any, params: Any) -> bool:
     """Whether a pad the simulation treats quasi-statically has a finite tangential stiffness (not exact)."""
+    return bool(_soft_quasi_static_names(sim, params))
+
+
+def _soft_quasi_static_names(sim: Any, params: Any) -> list[str]:
     kinds = dict(zip(sim.unknown_pads, sim.pad_kinds))
+    out = []
     for pad in params.model.pads:
         if kinds.get(pad.name) != "quasi-static":
             continue
         k = pad.k_ip
         value = float(params[k]) if isinstance(k, str) else float(k)
         if not math.isinf(value):
-            return True
-    return False
+            out.append(pad.name)
+    return out
+
+
+def soft_quasi_static_pads(space: Any, axis: Any = None, *, use_cache: bool = True) -> tuple[str, ...]:
+    """Pads whose tangential rate the simulation drops (``ldot := 0``) although their ``k_ip`` is finite.
+
+    These are the massless pads with Coulomb friction, no tangential damper and a finite ``k_ip``
+    (anywhere on ``axis`` when ``k_ip`` is its parameter): for them the simulated equations, and the
+    limit-cycle branches shot from them, are exact only to first order at the onset (``docs/nonlinear.md``).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    axis : Axis, optional
+        A path; its two ends are checked as well as the preset's values.
+    use_cache : bool
+        Use the on-disk code cache.
+
+    Returns
+    -------
+    tuple of str
+        Pad names, in the model's order (empty when the simulated equations are exact).
+    """
+    from ..simulation import simulation_model
+
+    params = space.resolve({})
+    sim = simulation_model(params.model, use_cache=use_cache)
+    where = [params] + ([space.resolve({axis.name: float(v)}) for v in (axis.start, axis.stop)]
+                        if axis is not None else [])
+    soft = {pad for pv in where for pad in _soft_quasi_static_names(sim, pv)}
+    return tuple(p.name for p in params.model.pads if p.name in soft)
+
+
+def cycle_route(space: Any, axis: Any = None, *, contact: str = "bilateral", pads: str = "auto",
+                use_cache: bool = True) -> str:
+    """The route that computes limit cycles of a model with the pads' true tangential dynamics.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides (after any pad option such as
+        :func:`~brakesqueal.model.options.damped_pads`).
+    axis : Axis, optional
+        The continuation path (its ends decide for a path in ``k_ip``).
+    contact : {"bilateral", "unilateral"}
+        As in :func:`squeal_branch`.
+    pads : {"auto", "exact", "quasi-static"}
+        ``"auto"``: shooting (:func:`squeal_branch`) wherever the simulated equations keep every pad's rate
+        (rigid pads, pads with mass, rate-dependent laws, tangential dampers); harmonic balance on the implicit
+        equations (:func:`~.harmonic.harmonic_branch`, the massless Coulomb pads exact) where soft Coulomb pads
+        would be quasi-static (:func:`soft_quasi_static_pads`).  ``"exact"``: harmonic balance.
+        ``"quasi-static"``: shooting with ``ldot := 0`` for those pads (exact to first order at the onset).
+
+    Returns
+    -------
+    str
+        ``"shooting"`` or ``"harmonic balance"``.
+
+    Raises
+    ------
+    ParameterError
+        A bad ``pads`` or ``contact``; harmonic balance with ``contact="unilateral"`` (it is bilateral, to the
+        located contact loss); and ``"auto"`` with unilateral contact and soft massless Coulomb pads: their rate
+        has no defined value through lift-off (the rate balance folds before ``F_n = 0``), so the treatment is
+        the user's choice, named in the message.
+    """
+    from ..errors import ParameterError
+
+    if pads not in PAD_TREATMENTS:
+        raise ParameterError(f"The option 'pads' must be one of {', '.join(PAD_TREATMENTS)}; got {pads!r}",
+                             parameter="pads")
+    if contact not in ("bilateral", "unilateral"):
+        raise ParameterError(f"The option 'contact' must be bilateral or unilateral; got {contact!r}",
+                             parameter="contact")
+    if pads == "quasi-static":
+        return "shooting"
+    if pads == "exact":
+        if contact != "bilateral":
+            raise ParameterError("The option 'pads' = exact (harmonic balance) is bilateral, to the located contact "
+                                 "loss; through lift-off keep the pads' rates with a tangential damper (--pad-damping "
+                                 "D) or choose pads = quasi-static", parameter="pads")
+        return "harmonic balance"
+    soft = soft_quasi_static_pads(space, axis, use_cache=use_cache)
+    if not soft:
+        return "shooting"
+    if contact == "bilateral":
+        return "harmonic balance"
+    raise ParameterError(
+        f"unilateral contact needs a choice for the massless Coulomb pads {', '.join(soft)} (finite k_ip): their "
+        "tangential rate has no defined value through lift-off (the rate balance folds before F_n = 0). Choose "
+        "--pad-damping D (the rates kept, a damper beside each pad; converges as D -> 0, e.g. 10 N s/m) or "
+        "--pads quasi-static (ldot := 0, exact to first order at the onset)", parameter="pads")
 
 
 def _hopf_dict(h: HopfResult) -> dict[str, Any]:
@@ -355,8 +456,8 @@ def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = 
                 if soft:
                     note = (f"the simulation and limit-cycle branches use quasi-static pads (ldot := 0; exact only "
                             f"to first order): l1 = {simulated.l1:.6g} ({simulated.criticality}) there; the pads' "
-                            "rates are kept by cycles --exact-pads (bilateral), --pad-damping D (through lift-off; "
-                            "a damper d_ip) or --pad-slope S")
+                            "rates are kept by cycles (default --pads auto: harmonic balance, bilateral), "
+                            "--pad-damping D (through lift-off; a damper d_ip) or --pad-slope S")
             except (BrakesquealError, np.linalg.LinAlgError) as exc:
                 note = f"no normal form of the simulated equations: {exc}"
             if simulated is not None and simulated.criticality != h.criticality:
@@ -534,7 +635,8 @@ class SquealSummary:
     table : list of dict
         Per branch point: ``p``, ``frequency_hz``, ``tilt_amplitude`` [rad] (largest first-harmonic tilt),
         ``F_n_max``, ``F_n_min`` [N] per pad (acting force), ``duty_cycle`` per pad (``None`` where a
-        bilateral branch is not valid: a pad would pull), ``stable``, ``sliding_reversal``.
+        bilateral branch is not valid: a pad would pull), ``stable`` (``None``: no verdict, harmonic balance),
+        ``sliding_reversal``.
     pads : tuple of str
         Pad names.
     """
@@ -559,7 +661,7 @@ class SquealSummary:
                 "pads": list(self.pads), "table": self.table}
 
     def text(self, rows: int = 8) -> str:
-        """A short report: onset, squeal range, hysteresis, and a table of ``rows`` branch points."""
+        """A short report: onset, squeal range, hysteresis, and a table of ``rows`` branch points (none if 0)."""
         P = self.parameter
         lines = [f"squeal onset (linear): {P} = {self.onset:.10g}, {self.criticality} "
                  f"({'soft onset' if self.criticality == 'supercritical' else 'hard onset: jump to large squeal'})"]
@@ -581,6 +683,8 @@ class SquealSummary:
         if self.validity_end is not None:
             lines.append(f"model validity ends at {P} = {self.validity_end:.8g}: a pad's sliding velocity "
                          "reverses on the cycle (stick-slip is not modelled)")
+        if rows <= 0:
+            return "\n".join(lines) + "\n"
         pads = self.pads
         head = (f"{P:>12} {'f [Hz]':>10} {'tilt [rad]':>11} "
                 + " ".join(f"{'Fn max ' + q:>11} {'duty ' + q:>7}" for q in pads) + "  stable")
@@ -591,7 +695,7 @@ class SquealSummary:
             r = tab[i]
             cells = " ".join(f"{r['F_n_max'][j]:11.5g} " + (f"{r['duty_cycle'][j]:7.3f}" if r["duty_cycle"][j]
                                                                 is not None else f"{'-':>7}") for j in range(len(pads)))
-            flag = "yes" if r["stable"] else "no"
+            flag = "-" if r["stable"] is None else "yes" if r["stable"] else "no"
             if r["sliding_reversal"]:
                 flag += " (sliding reverses)"
             lines.append(f"{r['p']:12.8g} {r['frequency_hz']:10.6g} {r['tilt_amplitude']:11.4g} {cells}  {flag}")

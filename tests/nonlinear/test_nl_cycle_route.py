@@ -1,0 +1,147 @@
+"""Which route computes limit cycles (``cycle_route``, ``cycles --pads``): the pads' true rates by default.
+
+The rule is checked against the model data written out here (a massless pad, Coulomb law, no damper, finite
+``k_ip``), on every built-in model and preset; the CLI's default against the two routes run explicitly; the
+harmonic-balance branch's folds against shooting's located fold on the same (bilateral, exact) equations.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from brakesqueal.analysis.maps import Axis
+from brakesqueal.cli import main
+from brakesqueal.errors import ParameterError
+from brakesqueal.model import MODELS, get_model
+from brakesqueal.model.options import damped_pads, regularised_pads
+from brakesqueal.model.parameters import ParameterSpace
+from brakesqueal.nonlinear.harmonic import harmonic_branch, turning_points
+from brakesqueal.nonlinear.models import cycle_route, soft_quasi_static_pads, squeal_branch
+
+FIG3 = ["--preset", "paper-fig3", "--set", "mu1=0.5", "--set", "mu2=0.5", "--along", "Omega=30:40"]
+
+
+def _soft_by_hand(space: ParameterSpace) -> set[str]:
+    """Massless pads (no tangential DOF) with the Coulomb law, no tangential damper and a finite k_ip."""
+    params = space.resolve({})
+    out = set()
+    for pad in params.model.pads:
+        if "tangential" in pad.dofs or pad.friction.law != "coulomb":
+            continue
+        d = pad.d_ip
+        if d is not None and (float(params[d]) if isinstance(d, str) else float(d)) != 0.0:
+            continue
+        k = float(params[pad.k_ip]) if isinstance(pad.k_ip, str) else float(pad.k_ip)
+        if not math.isinf(k):
+            out.add(pad.name)
+    return out
+
+
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_the_route_follows_the_pads_of_every_built_in_model(name):
+    spec = get_model(name)
+    for preset in spec.presets:
+        space = ParameterSpace.from_preset(preset.name)
+        soft = _soft_by_hand(space)
+        assert set(soft_quasi_static_pads(space)) == soft, preset.name
+        assert cycle_route(space) == ("harmonic balance" if soft else "shooting")
+        assert cycle_route(space, pads="quasi-static") == "shooting"
+        assert cycle_route(space, pads="exact") == "harmonic balance"
+        if soft:
+            with pytest.raises(ParameterError, match="--pad-damping D.*--pads quasi-static"):
+                cycle_route(space, contact="unilateral")
+        else:
+            assert cycle_route(space, contact="unilateral") == "shooting"
+
+
+def test_pad_options_and_paths_decide_the_route():
+    fig3 = ParameterSpace.from_preset("paper-fig3")  # k_ip = 1e8: soft
+    assert soft_quasi_static_pads(fig3) == ("1", "2")
+    rigid = ParameterSpace.from_preset("paper-fig3", {"k_ip": math.inf})
+    assert soft_quasi_static_pads(rigid) == () and cycle_route(rigid, contact="unilateral") == "shooting"
+    # a path in k_ip makes rigid pads soft on it
+    assert cycle_route(rigid, Axis("k_ip", 1e5, 1e10, 2, True)) == "harmonic balance"
+    # a damper or a rising law keeps the rates in the simulated equations: shooting, also through lift-off
+    for kept in (damped_pads(fig3, 10.0), regularised_pads(fig3, 1e-4)):
+        assert soft_quasi_static_pads(kept) == ()
+        assert cycle_route(kept, contact="unilateral") == "shooting"
+    with pytest.raises(ParameterError, match="bilateral"):
+        cycle_route(fig3, contact="unilateral", pads="exact")
+    for bad in ({"pads": "exactly"}, {"contact": "sometimes"}):
+        with pytest.raises(ParameterError, match="pads|contact"):
+            cycle_route(fig3, **bad)
+
+
+def test_cycles_default_is_the_exact_pads_route(capsys):
+    assert main(["cycles", *FIG3, "--max-points", "6", "--format", "json"]) == 0
+    auto = json.loads(capsys.readouterr().out)
+    assert main(["cycles", *FIG3, "--max-points", "6", "--format", "json", "--exact-pads"]) == 0
+    exact = json.loads(capsys.readouterr().out)
+    assert auto == exact and auto["method"].startswith("harmonic balance")
+    assert main(["cycles", *FIG3, "--max-points", "6", "--format", "json", "--pads", "quasi-static"]) == 0
+    qs = json.loads(capsys.readouterr().out)
+    # the two routes: same exact Hopf point; the quasi-static pads' branch starts from its own normal form
+    assert qs["hopf"]["hopf"]["p0"] == pytest.approx(auto["hopf"]["p0"], rel=1e-9)
+    assert qs["hopf"]["hopf_simulated"]["l1"] != pytest.approx(auto["hopf"]["l1"], rel=1e-3)
+    # the summary has the same keys on both routes
+    assert set(auto["summary"]) == set(qs["summary"])
+    assert auto["summary"]["onset"] == auto["hopf"]["p0"] and auto["summary"]["contact"] == "bilateral"
+    assert auto["summary"]["contact_loss"] == auto["contact_loss"]
+    rows = auto["summary"]["table"]
+    assert [r["p"] for r in rows] == [p["p"] for p in auto["points"]]
+    for r, pt in zip(rows, auto["points"]):
+        assert r["F_n_min"] == pt["F_n_min"] and r["stable"] == pt["stable"]
+        assert all(hi >= lo for hi, lo in zip(r["F_n_max"], r["F_n_min"]))
+    # every orbit before the located contact loss is pressed all period: duty 1; stable ones span the range
+    assert all(r["duty_cycle"] == [1.0, 1.0] for r in rows)
+    st = [r["p"] for r in rows if r["stable"]]
+    assert auto["summary"]["squeal_range"] == [min(st), max(st)]
+    # the text says which route and prints the summary
+    assert main(["cycles", *FIG3, "--max-points", "6"]) == 0
+    text = capsys.readouterr().out
+    assert "harmonic balance" in text and "squeal onset (linear)" in text and "exact pads" in text
+
+
+def test_cycles_unilateral_asks_for_the_pads_treatment(capsys):
+    assert main(["cycles", *FIG3, "--contact", "unilateral"]) == 2
+    err = capsys.readouterr().err
+    assert "--pad-damping D" in err and "--pads quasi-static" in err and "Traceback" not in err
+    assert main(["cycles", *FIG3, "--pads", "sometimes"]) == 2
+    assert "--pads" in capsys.readouterr().err
+    assert main(["cycles", *FIG3, "--exact-pads", "--pads", "quasi-static"]) == 2
+    assert main(["cycles", *FIG3, "--pads", "exact", "--contact", "unilateral"]) == 2
+    assert "bilateral" in capsys.readouterr().err
+
+
+def test_turning_points_locate_a_parabolic_fold():
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        top, h, c = rng.uniform(-5, 5), rng.uniform(0.01, 1.0), rng.uniform(-0.5, 0.5)
+        s = np.arange(-4, 6) + c  # the vertex anywhere between two samples
+        p = top - h * s**2  # a fold (maximum in p) at `top`
+        assert turning_points(p) == [pytest.approx(top, rel=1e-12, abs=1e-12)]
+        assert turning_points(-p) == [pytest.approx(-top, rel=1e-12, abs=1e-12)]
+    assert turning_points(np.linspace(0, 1, 9)) == []
+    two = np.concatenate([np.linspace(0, 1, 5), np.linspace(0.9, 0.2, 5), np.linspace(0.25, 0.6, 4)])
+    assert len(turning_points(two)) == 2
+
+
+def test_harmonic_balance_folds_agree_with_shooting():
+    # six-dof: massive pads, so shooting integrates the exact equations too; the subcritical branch turns at a
+    # fold past the contact loss (the bilateral equations continued on both routes)
+    space = ParameterSpace.from_preset("six-dof")
+    axis = Axis("d_t", 0.1, 1e4, 2, True)
+    shot = squeal_branch(space, axis, max_points=200)
+    lpc = [sp.p for sp in shot.branch.special if sp.kind == "LPC"]
+    assert lpc, shot.branch.message
+    hb = harmonic_branch(space, axis, max_points=250, ds_max=1.0, stability=False, stop_at_contact_loss=False)
+    p0 = hb.hopf.hopf.p0
+    assert hb.contact_loss is not None and p0 < hb.contact_loss < lpc[0]  # recorded on the way
+    assert len(hb.folds) >= 1
+    # located to the step: within 1 % of the fold's distance from the onset (2e-5 relative measured)
+    assert abs(hb.folds[0] - lpc[0]) < 0.01 * abs(lpc[0] - p0), (hb.folds, lpc)
+    assert hb.summary.folds == hb.folds and hb.summary.criticality == "subcritical"
