@@ -145,3 +145,77 @@ def test_harmonic_balance_folds_agree_with_shooting():
     # located to the step: within 1 % of the fold's distance from the onset (2e-5 relative measured)
     assert abs(hb.folds[0] - lpc[0]) < 0.01 * abs(lpc[0] - p0), (hb.folds, lpc)
     assert hb.summary.folds == hb.folds and hb.summary.criticality == "subcritical"
+
+
+def _hill_complex_companion(J, n, m, H, omega):
+    """Reference: Hill's pencil in the complex exponential basis, companion form of size 2(n + m)(2H + 1)
+    (the formulation harmonic.py used before hill_pencil_eigen), written out here."""
+    import scipy.linalg as sl
+
+    N = n + m
+    Mt = J.shape[-1]
+    th = 2 * np.pi * np.arange(Mt) / Mt
+    JQ, JdQ, JddQ = J[:, :n], J[:, n:2 * n], J[:, 2 * n:3 * n]
+    JL, JdL = J[:, 3 * n:3 * n + m], J[:, 3 * n + m:]
+    B0 = np.concatenate([JQ, JL], axis=1)
+    B1 = np.concatenate([JdQ, JdL], axis=1)
+    B2 = np.concatenate([JddQ, np.zeros_like(JL)], axis=1)
+    ks = np.arange(-H, H + 1)
+    Ec = np.exp(1j * np.outer(th, ks))
+    Pc = Ec.conj().T / Mt
+    Dk = 1j * omega * ks
+
+    def op(B, w):
+        return np.einsum("at,ikt,tb,b->iakb", Pc, B.astype(complex), Ec, w).reshape(N * ks.size, N * ks.size)
+
+    one = np.ones(ks.size)
+    A0 = op(B0, one) + op(B1, Dk) + op(B2, Dk * Dk)
+    A1 = op(B1, one) + 2 * op(B2, Dk)
+    A2 = op(B2, one)
+    S = N * ks.size
+    L = np.block([[np.zeros((S, S)), np.eye(S)], [-A0, -A1]])
+    R = np.block([[np.eye(S), np.zeros((S, S))], [np.zeros((S, S)), A2]])
+    lam, V = sl.eig(L, R)
+    return lam, V[:S].reshape(N, ks.size, -1)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_hill_pencil_equals_the_complex_companion_form(seed):
+    from brakesqueal.nonlinear.harmonic import hill_pencil_eigen
+
+    rng = np.random.default_rng(seed)
+    n, m, H = int(rng.integers(1, 4)), int(rng.integers(0, 3)), int(rng.integers(2, 9))
+    omega = float(rng.uniform(0.5, 5.0))
+    Mt = 4 * H + 4
+    th = 2 * np.pi * np.arange(Mt) / Mt
+    N = n + m
+
+    def periodic(rows, cols, size):  # smooth periodic coefficients: a few harmonics
+        out = rng.normal(scale=size, size=(rows, cols, 1)) * np.ones(Mt)
+        for k in (1, 2):
+            out = out + 0.2 * size * (rng.normal(size=(rows, cols, 1)) * np.cos(k * th)
+                                      + rng.normal(size=(rows, cols, 1)) * np.sin(k * th))
+        return out
+
+    J = np.zeros((N, 3 * n + 2 * m, Mt))
+    J[:, :n] = periodic(N, n, 3.0)
+    J[:, n:2 * n] = periodic(N, n, 0.5)
+    J[:n, 2 * n:3 * n] = np.eye(n)[:, :, None] + 0.1 * periodic(n, n, 1.0)  # mass on the coordinates' rows
+    J[:, 3 * n:3 * n + m] = periodic(N, m, 1.0)
+    J[n:, 3 * n + m:] = 2.0 * np.eye(m)[:, :, None] + 0.1 * periodic(m, m, 1.0)  # the pads' rates
+    lam, V = hill_pencil_eigen(J, n, m, H, omega)
+    ref, Vref = _hill_complex_companion(J, n, m, H, omega)
+    fin, rfin = lam[np.isfinite(lam)], ref[np.isfinite(ref)]
+    big = 1e6 * omega * H
+    fin, rfin = fin[np.abs(fin) < big], rfin[np.abs(rfin) < big]
+    assert fin.size == rfin.size == (2 * n + m) * (2 * H + 1)
+    scale = max(1.0, float(np.abs(rfin).max()))
+    for z in rfin:  # every reference eigenvalue once, to rounding
+        j = int(np.argmin(np.abs(fin - z)))
+        assert abs(fin[j] - z) < 1e-8 * scale, (z, fin[j])
+        fin = np.delete(fin, j)
+    for j in np.flatnonzero(np.isfinite(lam) & (np.abs(lam) < 0.5 * H * omega))[:5]:
+        i = int(np.argmin(np.abs(ref - lam[j])))
+        a, b = V[:, :, j].ravel(), Vref[:, :, i].ravel()
+        if np.min(np.abs(np.delete(ref, i) - ref[i])) > 1e-3 * scale:  # a simple eigenvalue
+            assert abs(np.vdot(a, b)) / (np.linalg.norm(a) * np.linalg.norm(b)) > 1 - 1e-8
