@@ -412,6 +412,60 @@ def bench_paper_model(*, points: int = 200, old_points: int = 20, brute_points: 
     ]  # fmt: skip
 
 
+def bench_exact_pads_branch(*, points: int = 200) -> list[BenchResult]:
+    """The route ``cycles`` takes by default on the paper's model (soft massless Coulomb pads): harmonic balance.
+
+    Fig. 3 set, ``mu1 = mu2 = 0.5``, ``k_ip = 1e8`` (preset ``paper-fig3``), ``Omega`` in [30, 200]: ``points``
+    points of :func:`~brakesqueal.nonlinear.harmonic.harmonic_branch` with Hill's stability, continued past the
+    contact loss (``stop_at_contact_loss=False``) so that the count is reached.  Baselines in the same process:
+    the same branch without stability (the share of Hill's method) and ``points`` points of the quasi-static pads'
+    branch shot with the compiled flow (``squeal_branch``, the route ``cycles`` took before on this model).
+
+    Parameters
+    ----------
+    points : int
+        Points of each branch.
+
+    Returns
+    -------
+    list of BenchResult
+    """
+    from brakesqueal.analysis.maps import Axis
+    from brakesqueal.model import ParameterSpace
+    from brakesqueal.nonlinear.harmonic import harmonic_branch
+    from brakesqueal.nonlinear.models import squeal_branch
+
+    space = ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5})
+    axis = Axis("Omega", 30.0, 200.0)
+    harmonic_branch(space, axis, max_points=3)  # warm: compiled code, imports
+    squeal_branch(space, axis, max_points=3)
+    t0 = time.perf_counter()
+    hb = harmonic_branch(space, axis, max_points=points, stop_at_contact_loss=False)
+    t_hb = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    harmonic_branch(space, axis, max_points=points, stop_at_contact_loss=False, stability=False)
+    t_nostab = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    qs = squeal_branch(space, axis, max_points=points, ds_max=0.2)
+    t_qs = time.perf_counter() - t0
+    n_qs = int(qs.data.sizes["point"])
+    return [
+        BenchResult(
+            f"paper model (k_ip = 1e8): {len(hb.points)}-point branch, exact pads (harmonic balance, Hill stability)",
+            t_hb, "s", t_nostab, t_nostab / t_hb,
+            {"baseline": "the same branch without stability (Newton and continuation only)",
+             "target_s": 20.0, "p_end": hb.points[-1].p, "contact_loss": hb.contact_loss,
+             "largest_harmonics": max(pt.harmonics for pt in hb.points)},
+        ),
+        BenchResult(
+            "paper model (k_ip = 1e8): exact-pads branch against the quasi-static pads' shot branch",
+            t_hb, "s", t_qs * len(hb.points) / max(n_qs, 1), t_qs * len(hb.points) / max(n_qs, 1) / t_hb,
+            {"baseline": f"squeal_branch (quasi-static pads, compiled flow), {n_qs} points scaled to "
+                         f"{len(hb.points)}", "quasi_static_s": round(t_qs, 3)},
+        ),
+    ]  # fmt: skip
+
+
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--points", type=int, default=200, help="points of the continued branch")
@@ -424,4 +478,5 @@ if __name__ == "__main__":
         if not 2 <= v <= 10_000:
             ap.error(f"{opt} must be in [2, 10000]; got {v}")
     emit(bench_nonlinear(points=a.points, brute_points=a.brute_points)
-         + bench_paper_model(points=a.paper_points, old_points=a.paper_old_points))
+         + bench_paper_model(points=a.paper_points, old_points=a.paper_old_points)
+         + bench_exact_pads_branch(points=a.paper_points))
