@@ -219,3 +219,24 @@ def test_hill_pencil_equals_the_complex_companion_form(seed):
         a, b = V[:, :, j].ravel(), Vref[:, :, i].ravel()
         if np.min(np.abs(np.delete(ref, i) - ref[i])) > 1e-3 * scale:  # a simple eigenvalue
             assert abs(np.vdot(a, b)) / (np.linalg.norm(a) * np.linalg.norm(b)) > 1 - 1e-8
+
+
+def test_a_nonlinear_simulation_says_when_its_pads_are_quasi_static():
+    from brakesqueal.simulation import simulate
+
+    def run(over, **kw):
+        space = ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5, "Omega": 60.0, **over})
+        return space, simulate(None, space.resolve({}), 0.3, events="continue", **kw)
+
+    space, tr = run({}, perturbation=[3e-3, 0.0])
+    assert tr.summary.regime == "nonlinear"
+    # the pads the route rule names (cycle_route) are those the run names
+    assert tr.soft_quasi_static_pads == soft_quasi_static_pads(space) == ("1", "2")
+    assert any("quasi-static" in w and "--pad-damping" in w for w in tr.summary.warnings)
+    _, small = run({}, perturbation=[1e-6, 0.0])  # the linear regime: the quasi-static pad is exact there
+    assert small.summary.regime == "linear" and not any("quasi-static" in w for w in small.summary.warnings)
+    _, rigid = run({"k_ip": math.inf}, perturbation=[3e-3, 0.0])
+    assert rigid.soft_quasi_static_pads == () and not any("quasi-static" in w for w in rigid.summary.warnings)
+    damped = damped_pads(ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5, "Omega": 60.0}), 10.0)
+    tr_d = simulate(None, damped.resolve({}), 0.05, perturbation=[3e-3, 0.0], events="continue")
+    assert tr_d.soft_quasi_static_pads == ()

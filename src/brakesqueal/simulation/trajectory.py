@@ -673,9 +673,28 @@ class Trajectory:
         fs = self.sample_rate if math.isfinite(self.sample_rate) else None
         s = summarize(self.status, t, y - y_s, self.modes, output_rate=fs, x_start=x_start,
                       integration_error=self.integration_error_bound(t, y - y_s), coordinates=self.n)  # fmt: skip
+        soft = self.soft_quasi_static_pads
+        if soft and s.regime != "linear":
+            extra += (f"pads {', '.join(soft)} are quasi-static (ldot := 0; their k_ip is finite): exact in the "
+                      "linear regime, only to first order beyond it; --pad-damping D keeps their rates "
+                      "(docs/nonlinear.md)",)
         if extra:
             s = replace(s, warnings=s.warnings + extra)
         return s
+
+    @property
+    def soft_quasi_static_pads(self) -> tuple[str, ...]:
+        """Pads integrated quasi-statically (``ldot := 0``) although their ``k_ip`` is finite: exact only to
+        first order beyond the linear regime (``docs/nonlinear.md``)."""
+        quasi = {u for u in self.pad_unknowns if u not in self.dynamic}
+        out = []
+        for pad in self.params.model.pads:
+            if not ({f"l{pad.name}", f"l_{pad.name}"} & quasi):
+                continue
+            k = pad.k_ip
+            if not math.isinf(float(self.params[k]) if isinstance(k, str) else float(k)):
+                out.append(pad.name)
+        return tuple(out)
 
     def integration_error_bound(self, t: np.ndarray, x: np.ndarray) -> float:
         """:func:`integration_error_bound` for this run over the samples ``x`` (deviations) at times ``t``.
