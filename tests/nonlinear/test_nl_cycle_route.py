@@ -240,3 +240,20 @@ def test_a_nonlinear_simulation_says_when_its_pads_are_quasi_static():
     damped = damped_pads(ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5, "Omega": 60.0}), 10.0)
     tr_d = simulate(None, damped.resolve({}), 0.05, perturbation=[3e-3, 0.0], events="continue")
     assert tr_d.soft_quasi_static_pads == ()
+
+
+def test_both_routes_share_the_summary_keys_of_the_json(capsys):
+    args = ["cycles", *FIG3, "--max-points", "6", "--format", "json"]
+    assert main(args) == 0
+    hb = json.loads(capsys.readouterr().out)
+    assert main([*args, "--pads", "quasi-static"]) == 0
+    shot = json.loads(capsys.readouterr().out)
+    common = {"status", "message", "contact_loss", "contact", "summary", "special_points", "hysteresis_range",
+              "in_contact_up_to", "amplitude_at_last_contact_point", "frequency_hz_at_last_contact_point"}
+    assert common <= set(hb) and common <= set(shot)
+    assert hb["special_points"][0] == {"kind": "H", "p": hb["hopf"]["p0"]}
+    # the last orbit with every pad pressed: the last point (the branch ends at a located contact loss, if any)
+    assert all(min(pt["F_n_min"]) > 0 for pt in hb["points"]) and hb["in_contact_up_to"] == hb["points"][-1]["p"]
+    last = hb["points"][-1]
+    assert hb["amplitude_at_last_contact_point"] == last["amplitude"]
+    assert hb["frequency_hz_at_last_contact_point"] == last["frequency_hz"]

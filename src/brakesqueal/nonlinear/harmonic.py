@@ -183,8 +183,11 @@ class HarmonicBranch:
     stability: str = "not computed"
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready summary: Hopf point, status, events and every point."""
+        """JSON-ready summary: Hopf point, status, events, the engineer's summary and every point."""
         h = self.hopf.hopf
+        summ = self.summary
+        pressed = [pt for pt, row in zip(self.points, summ.table) if row["duty_cycle"][0] is not None]
+        last = pressed[-1] if pressed else None
         return {"parameter": self.parameter, "method": "harmonic balance on the implicit equations "
                 "(exact massless Coulomb pads, tangential rates kept)",
                 "hopf": {"p0": h.p0, "omega0": h.omega0, "frequency_hz": h.frequency0_hz, "l1": h.l1,
@@ -192,7 +195,13 @@ class HarmonicBranch:
                 "status": self.status, "message": self.message, "contact_loss": self.contact_loss,
                 "sliding_reversal": self.sliding_reversal, "stability": self.stability,
                 "coords": list(self.coords), "pads": list(self.pads), "folds": self.folds,
-                "summary": self.summary.to_dict(), "points": [pt.to_dict() for pt in self.points]}
+                "summary": summ.to_dict(), "points": [pt.to_dict() for pt in self.points],
+                # the keys of the shooting route's JSON (SquealBranch.to_dict) that mean the same here
+                "contact": "bilateral", "hysteresis_range": summ.hysteresis_range,
+                "special_points": [{"kind": "H", "p": h.p0}] + [{"kind": "LPC", "p": f} for f in self.folds],
+                "in_contact_up_to": last.p if last is not None else None,
+                "amplitude_at_last_contact_point": dict(last.amplitude) if last is not None else None,
+                "frequency_hz_at_last_contact_point": last.frequency_hz if last is not None else None}
 
     @property
     def folds(self) -> list[float]:
