@@ -1,14 +1,17 @@
-"""A component field or kind is defined once, in ``model/components.py``; roles, TOML files and the schema follow.
+"""A component field or kind is defined once, in ``model/components.py``; roles, TOML files, schema and physics follow.
 
 Each test defines, inside the test, what a developer would add to ``components.py`` — a field made with
 :func:`~brakesqueal.model.components.param` on ``Pad`` (here on a subclass, registered in place of ``Pad``), or a
 new kind of component with its :class:`~brakesqueal.model.components.Kind` entry — and checks that
 :mod:`.roles` (ranges, units, descriptions, validation messages), :mod:`.io` (TOML read and write) and
-:mod:`.schema` pick it up with no change to those modules.  The registration is undone by ``monkeypatch``; the
-last test checks that nothing of it is left.
+:mod:`.schema` pick it up with no change to those modules.  A new kind with physics (a tilt spring and damper
+on the disk, written as hooks only) reaches the assembled equations, the linearization and the energy with no
+change to :mod:`brakesqueal.symbolic` or the simulation.  The registration is undone by ``monkeypatch``; a
+later test checks that nothing of it is left.
 
 The expected texts are written out by hand from the definitions in the tests (unit, description template,
-interval), not read back from the code under test.
+interval), not read back from the code under test; the spring's expected rows, stiffness, damping and energy
+are its closed forms written out by hand (below).
 """
 
 from __future__ import annotations
@@ -21,9 +24,16 @@ from typing import Any
 
 import pytest
 
+import numpy as np
+import symengine as se
+
+from brakesqueal.analysis.linear import linearize
 from brakesqueal.errors import ParameterError
 from brakesqueal.model import io as model_io
 from brakesqueal.model.components import COMPONENTS, Kind, ModelSpec, Pad, Value, attribute, param
+from brakesqueal.model.library import get_preset
+from brakesqueal.model.parameters import Parameters
+from brakesqueal.symbolic.assemble import ENERGY_TERMS, build_equations, energy_terms
 from brakesqueal.model.io import model_to_toml, spec_from_dict, spec_to_dict
 from brakesqueal.model.library import get_model
 from brakesqueal.model.roles import ROLES, parameter_roles, problems
@@ -59,8 +69,46 @@ class SpecWithDampers(ModelSpec):
     dampers: tuple[Damper, ...] = ()
 
 
+@dataclasses.dataclass(frozen=True)
+class TiltSpring:
+    """A new kind with physics: a rotational spring and damper between the tilting disk and ground.
+
+    Written as a developer would write it in ``components.py``: fields by ``param``/``attribute`` and the physics
+    hooks (no computer algebra imported; ``ctx.sm`` is the backend).  Its moment on the disk about O is
+    ``-x0 (k_s q1 + d_s q1dot) - y1 (k_s q2 + d_s q2dot)`` (as the supports of eq. 38), its potential
+    ``k_s (q1^2 + q2^2) / 2``.
+    """
+
+    name: str = attribute({"$ref": "#/$defs/componentName", "description": "Spring name."})
+    k_s: Value = param("k_s", "N m/rad", "tilt stiffness of {owner}", (0.0, math.inf, False, True))
+    d_s: Value = param("d_s", "N m s/rad", "tilt damping of {owner}", (0.0, math.inf, False, True))
+
+    def validate(self) -> None:
+        from brakesqueal.model.components import _check_fields
+
+        _check_fields(self, f"tilt spring '{self.name}'")
+
+    def assemble(self, ctx: Any) -> None:
+        kin, Q, dQ, v = ctx.kinematics, ctx.Q, ctx.dQ, ctx.val
+        x0, y1 = kin.A1[:, 0], kin.A1[:, 1]
+        ctx.moment = ctx.moment - x0 * (v(self.k_s) * Q["q1"] + v(self.d_s) * dQ["q1"]) \
+            - y1 * (v(self.k_s) * Q["q2"] + v(self.d_s) * dQ["q2"])
+
+    def energy(self, ctx: Any) -> dict[str, Any]:
+        return {"V_support": ctx.sm.Rational(1, 2) * ctx.val(self.k_s) * (ctx.Q["q1"] ** 2 + ctx.Q["q2"] ** 2)}
+
+
+@dataclasses.dataclass(frozen=True)
+class SpecWithTiltSprings(ModelSpec):
+    """What adding the kind's field to ``ModelSpec`` would give."""
+
+    tilt_springs: tuple[TiltSpring, ...] = ()
+
+
 # built before any registration: the paper's pads are plain Pads
 _PAPER = spec_to_dict(get_model("paper"), presets=False)
+# the paper's Fig. 2 values (symmetric model: the silent motion is q = 0), resolved before any registration
+_FIG2 = get_preset("paper-fig2").resolve().as_dict()
 
 
 def _paper() -> dict[str, Any]:
@@ -175,9 +223,55 @@ def test_a_new_kind_reaches_roles_toml_and_the_schema(dampers: None) -> None:
     assert [list(e.path) for e in validator.iter_errors(doc)] == [["dampers", 1, "c"]]
 
 
+@pytest.fixture
+def tilt_springs(monkeypatch: pytest.MonkeyPatch) -> None:
+    kind = Kind(TiltSpring, "tilt_spring", "tilt_springs", True, lambda t: f"tilt spring '{t.name}'",
+                "this tilt spring", "Optional tilt springs ([[tilt_springs]] tables).", "A test-only tilt spring.")
+    monkeypatch.setitem(COMPONENTS, "tilt_spring", kind)
+    monkeypatch.setattr(model_io, "ModelSpec", SpecWithTiltSprings)
+
+
+def test_a_new_kind_with_physics_reaches_the_equations_the_linearization_and_the_energy(
+        tilt_springs: None) -> None:
+    """A kind written with hooks only (``TiltSpring``) changes the rows, ``K``, ``D`` and the energy as its closed
+    form says: rows ``+ (k_s q1 + d_s q1dot)`` and ``+ cos(q1) (k_s q2 + d_s q2dot)`` (the moment's ``x0``, ``y0``
+    components, ``y1 = (0, cos q1, sin q1)``), hence ``K + k_s I``, ``D + d_s I`` at the trivial silent motion
+    (``q = 0``), and ``V_support + k_s (q1^2 + q2^2) / 2``."""
+    k_s, d_s = 3.0e4, 2.5
+    data = _paper()
+    data["parameters"].update(k_s=k_s, d_s=d_s)
+    data["tilt_springs"] = [{"name": "tilt", "k_s": "k_s", "d_s": "d_s"}]
+    spec = spec_from_dict(data)
+    assert spec.unit("k_s") == "N m/rad" and spec.describe_parameter("d_s") == "tilt damping of tilt spring 'tilt'"
+    assert spec_from_dict(tomllib.loads(model_to_toml(spec))) == spec
+    bare = spec_from_dict(_paper())  # the same model without the spring
+    assert bare.tilt_springs == ()  # type: ignore[attr-defined]
+
+    q1, q2, dq1, dq2, ks, ds = (se.Symbol(n) for n in ("q1", "q2", "dq1", "dq2", "k_s", "d_s"))
+    expected_rows = [ks * q1 + ds * dq1, se.cos(q1) * (ks * q2 + ds * dq2)]
+    for kronecker in (True, False):
+        eq, eq0 = build_equations(spec, kronecker=kronecker), build_equations(bare, kronecker=kronecker)
+        assert eq.coords == eq0.coords == ("q1", "q2")
+        for i in range(2):
+            assert se.expand(eq.R[i] - eq0.R[i] - expected_rows[i]) == 0
+    terms, terms0 = energy_terms(eq), energy_terms(eq0)
+    for k in ENERGY_TERMS:
+        extra = ks * (q1**2 + q2**2) / 2 if k == "V_support" else 0
+        assert se.expand(terms[k] - terms0[k] - extra) == 0, k
+
+    lm = linearize(Parameters(spec, {**_FIG2, "k_s": k_s, "d_s": d_s}))
+    lm0 = linearize(Parameters(bare, _FIG2))
+    assert lm.silent.trivial and lm0.silent.trivial
+    np.testing.assert_allclose(lm.M, lm0.M, rtol=1e-12, atol=0.0)
+    scale = np.abs(lm0.K).max()
+    np.testing.assert_allclose(lm.K - lm0.K, k_s * np.eye(2), rtol=0.0, atol=1e-12 * scale)
+    np.testing.assert_allclose(lm.D - lm0.D, d_s * np.eye(2), rtol=0.0, atol=1e-12 * max(np.abs(lm0.D).max(), d_s))
+    assert k_s > 1e6 * 1e-12 * scale and d_s > 1e-6 * np.abs(lm0.D).max()  # the shifts are far above the tolerance
+
+
 def test_registrations_are_undone() -> None:
     assert list(COMPONENTS) == ["disk", "pad", "caliper"] and COMPONENTS["pad"].cls is Pad
-    assert "pad.wear" not in ROLES and "damper.c" not in ROLES
+    assert "pad.wear" not in ROLES and "damper.c" not in ROLES and "tilt_spring.k_s" not in ROLES
     s = build_schema()
     assert "wear" not in s["$defs"]["pad"]["properties"] and "dampers" not in s["properties"]
     assert model_io.ModelSpec is ModelSpec

@@ -13,6 +13,17 @@ table, how messages name it).  Roles (:mod:`.roles`), model files
 (:mod:`.io`) and the schema (:mod:`.schema`) are derived from them
 (``docs/extending.md``).
 
+A component's physics is written here too, as methods of its class that
+import no computer algebra (they receive an assembly context ``ctx``,
+:class:`brakesqueal.symbolic.assemble.Assembly`, whose ``ctx.sm`` is
+``symengine`` or ``sympy``): ``coordinates()`` and ``deformations()`` name
+its coordinates ``Q`` and pad deformations ``L``; ``prepare(ctx)``,
+``assemble(ctx)`` and ``finish(ctx)`` add its residual rows, its forces on
+other components and its moments on the disk (called in that order, each
+over every component: the disk's kinematics first, its Euler equations last);
+``energy(ctx)`` returns its kinetic and potential energy terms.  A class
+without a hook contributes nothing there.
+
 Physical conventions (see ``docs/model-builder.md``):
 
 * A pad at angle ``angle_deg`` sits at ``Rz(angle) (0, -radius, 0)``; the
@@ -48,6 +59,7 @@ from .expressions import RESERVED_NAMES
 from .friction import FieldDef
 
 if TYPE_CHECKING:
+    from ..symbolic.assemble import Assembly
     from .parameters import Preset
     from .roles import ParameterRoles
 
@@ -157,6 +169,14 @@ def _positive_with(dof: str, key: str) -> dict[str, Any]:
 
 _COMPONENT_NAME = {"$ref": "#/$defs/componentName"}
 _tilt = functools.partial(param, unless="tilting")  # a disk field unused when the disk does not tilt
+
+
+def state_name(prefix: str, component: str) -> str:
+    """Name of a component's coordinate: ``w1`` for pad ``"1"`` (the paper's names), ``w_upper`` otherwise."""
+    return f"{prefix}{component}" if component.isdigit() else f"{prefix}_{component}"
+
+
+_TILT = ("q1", "q2")  # the disk's tilt coordinates
 
 
 class FrictionLaw:
@@ -284,6 +304,41 @@ class Disk:
         """Check the fields; raise :class:`ParameterError` naming the disk."""
         _check_fields(self, "disk")
 
+    # physics hooks (docs/extending.md): ctx is a brakesqueal.symbolic.assemble.Assembly
+    def coordinates(self) -> tuple[str, ...]:
+        """The tilt angles ``q1, q2`` of a tilting disk (none for a belt)."""
+        return _TILT if self.tilting else ()
+
+    def prepare(self, ctx: Assembly) -> None:
+        """The disk's kinematics, before every other component: Cardan angles with the spin constraint
+        (eqs. 2-11, 40-42), or a belt spinning about ``z0``."""
+        ctx.disk_kinematics(ctx.val(self.Omega), _TILT if self.tilting else None)
+
+    def finish(self, ctx: Assembly) -> None:
+        """The Euler equations of the tilting disk (eqs. 35-45) with the moments the other components added."""
+        if self.tilting:
+            v = ctx.val
+            psi = ctx.euler_rows(_TILT, ctx.sm.diag(v(self.Theta), v(self.Theta), v(self.Phi)), v(self.k_t),
+                                 v(self.d_t))
+            ctx.add_row("q1", psi[0])
+            ctx.add_row("q2", psi[1])
+
+    def energy(self, ctx: Assembly) -> dict[str, Any]:
+        """Kinetic energy by degree in the tilt rates (spin constraint substituted) and the supports' potential."""
+        if not self.tilting:
+            return {}
+        sm, v, kin = ctx.sm, ctx.val, ctx.kinematics
+        assert kin is not None, "a tilting disk's equations carry its kinematics"
+        w3 = kin.A.T * (kin.J_R0 * ctx.qdot)  # body-frame angular velocity with the constraint (eq. 41)
+        I3 = sm.diag(v(self.Theta), v(self.Theta), v(self.Phi))
+        T = (w3.T * I3 * w3)[0, 0] / 2
+        dq1, dq2 = (ctx.dQ[n] for n in _TILT)
+        Tm = T.subs({dq1: -dq1, dq2: -dq2})  # T2 and T0 are even in the tilt rates, T1 odd
+        T0 = T.subs({dq1: 0, dq2: 0})
+        q1, q2 = (ctx.Q[n] for n in _TILT)
+        return {"T2": sm.expand((T + Tm) / 2 - T0), "T1": sm.expand((T - Tm) / 2), "T0": T0,
+                "V_support": sm.Rational(1, 2) * v(self.k_t) * (q1**2 + q2**2)}
+
 
 @dataclass(frozen=True)
 class Pad:
@@ -334,6 +389,109 @@ class Pad:
     def label(self) -> str:
         """``pad 'name'`` for messages."""
         return f"pad '{self.name}'"
+
+    @property
+    def rigid(self) -> bool:
+        """Whether the tangential support is rigid (``k_ip`` the number ``inf``)."""
+        return not isinstance(self.k_ip, str) and math.isinf(self.k_ip)
+
+    @property
+    def quasi_static(self) -> bool:
+        """Whether the pad is massless tangentially with a finite stiffness: its deformation ``l`` is in ``L``."""
+        return "tangential" not in self.dofs and not self.rigid
+
+    # physics hooks (docs/extending.md): ctx is a brakesqueal.symbolic.assemble.Assembly
+    def coordinates(self) -> list[str]:
+        """``w_<pad>`` and ``u_<pad>`` of its normal and tangential DOFs."""
+        return [state_name("w" if d == "normal" else "u", self.name) for d in ("normal", "tangential")
+                if d in self.dofs]
+
+    def deformations(self) -> list[str]:
+        """``l_<pad>``: the tangential deformation of a massless pad with a finite tangential stiffness."""
+        return [state_name("l", self.name)] if self.quasi_static else []
+
+    def _mount(self, ctx: Assembly) -> tuple[Caliper | None, Any, Any, Any]:
+        """The caliper carrying the supports, its normal and tangential (along ``e_t``) displacements, ``cos a``."""
+        ca = ctx.angle_cos_sin(self.angle_deg)[0]
+        mount = next((c for c in ctx.spec.calipers if c.name == self.mount), None) if self.mount else None
+        zero = ctx.sm.Integer(0)
+        w_m = ctx.Q[state_name("wc", mount.name)] if mount and "normal" in mount.dofs else zero
+        u_m = ctx.Q[state_name("uc", mount.name)] * ca if mount and "tangential" in mount.dofs else zero
+        return mount, w_m, u_m, ca
+
+    def _l(self, ctx: Assembly, u_m: Any) -> Any:
+        """The pad's tangential position: its coordinate, its deformation, or the mount's (rigid support)."""
+        if "tangential" in self.dofs:
+            return ctx.Q[state_name("u", self.name)]
+        return u_m if self.rigid else ctx.L[state_name("l", self.name)]
+
+    def assemble(self, ctx: Assembly) -> None:
+        """The pad's contact (eqs. 12-34), its rows (pad mass), balance ``G``, reactions on its caliper, moment on
+        the disk."""
+        sm, val, disk = ctx.sm, ctx.val, ctx.spec.disk
+        s = 1 if self.face == "upper" else -1
+        r, N0 = val(self.radius), val(self.preload)
+        ca, sa = ctx.angle_cos_sin(self.angle_deg)
+        mount, w_m, u_m, _ = self._mount(ctx)
+        l = self._l(ctx, u_m)
+        normal, quasi = "normal" in self.dofs, self.quasi_static
+        law = self.friction
+        c = ctx.pad_contact(
+            side=s, h0=val(disk.h_upper if s == 1 else disk.h_lower), base=sm.Matrix([r * sa, -r * ca, 0]),
+            e_t=sm.Matrix([ca, sa, 0]), l=l, friction=lambda v: ctx.friction(law, v), N0=N0,
+            nominal_speed=ctx.Omega * r, k=val(self.k), d=val(self.d), w_m=w_m,
+            normal_dof=ctx.Q[state_name("w", self.name)] if normal else None, k_c=val(self.k_c) if normal else None,
+            d_c=val(self.d_c) if normal else None, u_m=u_m, compliance=val.compliance(self.k_ip) if quasi else None,
+            engaged=ctx.engagement.get(self.name) if ctx.engagement else None,
+            damping_t=val(self.d_ip) if quasi else None,
+        )  # fmt: skip
+        if normal:
+            n = state_name("w", self.name)
+            ctx.add_row(n, val(self.mass) * ctx.ddQ[n] - c.support_normal + c.f_p[2])
+        if "tangential" in self.dofs:
+            n = state_name("u", self.name)
+            F_t = -(val(self.k_ip) * (l - u_m) + val(self.d_ip) * (ctx.dQ[n] - ctx.rate(u_m)) + c.mu_star * N0)
+            ctx.add_row(n, val(self.mass) * ctx.ddQ[n] - F_t + c.f_t)
+        else:
+            F_t = c.f_t
+            if quasi:
+                ctx.G_rows.append(c.g)
+        if mount:  # the supports' reactions on the caliper
+            if "normal" in mount.dofs:
+                ctx.add_row(state_name("wc", mount.name), c.support_normal - s * N0)
+            if "tangential" in mount.dofs:
+                ctx.add_row(state_name("uc", mount.name), (F_t + c.mu_star * N0) * ca)
+        ctx.moment = ctx.moment + c.moment
+        ctx.contacts[self.name] = c
+        ctx.tangential[self.name] = l
+
+    def energy(self, ctx: Assembly) -> dict[str, Any]:
+        """Kinetic energy of the pad mass; potential of the pad's springs and preload (``V_pads``)."""
+        sm, val = ctx.sm, ctx.val
+        half = sm.Rational(1, 2)
+        c, l = ctx.contacts[self.name], ctx.tangential[self.name]
+        s = 1 if self.face == "upper" else -1
+        N0, k = val(self.preload), val(self.k)
+        mount, w_m, u_m, ca = self._mount(ctx)
+        T2 = V = sm.Integer(0)
+        if "normal" in self.dofs:
+            n = state_name("w", self.name)
+            T2 += half * val(self.mass) * ctx.dQ[n] ** 2
+            delta = s * (ctx.Q[n] - c.h)
+            V += half * k * (ctx.Q[n] - w_m) ** 2 - s * N0 * ctx.Q[n] + N0 * delta + half * val(self.k_c) * delta**2
+        else:
+            V += half * k * (c.h - w_m) ** 2 - s * N0 * c.h
+        if "tangential" in self.dofs:
+            n = state_name("u", self.name)
+            T2 += half * val(self.mass) * ctx.dQ[n] ** 2
+            V += half * val(self.k_ip) * (ctx.Q[n] - u_m) ** 2 + c.mu_star * N0 * ctx.Q[n]
+        elif not self.rigid:
+            # massless pad on its balance g = 0 (eqs. 33-34): k_ip (l - u_m)^2 / 2 = -(l - u_m)(f_t + mu* N0
+            # + d_ip (ldot - u_mdot)) / 2, finite also for a rigid support given as k_ip = inf (compliance 0)
+            u_dot = ctx.dQ[state_name("uc", mount.name)] * ca if mount and "tangential" in mount.dofs else 0
+            F = c.f_t + c.mu_star * N0 + val(self.d_ip) * (ctx.dL[state_name("l", self.name)] - u_dot)
+            V += -half * (l - u_m) * F + c.mu_star * N0 * l
+        return {"T2": T2, "V_pads": V}
 
     def validate(self) -> None:
         """Check the fields; raise :class:`ParameterError` naming the pad."""
@@ -387,6 +545,30 @@ class Caliper:
     def validate(self) -> None:
         """Check the fields; raise :class:`ParameterError` naming the caliper."""
         _check_fields(self, f"caliper '{self.name}'")
+
+    # physics hooks (docs/extending.md): ctx is a brakesqueal.symbolic.assemble.Assembly
+    def _dofs(self) -> list[tuple[str, Any, Any]]:
+        return [(state_name(pre, self.name), k, d) for dof, pre, k, d in
+                (("normal", "wc", self.k_n, self.d_n), ("tangential", "uc", self.k_t, self.d_t)) if dof in self.dofs]
+
+    def coordinates(self) -> list[str]:
+        """``wc_<caliper>`` and ``uc_<caliper>`` of its normal and tangential translations."""
+        return [n for n, _, _ in self._dofs()]
+
+    def assemble(self, ctx: Assembly) -> None:
+        """Newton's law of each translation; the reactions of the pads mounted on it are added by the pads."""
+        v = ctx.val
+        for n, k, d in self._dofs():
+            ctx.add_row(n, v(self.mass) * ctx.ddQ[n] + v(k) * ctx.Q[n] + v(d) * ctx.dQ[n])
+
+    def energy(self, ctx: Assembly) -> dict[str, Any]:
+        """Kinetic energy of the caliper mass and potential of its springs to ground (``V_support``)."""
+        half, v = ctx.sm.Rational(1, 2), ctx.val
+        T2 = V = ctx.sm.Integer(0)
+        for n, k, _ in self._dofs():
+            T2 += half * v(self.mass) * ctx.dQ[n] ** 2
+            V += half * v(k) * ctx.Q[n] ** 2
+        return {"T2": T2, "V_support": V}
 
 
 #: Largest number of pads a model may have (assembly cost grows quickly with it).

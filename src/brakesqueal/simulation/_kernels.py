@@ -191,60 +191,14 @@ def _pad_scales(se: Any, eq: Any) -> list[Any]:
 
 
 def _energy(se: Any, eq: Any) -> list[Any]:
-    """``T2, T1, T0, V_support, V_pads`` (see ``docs/simulation.md``, energy)."""
-    from ..symbolic.contact import angle_cos_sin
+    """``T2, T1, T0, V_support, V_pads``: the sum of the components' ``energy`` hooks (``docs/simulation.md``, energy).
 
-    spec = eq.spec
-    Q = dict(zip(eq.coords, eq.Q))
-    dQ = dict(zip(eq.coords, eq.dQ))
-    val = lambda v: _value(se, eq, v)  # noqa: E731
-    half = se.Rational(1, 2)
-    T2 = T1 = T0 = se.Integer(0)
-    V_support = V_pads = se.Integer(0)
-    disk = spec.disk
-    if disk.tilting:
-        kin = eq.kinematics
-        w3 = kin.A.T * (kin.J_R0 * eq.constraint_qdot)  # body-frame angular velocity with the constraint (eq. 41)
-        I3 = se.diag(val(disk.Theta), val(disk.Theta), val(disk.Phi))
-        T = (w3.T * I3 * w3)[0, 0] / 2
-        dqm = (dQ["q1"], dQ["q2"])
-        Tm = T.subs({dqm[0]: -dqm[0], dqm[1]: -dqm[1]})
-        T0 = T.subs({dqm[0]: 0, dqm[1]: 0})
-        T2 = se.expand((T + Tm) / 2 - T0)
-        T1 = se.expand((T - Tm) / 2)
-        V_support = half * val(disk.k_t) * (Q["q1"] ** 2 + Q["q2"] ** 2)
-    cal = {c.name: c for c in spec.calipers}
-    for cp in spec.calipers:
-        for d, pre, k in (("normal", "wc", cp.k_n), ("tangential", "uc", cp.k_t)):
-            if d in cp.dofs:
-                name = _state_name(pre, cp.name)
-                T2 += half * val(cp.mass) * dQ[name] ** 2
-                V_support += half * val(k) * Q[name] ** 2
-    for pad, c, l in zip(spec.pads, eq.pads, eq.tangential):
-        s = 1 if pad.face == "upper" else -1
-        N0, k = val(pad.preload), val(pad.k)
-        mount = cal.get(pad.mount) if pad.mount else None
-        ca = angle_cos_sin(se, pad.angle_deg)[0]
-        w_m = Q[_state_name("wc", mount.name)] if mount and "normal" in mount.dofs else se.Integer(0)
-        u_m = Q[_state_name("uc", mount.name)] * ca if mount and "tangential" in mount.dofs else se.Integer(0)
-        if "normal" in pad.dofs:
-            w = Q[_state_name("w", pad.name)]
-            T2 += half * val(pad.mass) * dQ[_state_name("w", pad.name)] ** 2
-            delta = s * (w - c.h)
-            V_pads += half * k * (w - w_m) ** 2 - s * N0 * w + N0 * delta + half * val(pad.k_c) * delta**2
-        else:
-            V_pads += half * k * (c.h - w_m) ** 2 - s * N0 * c.h
-        if "tangential" in pad.dofs:
-            u = Q[_state_name("u", pad.name)]
-            T2 += half * val(pad.mass) * dQ[_state_name("u", pad.name)] ** 2
-            V_pads += half * val(pad.k_ip) * (u - u_m) ** 2 + c.mu_star * N0 * u
-        elif not (not isinstance(pad.k_ip, str) and math.isinf(pad.k_ip)):
-            # massless pad on its balance g = 0 (eqs. 33-34): k_ip (l - u_m)^2 / 2 = -(l - u_m)(f_t + mu* N0
-            # + d_ip (ldot - u_mdot)) / 2, finite also for a rigid support given as k_ip = inf (compliance 0)
-            u_dot = dQ[_state_name("uc", mount.name)] * ca if mount and "tangential" in mount.dofs else 0
-            F = c.f_t + c.mu_star * N0 + val(pad.d_ip) * (eq.dL[list(eq.L).index(l)] - u_dot)  # d_ip = 0: no term
-            V_pads += -half * (l - u_m) * F + c.mu_star * N0 * l
-    return [T2, T1, T0, V_support, V_pads]
+    ``se`` is the backend of ``eq`` (kept for the callers' symmetry with the other builders).
+    """
+    from ..symbolic.assemble import ENERGY_TERMS, energy_terms
+
+    terms = energy_terms(eq)
+    return [terms[k] for k in ENERGY_TERMS]
 
 
 _PREAMBLE = '''import math

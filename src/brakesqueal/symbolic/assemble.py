@@ -1,12 +1,16 @@
 r"""Assembly of the nonlinear equations of any model (the paper's procedure, eqs. 2-45).
 
-The disk's tilting DOFs follow the paper unchanged: Cardan kinematics (eqs.
-2-11), matrix Euler equations with Kronecker products (eqs. 35-38) and the
-elimination of the spin constraint (eqs. 40-45), with the contact moments
-summed over the pads.  Each pad contributes its contact (:mod:`.contact`,
-eqs. 12-34) and, depending on its DOFs, either the massless relations of the
-paper or Newton's law for its mass; calipers add Newton's law for their
-translations.
+Each component carries its physics as hooks written next to its data in
+:mod:`brakesqueal.model.components` (backend-neutral, like the friction laws'
+formulas); :func:`build_equations` is the generic driver that calls them with
+an :class:`Assembly` context, in a fixed order: the disk's kinematics
+(Cardan angles, eqs. 2-11, with the spin constraint, eqs. 40-42), then the
+pads (their contact, :mod:`.contact`, eqs. 12-34, and either the massless
+relations of the paper or Newton's law for their mass), the calipers
+(Newton's law for their translations) and any other kind, and last the
+disk's matrix Euler equations with Kronecker products (eqs. 35-38) and the
+elimination of the spin constraint (eqs. 43-45), with the moments summed
+over the components.  :func:`energy_terms` sums the components' energy hooks.
 
 Result: residuals ``R(Q, Qdot, Qddot, L, Ldot) = 0`` (one row per coordinate
 of ``Q``) and ``G(Q, Qdot, L, Ldot) = 0`` (tangential balance of every massless
@@ -21,16 +25,19 @@ simulation is decided there (:mod:`brakesqueal.analysis.linear`).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
+from ..model.components import components
 from .backend import Backend, get_backend
-from .constraint import ReducedEquations, reduce_equations, spin_constraint
+from .constraint import ReducedEquations, SpinConstraint, reduce_equations, spin_constraint
 from .contact import PadContact, angle_cos_sin, friction_coefficient, pad_contact
 from .euler import angular_momentum_rate, euler_matrices, support_moment
 from .kinematics import CardanKinematics, cardan_kinematics
 
-__all__ = ["Equations", "build_equations", "compliance_name"]
+__all__ = ["Equations", "Assembly", "ENERGY_TERMS", "PHASES", "build_equations", "energy_terms",
+           "compliance_name"]
 
 
 def compliance_name(name: str, taken: Any = ()) -> str:
@@ -121,15 +128,6 @@ class Equations:
         raise KeyError(name)
 
 
-def _name(prefix: str, component: str) -> str:
-    """State name of a component: ``l1`` for pad ``"1"`` (the paper's names), ``l_upper`` otherwise."""
-    return f"{prefix}{component}" if component.isdigit() else f"{prefix}_{component}"
-
-
-def _rigid(pad: Any) -> bool:
-    return not isinstance(pad.k_ip, str) and math.isinf(pad.k_ip)
-
-
 class _Values:
     """Component field → symbolic value (names → symbols, stiffness names → 1/compliance)."""
 
@@ -154,9 +152,173 @@ class _Values:
         return self.sm.Integer(0) if math.isinf(v) else 1 / self.__call__(v)
 
 
+#: Names of the energy terms a component's ``energy`` hook may return (``docs/simulation.md``, energy).
+ENERGY_TERMS = ("T2", "T1", "T0", "V_support", "V_pads")
+
+#: The assembly hooks of a component, in the order :func:`build_equations` calls them (each over every component).
+PHASES = ("prepare", "assemble", "finish")
+
+
+class Assembly:
+    """What a component's physics hooks see while a model is assembled (or its energy written).
+
+    The hooks are methods of the component classes (:mod:`brakesqueal.model.components`, which
+    import no computer algebra): ``coordinates()`` and ``deformations()`` name the component's
+    coordinates ``Q`` and pad deformations ``L``; ``prepare(ctx)``, ``assemble(ctx)`` and
+    ``finish(ctx)`` are called in that order, each for every component in
+    :data:`~brakesqueal.model.components.COMPONENTS` order (the disk's kinematics are prepared
+    first; its Euler equations are finished last, with the moments the other components added);
+    ``energy(ctx)`` returns a component's terms of :data:`ENERGY_TERMS`.
+
+    Attributes
+    ----------
+    sm : module
+        The computer-algebra backend (``symengine`` or ``sympy``).
+    spec : ModelSpec
+        The model.
+    val : callable
+        ``val(field_value)``: a component field's symbolic value (a parameter name → its symbol, a
+        tangential stiffness name → ``1/compliance``, a number → an exact number, ``None`` → 0);
+        ``val.compliance(k_ip)`` is the compliance ``1/k_ip`` (0 for ``inf``).
+    coords, algebraic : list of str
+        Names of the coordinates ``Q`` and the pad deformations ``L``.
+    Q, dQ, ddQ, L, dL : dict
+        Their symbols by name (``dQ["q1"]`` is the symbol ``dq1``).
+    engagement : mapping or None
+        Pad name → factor of its contact force (unilateral contact), ``None``: every pad pressed.
+    kronecker, keep_q3 : bool
+        Options of :func:`build_equations`.
+    Omega, omega0, z3 : expression, Matrix, Matrix
+        Spin rate, angular velocity of the disk and its axis in the fixed frame (set by
+        :meth:`disk_kinematics`).
+    kinematics, constraint, qdot
+        :class:`~.kinematics.CardanKinematics`, :class:`~.constraint.SpinConstraint` and
+        ``qdot = s + S q_mdot`` (eq. 41) of a tilting disk (``None`` otherwise).
+    rows : dict
+        Residual row of each coordinate (Newton's law ``M qddot - F = 0``), summed by :meth:`add_row`.
+    G_rows : list
+        Residuals ``G`` of the pads' tangential balances, in ``L`` order.
+    moment : Matrix
+        Sum of the moments about O acting on the disk (fixed frame; the contact moments of eq. 38).
+    contacts, tangential : dict
+        Per pad name, its :class:`~.contact.PadContact` and tangential position ``l`` (the
+        ``Equations.pads`` and ``Equations.tangential``, in pad order).
+    reduced : ReducedEquations or None
+        The disk's matrices of eq. (45) (set by :meth:`euler_rows` on the Kronecker route).
+    """
+
+    def __init__(self, sm: Any, spec: Any, coords: list[str], algebraic: list[str], *, kronecker: bool = True,
+                 keep_q3: bool = False, engagement: Any = None) -> None:
+        self.sm = sm
+        self.spec = spec
+        self.val = _Values(sm, spec)
+        self.coords, self.algebraic = coords, algebraic
+        self.Q = {n: sm.Symbol(n) for n in coords}
+        self.dQ = {n: sm.Symbol(f"d{n}") for n in coords}
+        self.ddQ = {n: sm.Symbol(f"dd{n}") for n in coords}
+        self.L = {n: sm.Symbol(n) for n in algebraic}
+        self.dL = {n: sm.Symbol(f"d{n}") for n in algebraic}
+        self.engagement = engagement
+        self.kronecker, self.keep_q3 = kronecker, keep_q3
+        self.Omega: Any = None
+        self.omega0: Any = None
+        self.z3: Any = None
+        self.kinematics: CardanKinematics | None = None
+        self.constraint: SpinConstraint | None = None
+        self.qdot: Any = None
+        self.rows: dict[str, Any] = {}
+        self.G_rows: list[Any] = []
+        self.moment = sm.zeros(3, 1)
+        self.contacts: dict[str, PadContact] = {}
+        self.tangential: dict[str, Any] = {}
+        self.reduced: ReducedEquations | None = None
+
+    @classmethod
+    def of(cls, eq: Equations) -> Assembly:
+        """The context of assembled equations (for the ``energy`` hooks): symbols, disk kinematics, pad contacts."""
+        ctx = cls(get_backend(cast(Backend, eq.backend)), eq.spec, list(eq.coords), list(eq.algebraic))
+        ctx.Q, ctx.dQ, ctx.ddQ = (dict(zip(eq.coords, x)) for x in (eq.Q, eq.dQ, eq.ddQ))
+        ctx.L, ctx.dL = dict(zip(eq.algebraic, eq.L)), dict(zip(eq.algebraic, eq.dL))
+        ctx.kinematics, ctx.qdot, ctx.reduced = eq.kinematics, eq.constraint_qdot, eq.reduced
+        ctx.contacts = {p.name: c for p, c in zip(eq.spec.pads, eq.pads)}
+        ctx.tangential = {p.name: t for p, t in zip(eq.spec.pads, eq.tangential)}
+        return ctx
+
+    def rate(self, e: Any) -> Any:
+        """Time derivative of an expression of ``Q`` and ``L`` along the motion."""
+        out = self.sm.Integer(0)
+        for n in self.coords:
+            out += e.diff(self.Q[n]) * self.dQ[n]
+        for n in self.algebraic:
+            out += e.diff(self.L[n]) * self.dL[n]
+        return out
+
+    def add_row(self, coordinate: str, expr: Any) -> None:
+        """Add ``expr`` to the residual row of a coordinate (a generalized force enters with a minus sign)."""
+        self.rows[coordinate] = self.rows[coordinate] + expr if coordinate in self.rows else expr
+
+    def angle_cos_sin(self, deg: float) -> tuple[Any, Any]:
+        """Exact ``cos``/``sin`` of an angle in degrees (:func:`.contact.angle_cos_sin`)."""
+        return angle_cos_sin(self.sm, deg)
+
+    def friction(self, law: Any, v: Any) -> Any:
+        """``mu(v)`` of a :class:`~brakesqueal.model.components.FrictionLaw` (its fields through :attr:`val`)."""
+        return friction_coefficient(self.sm, law, v, self.val)
+
+    def pad_contact(self, **kw: Any) -> PadContact:
+        """A pad's contact quantities (paper eqs. 12-34): :func:`.contact.pad_contact` with this backend,
+        the disk's ``z3``, ``omega0`` and :meth:`rate`; the other keywords are those of that function."""
+        return pad_contact(self.sm, z3=self.z3, omega0=self.omega0, rate=self.rate, **kw)
+
+    def disk_kinematics(self, Omega: Any, tilt: tuple[str, str] | None) -> None:
+        """Set the disk's kinematics: spin rate ``Omega``, angular velocity ``omega0``, axis ``z3``.
+
+        ``tilt``: the names of the tilt coordinates ``(q1, q2)`` (Cardan kinematics, eqs. 2-11, with the
+        spin constraint eqs. 40-42 substituted), or ``None`` for a disk spinning about ``z0``.
+        """
+        sm = self.sm
+        self.Omega = Omega
+        if tilt is None:
+            self.z3 = sm.Matrix([0, 0, 1])
+            self.omega0 = self.z3 * Omega
+            return
+        q_m = (self.Q[tilt[0]], self.Q[tilt[1]])
+        q3 = sm.Symbol("q3")
+        kin = cardan_kinematics(sm, (q_m[0], q_m[1], q3))
+        if not self.keep_q3:
+            sub = {q3: sm.Integer(0)}
+            kin = CardanKinematics(A=kin.A.subs(sub), A1=kin.A1, A2=kin.A2, J_R0=kin.J_R0,
+                                   J_R3=kin.J_R3.subs(sub), H_R0=kin.H_R0, H_R3=kin.H_R3.subs(sub), q=kin.q)
+        con = spin_constraint(sm, q_m, Omega)
+        self.kinematics, self.constraint = kin, con
+        self.qdot = con.s + con.S * sm.Matrix([self.dQ[tilt[0]], self.dQ[tilt[1]]])  # eq. (41)
+        self.omega0 = kin.J_R0 * self.qdot  # eq. (6) with the constraint
+        self.z3 = kin.A[:, 2]
+
+    def euler_rows(self, tilt: tuple[str, str], I3: Any, k_t: Any, d_t: Any) -> Any:
+        """The disk's two residual rows (eq. 44) with the summed :attr:`moment` (Kronecker route or chain rule).
+
+        ``I3``: inertia tensor in the body frame; ``k_t``, ``d_t``: rotational supports (eq. 45).
+        """
+        sm, kin, con = self.sm, self.kinematics, self.constraint
+        assert kin is not None and con is not None, "disk_kinematics() sets the tilt kinematics first"
+        q_m = (self.Q[tilt[0]], self.Q[tilt[1]])
+        dq_m, ddq_m = (self.dQ[tilt[0]], self.dQ[tilt[1]]), (self.ddQ[tilt[0]], self.ddQ[tilt[1]])
+        if self.kronecker:
+            M0, Cstar0 = euler_matrices(sm, kin, I3)
+            self.reduced = reduce_equations(sm, M0, Cstar0, con, q_m, dq_m, ddq_m, k_t, d_t, self.moment)
+            return self.reduced.psi
+        return _psi_without_kronecker(sm, kin, I3, con, dq_m, ddq_m, k_t, d_t, self.moment)
+
+
 def build_equations(spec: Any, backend: Backend = "symengine", *, kronecker: bool = True,
                     keep_q3: bool = False, engagement: Any = None) -> Equations:
-    """Assemble the nonlinear equations of a model.
+    """Assemble the nonlinear equations of a model from its components' physics hooks.
+
+    The driver of :class:`Assembly`: every component names its coordinates and pad deformations, then
+    the hooks ``prepare`` (the disk's kinematics), ``assemble`` (pads, calipers, other kinds: forces,
+    rows, moments on the disk) and ``finish`` (the disk's Euler equations, eqs. 35-45) run in that
+    order, each over every component in :data:`~brakesqueal.model.components.COMPONENTS` order.
 
     Parameters
     ----------
@@ -179,133 +341,69 @@ def build_equations(spec: Any, backend: Backend = "symengine", *, kronecker: boo
     Returns
     -------
     Equations
+
+    Raises
+    ------
+    ValueError
+        If a component names a coordinate that no hook gives a residual row.
     """
     sm = get_backend(backend)
-    val = _Values(sm, spec)
-    disk = spec.disk
-    Omega = val(disk.Omega)
-    coords: list[str] = ["q1", "q2"] if disk.tilting else []
-    for p in spec.pads:
-        coords += [_name("w" if d == "normal" else "u", p.name) for d in ("normal", "tangential") if d in p.dofs]
-    for c in spec.calipers:
-        coords += [_name("wc" if d == "normal" else "uc", c.name) for d in ("normal", "tangential") if d in c.dofs]
-    algebraic = [_name("l", p.name) for p in spec.pads if "tangential" not in p.dofs and not _rigid(p)]
-    Q = {n: sm.Symbol(n) for n in coords}
-    dQ = {n: sm.Symbol(f"d{n}") for n in coords}
-    ddQ = {n: sm.Symbol(f"dd{n}") for n in coords}
-    L = {n: sm.Symbol(n) for n in algebraic}
-    dL = {n: sm.Symbol(f"d{n}") for n in algebraic}
-
-    def rate(e: Any) -> Any:
-        """Time derivative of an expression of ``Q`` and ``L`` along the motion."""
-        out = sm.Integer(0)
-        for n in coords:
-            out += e.diff(Q[n]) * dQ[n]
-        for n in algebraic:
-            out += e.diff(L[n]) * dL[n]
-        return out
-
-    z0 = sm.Matrix([0, 0, 1])
-    kin = con = qdot = None
-    if disk.tilting:
-        q_m = (Q["q1"], Q["q2"])
-        q3 = sm.Symbol("q3")
-        kin = cardan_kinematics(sm, (q_m[0], q_m[1], q3))
-        if not keep_q3:
-            sub = {q3: sm.Integer(0)}
-            kin = CardanKinematics(A=kin.A.subs(sub), A1=kin.A1, A2=kin.A2, J_R0=kin.J_R0,
-                                   J_R3=kin.J_R3.subs(sub), H_R0=kin.H_R0, H_R3=kin.H_R3.subs(sub), q=kin.q)
-        con = spin_constraint(sm, q_m, Omega)
-        qdot = con.s + con.S * sm.Matrix([dQ["q1"], dQ["q2"]])  # eq. (41)
-        omega0 = kin.J_R0 * qdot  # eq. (6) with the constraint
-        z3 = kin.A[:, 2]
-    else:
-        omega0 = z0 * Omega
-        z3 = z0
-    cal = {c.name: c for c in spec.calipers}
-    rows: dict[str, Any] = {}
-    G_rows: list[Any] = []
-    moment = sm.zeros(3, 1)
-    cal_normal = {c.name: sm.Integer(0) for c in spec.calipers}
-    cal_tang = {c.name: sm.Integer(0) for c in spec.calipers}
-    contacts: list[PadContact] = []
-    tangential: list[Any] = []
-    for pad in spec.pads:
-        s = 1 if pad.face == "upper" else -1
-        r, N0 = val(pad.radius), val(pad.preload)
-        ca, sa = angle_cos_sin(sm, pad.angle_deg)
-        e_t = sm.Matrix([ca, sa, 0])
-        base = sm.Matrix([r * sa, -r * ca, 0])
-        mount = cal.get(pad.mount) if pad.mount else None
-        w_m = Q[_name("wc", mount.name)] if mount and "normal" in mount.dofs else sm.Integer(0)
-        u_m = Q[_name("uc", mount.name)] * ca if mount and "tangential" in mount.dofs else sm.Integer(0)
-        if "tangential" in pad.dofs:
-            l = Q[_name("u", pad.name)]
-        elif _rigid(pad):
-            l = u_m
-        else:
-            l = L[_name("l", pad.name)]
-        normal = "normal" in pad.dofs
-        quasi = "tangential" not in pad.dofs and not _rigid(pad)
-        law = pad.friction
-
-        def mu_of(v: Any, law: Any = law) -> Any:
-            return friction_coefficient(sm, law, v, val)
-
-        c = pad_contact(
-            sm, side=s, h0=val(disk.h_upper if s == 1 else disk.h_lower), base=base, e_t=e_t, l=l, z3=z3,
-            omega0=omega0, rate=rate, friction=mu_of,
-            N0=N0, nominal_speed=Omega * r, k=val(pad.k), d=val(pad.d), w_m=w_m,
-            normal_dof=Q[_name("w", pad.name)] if normal else None, k_c=val(pad.k_c) if normal else None,
-            d_c=val(pad.d_c) if normal else None, u_m=u_m, compliance=val.compliance(pad.k_ip) if quasi else None,
-            engaged=engagement.get(pad.name) if engagement else None,
-            damping_t=val(pad.d_ip) if quasi else None,
-        )  # fmt: skip
-        if normal:
-            n = _name("w", pad.name)
-            rows[n] = val(pad.mass) * ddQ[n] - c.support_normal + c.f_p[2]
-        if "tangential" in pad.dofs:
-            n = _name("u", pad.name)
-            F_t = -(val(pad.k_ip) * (l - u_m) + val(pad.d_ip) * (dQ[n] - rate(u_m)) + c.mu_star * N0)
-            rows[n] = val(pad.mass) * ddQ[n] - F_t + c.f_t
-        else:
-            F_t = c.f_t
-            if quasi:
-                G_rows.append(c.g)
-        if mount:
-            cal_normal[mount.name] += c.support_normal - s * N0
-            cal_tang[mount.name] += (F_t + c.mu_star * N0) * ca
-        moment = moment + c.moment
-        contacts.append(c)
-        tangential.append(l)
-    for cp in spec.calipers:
-        if "normal" in cp.dofs:
-            n = _name("wc", cp.name)
-            rows[n] = val(cp.mass) * ddQ[n] + val(cp.k_n) * Q[n] + val(cp.d_n) * dQ[n] + cal_normal[cp.name]
-        if "tangential" in cp.dofs:
-            n = _name("uc", cp.name)
-            rows[n] = val(cp.mass) * ddQ[n] + val(cp.k_t) * Q[n] + val(cp.d_t) * dQ[n] + cal_tang[cp.name]
-    red = None
-    if disk.tilting:
-        I3 = sm.diag(val(disk.Theta), val(disk.Theta), val(disk.Phi))
-        q_m, dq_m, ddq_m = (Q["q1"], Q["q2"]), (dQ["q1"], dQ["q2"]), (ddQ["q1"], ddQ["q2"])
-        assert kin is not None and con is not None
-        if kronecker:
-            M0, Cstar0 = euler_matrices(sm, kin, I3)
-            red = reduce_equations(sm, M0, Cstar0, con, q_m, dq_m, ddq_m, val(disk.k_t), val(disk.d_t), moment)
-            rows["q1"], rows["q2"] = red.psi[0], red.psi[1]
-        else:
-            psi = _psi_without_kronecker(sm, kin, I3, con, dq_m, ddq_m, val(disk.k_t), val(disk.d_t), moment)
-            rows["q1"], rows["q2"] = psi[0], psi[1]
-    R = sm.Matrix([rows[n] for n in coords])
-    G = sm.Matrix(G_rows) if G_rows else None
+    parts = [comp for _, comp in components(spec)]
+    coords = [n for comp in parts for n in _hook(comp, "coordinates", lambda: ())()]
+    algebraic = [n for comp in parts for n in _hook(comp, "deformations", lambda: ())()]
+    ctx = Assembly(sm, spec, coords, algebraic, kronecker=kronecker, keep_q3=keep_q3, engagement=engagement)
+    for phase in PHASES:
+        for comp in parts:
+            _hook(comp, phase, lambda ctx: None)(ctx)
+    missing = [n for n in coords if n not in ctx.rows]
+    if missing:
+        raise ValueError(f"model '{spec.name}': no residual row for coordinate(s) {', '.join(missing)}")
+    R = sm.Matrix([ctx.rows[n] for n in coords])
+    G = sm.Matrix(ctx.G_rows) if ctx.G_rows else None
+    val = ctx.val
     return Equations(
-        spec=spec, coords=tuple(coords), algebraic=tuple(algebraic), R=R, G=G, Q=[Q[n] for n in coords],
-        dQ=[dQ[n] for n in coords], ddQ=[ddQ[n] for n in coords], L=[L[n] for n in algebraic],
-        dL=[dL[n] for n in algebraic], params=[val.sym[n] for n in spec.parameters],
-        param_names=tuple(val.pname[n] for n in spec.parameters), pads=tuple(contacts),
-        tangential=tuple(tangential), reduced=red, kinematics=kin, constraint_qdot=qdot, backend=backend,
+        spec=spec, coords=tuple(coords), algebraic=tuple(algebraic), R=R, G=G, Q=[ctx.Q[n] for n in coords],
+        dQ=[ctx.dQ[n] for n in coords], ddQ=[ctx.ddQ[n] for n in coords], L=[ctx.L[n] for n in algebraic],
+        dL=[ctx.dL[n] for n in algebraic], params=[val.sym[n] for n in spec.parameters],
+        param_names=tuple(val.pname[n] for n in spec.parameters), pads=tuple(ctx.contacts.values()),
+        tangential=tuple(ctx.tangential.values()), reduced=ctx.reduced, kinematics=ctx.kinematics,
+        constraint_qdot=ctx.qdot, backend=backend,
     )  # fmt: skip
+
+
+def energy_terms(eq: Equations) -> dict[str, Any]:
+    """The energy of a model's motion, summed over its components' ``energy`` hooks.
+
+    Parameters
+    ----------
+    eq : Equations
+        The model's assembled equations.
+
+    Returns
+    -------
+    dict
+        Every name of :data:`ENERGY_TERMS` → its expression (kinetic energy by degree in the tilt rates
+        ``T2, T1, T0``; potentials ``V_support`` of supports and ``V_pads`` of pad springs and preloads).
+
+    Raises
+    ------
+    ValueError
+        If a hook returns a term that is not one of :data:`ENERGY_TERMS`.
+    """
+    ctx = Assembly.of(eq)
+    total = {k: ctx.sm.Integer(0) for k in ENERGY_TERMS}
+    for _, comp in components(eq.spec):
+        for k, v in _hook(comp, "energy", lambda ctx: {})(ctx).items():
+            if k not in total:
+                raise ValueError(f"{type(comp).__name__}.energy returned '{k}'; the terms are "
+                                 f"{', '.join(ENERGY_TERMS)}")
+            total[k] += v
+    return total
+
+
+def _hook(comp: Any, name: str, default: Callable[..., Any]) -> Callable[..., Any]:
+    """A component's physics hook, or ``default`` when its class defines none (a kind with data only)."""
+    return getattr(comp, name, None) or default
 
 
 def _psi_without_kronecker(sm: Any, kin: Any, I3: Any, con: Any, dq_m: Any, ddq_m: Any, k_t: Any, d_t: Any,
