@@ -29,6 +29,21 @@ Mechanical Systems*, eq. 7.58):
 
 A grazing crossing (``|grad h . f-|`` tiny) or an immediate re-crossing
 (sliding) stops with an explicit status instead of returning wrong sensitivities.
+
+With an implicit method (``"Radau"``, ``"BDF"``, ``"LSODA"``: stiff systems, e.g. pads with a
+tangential damper, whose modes decay at ``k_ip / d_ip``) the integrator is given the Jacobian of the
+augmented right-hand side (:func:`augmented_jacobian`): with ``Z`` stored row-major,
+
+.. math::
+
+   \frac{\partial (x', Z')}{\partial (x, Z)} = \begin{pmatrix} A & 0 \\ C & A \otimes I_{n+1} \end{pmatrix},
+   \qquad C_{(i, j), l} = \sum_k \partial_{x_l} A_{ik} Z_{kj} + \delta_{jn} \partial_p A_{il},
+
+``C`` by central differences of the mode's Jacobian (``augmented_jacobian="full"``) or dropped
+(``"block"``, default): the Newton iterations of an implicit method only need an approximation of the
+Jacobian, and the dropped block is strictly lower triangular in the (x, Z) blocks, so it delays
+their convergence by at most one iteration (the x block does not depend on ``Z``, and ``Z`` is linear).
+SciPy would otherwise difference the ``n (n + 2)`` augmented equations.
 """
 
 from __future__ import annotations
@@ -43,7 +58,12 @@ from scipy.integrate import solve_ivp
 from ..errors import BrakesquealError, ParameterError
 from .system import PiecewiseSystem, SmoothSystem, Transition
 
-__all__ = ["Flow", "FlowResult", "ScipyFlow", "FlowError", "Event"]
+__all__ = ["Flow", "FlowResult", "ScipyFlow", "FlowError", "Event", "IMPLICIT_METHODS", "augmented_jacobian"]
+
+#: ``solve_ivp`` methods that use a Jacobian (implicit, for stiff systems).
+IMPLICIT_METHODS: tuple[str, ...] = ("Radau", "BDF", "LSODA")
+#: ``solve_ivp`` methods :class:`ScipyFlow` accepts.
+METHODS: tuple[str, ...] = ("DOP853", "RK45", "RK23") + IMPLICIT_METHODS
 
 
 class FlowError(BrakesquealError):
@@ -163,8 +183,9 @@ class ScipyFlow:
     system : SmoothSystem or PiecewiseSystem
         The system.
     method : str
-        A ``solve_ivp`` explicit method (``"DOP853"`` default, ``"RK45"``,
-        ``"Radau"``, ...).
+        A ``solve_ivp`` method: explicit ``"DOP853"`` (default), ``"RK45"``, ``"RK23"``, or implicit
+        ``"Radau"``, ``"BDF"``, ``"LSODA"`` for stiff systems (given the Jacobian of the augmented system,
+        see the module docstring).
     rtol : float
         Relative tolerance (default ``1e-11``), in ``[1e-13, 1e-3]``.
     atol : float or ndarray, optional
@@ -174,6 +195,14 @@ class ScipyFlow:
         ``"variational"`` (default) or ``"finite-difference"``.
     max_events : int
         Maximum number of switching events in one flow (default 1000).
+    augmented_jacobian : str
+        Implicit methods only: ``"block"`` (default; the blocks ``A`` and ``A (x) I``, without the
+        coupling ``dA/dx Z``) or ``"full"`` (with it, by central differences of the mode's Jacobian).
+    atol_monodromy : float, optional
+        Absolute tolerance of the monodromy's entries (default ``1e-3 rtol``).  A mode whose Jacobian
+        is a finite difference with large entries (pads with a stiff damper: ``k_ip / d_ip``) has rounding
+        noise in ``A Z`` that this tolerance, not the dynamics, then limits the step to; ``rtol``
+        (the monodromy to ``rtol`` of its O(1) scale) removes that limit.
     """
 
     system: Any
@@ -182,6 +211,8 @@ class ScipyFlow:
     atol: Any = None
     monodromy: Literal["variational", "finite-difference"] = "variational"
     max_events: int = 1000
+    augmented_jacobian: Literal["block", "full"] = "block"
+    atol_monodromy: float | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.system, (SmoothSystem, PiecewiseSystem)):
@@ -194,7 +225,22 @@ class ScipyFlow:
             raise ParameterError(
                 f"The option 'monodromy' must be 'variational' or 'finite-difference'; got {self.monodromy!r}"
             )
+        if self.method not in METHODS:
+            raise ParameterError(f"The option 'method' must be one of {', '.join(METHODS)}; got {self.method!r}")
+        if self.augmented_jacobian not in ("block", "full"):
+            raise ParameterError(
+                f"The option 'augmented_jacobian' must be 'block' or 'full'; got {self.augmented_jacobian!r}"
+            )
+        if self.atol_monodromy is not None and not (
+            isinstance(self.atol_monodromy, (int, float)) and 0 < self.atol_monodromy < 1
+        ):
+            raise ParameterError(f"The option 'atol_monodromy' must be in (0, 1); got {self.atol_monodromy!r}")
         self._pw = self.system.as_piecewise()
+
+    @property
+    def implicit(self) -> bool:
+        """``True`` for an implicit (stiff) method, which is given the augmented Jacobian."""
+        return self.method in IMPLICIT_METHODS
 
     # ------------------------------------------------------------------ API
     def __call__(self, x0: np.ndarray, T: float, p: float, *, sensitivities: bool = True, n_samples: int = 0,
@@ -244,7 +290,8 @@ class ScipyFlow:
         if not sens:
             return ax
         # Z = [M | x_p]: M entries are O(1); x_p scaled like x per unit of p (rtol dominates in practice)
-        Z = np.column_stack([np.full((n, n), 1e-3 * self.rtol), ax])
+        am = 1e-3 * self.rtol if self.atol_monodromy is None else float(self.atol_monodromy)
+        Z = np.column_stack([np.full((n, n), am), ax])
         return np.concatenate([ax, Z.ravel()])
 
     def _integrate(self, x0: np.ndarray, T: float, p: float, sens: bool, n_samples: int,
@@ -267,6 +314,12 @@ class ScipyFlow:
             msys = pw.modes[mode]
             trans = pw.transitions[mode]
             rhs = _rejecting(_augmented_rhs(msys, p, n) if sens else (lambda _t, yy, _m=msys: _m.rhs(yy, p)))
+            jac_opt: dict[str, Any] = {}
+            if self.implicit:
+                full = self.augmented_jacobian == "full"
+                jac_opt["jac"] = _jac_failing(
+                    (lambda _t, yy, _m=msys: augmented_jacobian(_m, yy, p, coupling=full)) if sens
+                    else (lambda _t, yy, _m=msys: _m.jacobian(yy, p)))
             evs = []
             dirs = [float(start_dirs.get(i, tr.direction)) for i, tr in enumerate(trans)]
             # a guard that is zero at the segment start (just after an event) would report a root there:
@@ -296,7 +349,7 @@ class ScipyFlow:
             if t_samp is not None:
                 t_eval = np.append(t_samp[k_next:], T)
             sol = solve_ivp(rhs, (t, T), y, method=self.method, rtol=self.rtol, atol=atol, events=evs or None,
-                            t_eval=t_eval, dense_output=bool(trans))  # fmt: skip
+                            t_eval=t_eval, dense_output=bool(trans), **jac_opt)  # fmt: skip
             nfev += int(sol.nfev)
             if sol.status == -1:
                 raise FlowError(f"integration failed at t = {t:.6g} s: {sol.message}")
@@ -498,3 +551,77 @@ def _augmented_rhs(msys: SmoothSystem, p: float, n: int) -> Any:
         return np.concatenate((np.asarray(f(x, p), dtype=float), dZ.ravel()))
 
     return rhs
+
+
+def _jac_failing(jac: Any) -> Any:
+    """``jac`` raising :class:`FlowError` where the Jacobian cannot be evaluated (no NaN into the LU)."""
+
+    def safe(t: float, y: np.ndarray) -> np.ndarray:
+        try:
+            J = jac(t, y)
+        except ParameterError as exc:
+            raise FlowError(f"the Jacobian cannot be evaluated at t = {t:.6g} s: {exc}") from exc
+        if not np.all(np.isfinite(J)):
+            raise FlowError(f"the Jacobian is not finite at t = {t:.6g} s")
+        return J
+
+    return safe
+
+
+def augmented_jacobian(system: SmoothSystem, y: np.ndarray, p: float, *, coupling: bool = True,
+                       step: float | None = None) -> np.ndarray:  # fmt: skip
+    r"""Jacobian of the state augmented with the variational equations (see the module docstring).
+
+    The augmented state is ``y = (x, Z)`` with ``Z = [M | x_p]`` (``n x (n + 1)``, row-major) and
+    ``y' = (f(x, p), A(x, p) Z + [0 | f_p(x, p)])``.
+
+    Parameters
+    ----------
+    system : SmoothSystem
+        The (mode's) vector field with its Jacobian ``A = f_x``.
+    y : ndarray, shape (n (n + 2),)
+        Augmented state.
+    p : float
+        Parameter.
+    coupling : bool
+        Include the block ``d(A Z + [0 | f_p]) / dx`` (fourth-order central differences of ``A`` along
+        each coordinate, step ``eps**(1/5) max(1, |x_l|)``, and ``dA/dp``); without it the Jacobian is
+        block diagonal (exact for a linear system).
+    step : float, optional
+        Relative finite-difference step of the coupling (default ``eps**(1/5)``).
+
+    Returns
+    -------
+    ndarray, shape (n (n + 2), n (n + 2))
+        ``[[A, 0], [C, A (x) I_{n+1}]]``.
+
+    Raises
+    ------
+    ParameterError
+        ``y`` has the wrong size.
+    """
+    n = system.n
+    n1 = n + 1
+    y = np.asarray(y, dtype=float)
+    if y.shape != (n * (n + 2),):
+        raise ParameterError(f"augmented_jacobian: 'y' must have n (n + 2) = {n * (n + 2)} entries; got {y.shape}")
+    x = y[:n]
+    A = system.jacobian(x, p)
+    N = n * (n + 2)
+    J = np.zeros((N, N))
+    J[:n, :n] = A
+    J[n:, n:] = np.kron(A, np.eye(n1))
+    if coupling:
+        Z = y[n:].reshape(n, n1)
+        rel = float(step) if step is not None else float(np.finfo(float).eps) ** (1 / 5)
+        C = np.empty((n, n1, n))  # C[i, j, l] = d(A Z)_{ij} / dx_l
+        for l_ in range(n):
+            h = rel * max(1.0, abs(float(x[l_])))
+            e = np.zeros(n)
+            e[l_] = h
+            Ak = {k: system.jacobian(x + k * e, p) for k in (-2, -1, 1, 2)}
+            dA = (8 * (Ak[1] - Ak[-1]) - (Ak[2] - Ak[-2])) / (12 * h)
+            C[:, :, l_] = dA @ Z
+        C[:, n, :] += system.A_p(x, p)  # d f_p / dx = d A / dp
+        J[n:, :n] = C.reshape(n * n1, n)
+    return J
