@@ -446,7 +446,7 @@ def bench_exact_pads_branch(*, points: int = 200) -> list[BenchResult]:
     harmonic_branch(space, axis, max_points=points, stop_at_contact_loss=False, stability=False)
     t_nostab = time.perf_counter() - t0
     t0 = time.perf_counter()
-    qs = squeal_branch(space, axis, max_points=points, ds_max=0.2)
+    qs = squeal_branch(space, axis, max_points=points)  # cycles' settings
     t_qs = time.perf_counter() - t0
     n_qs = int(qs.data.sizes["point"])
     return [

@@ -44,10 +44,12 @@ def _soft_by_hand(space: ParameterSpace) -> set[str]:
 @pytest.mark.parametrize("name", sorted(MODELS))
 def test_the_route_follows_the_pads_of_every_built_in_model(name):
     spec = get_model(name)
-    for preset in spec.presets:
-        space = ParameterSpace.from_preset(preset.name)
+    names = spec.preset_names()
+    assert names  # every built-in model has presets
+    for preset in names:
+        space = ParameterSpace.from_preset(preset)
         soft = _soft_by_hand(space)
-        assert set(soft_quasi_static_pads(space)) == soft, preset.name
+        assert set(soft_quasi_static_pads(space)) == soft, preset
         assert cycle_route(space) == ("harmonic balance" if soft else "shooting")
         assert cycle_route(space, pads="quasi-static") == "shooting"
         assert cycle_route(space, pads="exact") == "harmonic balance"
@@ -251,9 +253,51 @@ def test_both_routes_share_the_summary_keys_of_the_json(capsys):
     common = {"status", "message", "contact_loss", "contact", "summary", "special_points", "hysteresis_range",
               "in_contact_up_to", "amplitude_at_last_contact_point", "frequency_hz_at_last_contact_point"}
     assert common <= set(hb) and common <= set(shot)
+    assert (hb["route"], shot["route"]) == ("harmonic balance", "shooting")
+    assert hb["n_points"] == len(hb["points"]) and shot["n_points"] == shot["points"]
     assert hb["special_points"][0] == {"kind": "H", "p": hb["hopf"]["p0"]}
     # the last orbit with every pad pressed: the last point (the branch ends at a located contact loss, if any)
     assert all(min(pt["F_n_min"]) > 0 for pt in hb["points"]) and hb["in_contact_up_to"] == hb["points"][-1]["p"]
     last = hb["points"][-1]
     assert hb["amplitude_at_last_contact_point"] == last["amplitude"]
     assert hb["frequency_hz_at_last_contact_point"] == last["frequency_hz"]
+
+
+def _synthetic_branch(ps, stable, fmin, criticality="subcritical"):
+    """A HarmonicBranch assembled by hand: only the fields the summary reads carry meaning."""
+    from types import SimpleNamespace
+
+    from brakesqueal.nonlinear.harmonic import HarmonicBranch, HarmonicPoint
+
+    pts = tuple(HarmonicPoint(p, 10.0, 10.0 / (2 * np.pi), {"q1": 1e-3 * (i + 1)}, 1e-3 * (i + 1), (f, f), 1.0,
+                              1e-12, 1e-9, 6, np.zeros((1, 13)), None, st, None, None, (3000.0, 3000.0))
+                for i, (p, st, f) in enumerate(zip(ps, stable, fmin)))
+    h = SimpleNamespace(p0=0.0, criticality=criticality, side=1, omega0=10.0, frequency0_hz=1.6, l1=1.0,
+                        l1_error=0.0)
+    return HarmonicBranch("p", SimpleNamespace(hopf=h), pts, "max_points", "", None, None, ("q1",), ("1", "2"))
+
+
+def test_the_summary_reads_folds_verdicts_and_contact_like_shooting():
+    ps = [0.1, 0.2, 0.3, 0.34, 0.3, 0.2]
+    # unstable cycles, no verdict around the fold (an exponent crossing 0), then stable ones: hysteresis
+    b = _synthetic_branch(ps, [False, False, None, None, None, True], [2000.0] * 6)
+    s = b.summary
+    assert len(b.folds) == 1 and 0.34 <= b.folds[0] <= 0.36
+    assert s.hysteresis_range == (0.0, b.folds[0]) and s.squeal_range == (0.2, 0.2)
+    # the pads lift off before the first verdict after the fold: the bilateral branch is not valid there
+    lifted = _synthetic_branch(ps, [False, False, None, None, None, True], [2000.0, 1000.0, 500.0, -1.0, 5.0, 9.0])
+    sl = lifted.summary
+    assert sl.hysteresis_range is None and sl.squeal_range is None
+    # the first run of pressed orbits only: the orbits after the first lift-off are not valid even if F_n > 0
+    assert [r["duty_cycle"][0] for r in sl.table] == [1.0, 1.0, 1.0, None, None, None]
+    assert lifted.to_dict()["in_contact_up_to"] == 0.3
+    # a branch without verdicts says so rather than "no stable limit cycle"
+    none = _synthetic_branch(ps[:3], [None] * 3, [2000.0] * 3, "supercritical")
+    text = none.summary.text(rows=0)
+    assert "stability not computed" in text and "no stable limit cycle" not in text
+    assert none.to_dict()["route"] == "harmonic balance" and none.to_dict()["n_points"] == 3
+
+
+def test_quasi_static_pads_do_not_combine_with_kept_rates(capsys):
+    assert main(["cycles", *FIG3, "--pads", "quasi-static", "--pad-damping", "10"]) == 2
+    assert "--pads quasi-static" in capsys.readouterr().err

@@ -246,10 +246,12 @@ def cycles(
                                              "implicit equations, the massless Coulomb pads exact (tangential rates "
                                              "kept, no regularisation); bilateral, to the located contact "
                                              "loss.")] = False,
-    harmonics: Annotated[int, typer.Option("--harmonics", min=1, max=200, help="With --exact-pads: initial number "
-                                           "of harmonics (raised while the truncation error exceeds 1e-6).")] = 6,
-    max_harmonics: Annotated[int, typer.Option("--max-harmonics", min=1, max=400, help="With --exact-pads: largest "
-                                               "number of harmonics (the branch stops where more are needed).")] = 60,
+    harmonics: Annotated[int, typer.Option("--harmonics", min=1, max=200, help="Harmonic-balance route (soft "
+                                           "Coulomb pads by default, or --pads exact): initial number of harmonics "
+                                           "(raised while the truncation error exceeds 1e-6).")] = 6,
+    max_harmonics: Annotated[int, typer.Option("--max-harmonics", min=1, max=400, help="Harmonic-balance route: "
+                                               "largest number of harmonics (the branch stops where more are "
+                                               "needed).")] = 60,
 ) -> None:
     """Limit cycles from the first Hopf point on a path: amplitude, frequency, stability, where a pad lifts off."""
     from ..analysis.maps import parse_axis
@@ -265,6 +267,9 @@ def cycles(
         if pads == "quasi-static":
             raise ParameterError("The option '--exact-pads' cannot be combined with --pads quasi-static")
         pads = "exact"
+    if pads == "quasi-static" and (pad_damping is not None or pad_slope is not None):
+        raise ParameterError("The option '--pads quasi-static' cannot be combined with --pad-damping or --pad-slope "
+                             "(they keep the pads' rates)")
     base = space_from(model, preset, params, set_)
     space = pads_option(base, pad_slope, stick_speed, pad_damping)  # checked before anything is computed
     if cycle_route(space, axis, contact=contact, pads=pads) == "harmonic balance":
@@ -326,8 +331,8 @@ def _cycles_exact_pads(axis: Any, space: Any, *, fmt: OutFormat, max_points: int
     for flag, bad in (("--contact unilateral", contact != "bilateral"), ("--pad-slope", pad_slope is not None),
                       ("--stick-speed", stick_speed is not None)):
         if bad:
-            raise ParameterError(f"The option '--pads exact' cannot be combined with {flag} (the exact pads are "
-                                 "bilateral and unregularised)")
+            raise ParameterError(f"The option '--pads exact' (or --exact-pads) cannot be combined with {flag} (the "
+                                 "exact pads are bilateral and unregularised)")
     space = pads_option(space, None, None, pad_damping)  # a damper is part of the model: balanced exactly too
     if max_harmonics < harmonics:
         raise ParameterError(f"The option '--max-harmonics' must be >= --harmonics = {harmonics}; got {max_harmonics}")

@@ -696,7 +696,7 @@ def cycles_view(space: Any, along: str, rng: SliderRange) -> CyclesView:
     if harmonic:
         from ..nonlinear.harmonic import harmonic_branch
 
-        br: Any = harmonic_branch(space, axis)
+        br: Any = harmonic_branch(space, axis, max_points=25, max_harmonics=40)  # bounded: an interactive view
     else:
         br = squeal_branch(space, axis)
     s = br.summary

@@ -188,7 +188,8 @@ class HarmonicBranch:
         summ = self.summary
         pressed = [pt for pt, row in zip(self.points, summ.table) if row["duty_cycle"][0] is not None]
         last = pressed[-1] if pressed else None
-        return {"parameter": self.parameter, "method": "harmonic balance on the implicit equations "
+        return {"parameter": self.parameter, "route": "harmonic balance", "n_points": len(self.points),
+                "method": "harmonic balance on the implicit equations "
                 "(exact massless Coulomb pads, tangential rates kept)",
                 "hopf": {"p0": h.p0, "omega0": h.omega0, "frequency_hz": h.frequency0_hz, "l1": h.l1,
                          "l1_error": h.l1_error, "criticality": h.criticality, "side": h.side},
@@ -199,7 +200,7 @@ class HarmonicBranch:
                 # the keys of the shooting route's JSON (SquealBranch.to_dict) that mean the same here
                 "contact": "bilateral", "hysteresis_range": summ.hysteresis_range,
                 "special_points": [{"kind": "H", "p": h.p0}] + [{"kind": "LPC", "p": f} for f in self.folds],
-                "in_contact_up_to": last.p if last is not None else None,
+                "in_contact_up_to": last.p if last is not None else h.p0,
                 "amplitude_at_last_contact_point": dict(last.amplitude) if last is not None else None,
                 "frequency_hz_at_last_contact_point": last.frequency_hz if last is not None else None}
 
@@ -216,17 +217,22 @@ class HarmonicBranch:
     def summary(self) -> Any:
         """The engineer's summary (:class:`~.models.SquealSummary`) of the branch, as for shooting.
 
-        The squeal range spans the stable orbits with every pad pressed (the located contact-loss orbit
-        included); points without a stability verdict count as neither.  The hysteresis range, as for
-        shooting, lies between a subcritical Hopf point and the first fold (:attr:`folds`) where the unstable
-        cycles turn into stable ones, here only if the pads are pressed up to there.
+        The branch is valid (bilateral contact) from the onset up to its first orbit on which a pad lifts off:
+        every pad's smallest normal force at least ``-1e-6`` times that orbit's largest (the located contact-loss
+        orbit, at ``F_n = 0`` to rounding, included).  The squeal range spans the stable valid orbits; orbits
+        without a stability verdict count as neither.  The hysteresis range, as for shooting, lies between a
+        subcritical Hopf point and the first fold (:attr:`folds`) where the unstable cycles turn into stable ones
+        (the first orbit with a verdict after the turn is stable; right at the fold an exponent crosses 0 and the
+        orbits have no verdict), here only if the branch is valid up to there.
         """
         from .models import SquealSummary
 
         h = self.hopf.hopf
         pts = self.points
-        fmax = max((max(pt.F_n_max) for pt in pts if pt.F_n_max), default=1.0)
-        valid = [min(pt.F_n_min) >= -1e-6 * fmax for pt in pts]
+        valid: list[bool] = []
+        for pt in pts:  # the first run of pressed orbits
+            pressed = min(pt.F_n_min) >= -1e-6 * max(max(pt.F_n_max, default=0.0), 1e-300)
+            valid.append(pressed and (not valid or valid[-1]))
         ok = [pt.p for pt, v in zip(pts, valid) if v and pt.stable]
         rng = (min(ok), max(ok)) if ok else None
         folds = self.folds
@@ -234,8 +240,9 @@ class HarmonicBranch:
         pv = np.array([h.p0] + [pt.p for pt in pts])
         turns = [i for i in range(1, pv.size - 1) if (pv[i] - pv[i - 1]) * (pv[i + 1] - pv[i]) < 0]
         if h.criticality == "subcritical" and turns:  # unstable cycles turning into stable ones (as shooting)
-            after = turns[0]  # the orbit after the first turn is points[turns[0]]
-            if after < len(pts) and pts[after].stable and all(valid[:after + 1]):
+            # points[turns[0]] is the first orbit after the turn; take the first one with a verdict
+            j = next((k for k in range(turns[0], len(pts)) if pts[k].stable is not None), None)
+            if j is not None and pts[j].stable and valid[j]:
                 hyst = (min(folds[0], h.p0), max(folds[0], h.p0))
         table = [{"p": pt.p, "frequency_hz": pt.frequency_hz,
                   "tilt_amplitude": math.nan if pt.tilt_amplitude is None else pt.tilt_amplitude,

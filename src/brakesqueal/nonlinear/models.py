@@ -376,9 +376,10 @@ def cycle_route(space: Any, axis: Any = None, *, contact: str = "bilateral", pad
         return "shooting"
     if pads == "exact":
         if contact != "bilateral":
-            raise ParameterError("The option 'pads' = exact (harmonic balance) is bilateral, to the located contact "
-                                 "loss; through lift-off keep the pads' rates with a tangential damper (--pad-damping "
-                                 "D) or choose pads = quasi-static", parameter="pads")
+            raise ParameterError("The option 'pads' = exact (harmonic balance; --pads exact or --exact-pads) is "
+                                 "bilateral, to the located contact loss; through lift-off keep the pads' rates with "
+                                 "a tangential damper (--pad-damping D) or choose --pads quasi-static",
+                                 parameter="pads")
         return "harmonic balance"
     soft = soft_quasi_static_pads(space, axis, use_cache=use_cache)
     if not soft:
@@ -665,7 +666,9 @@ class SquealSummary:
         P = self.parameter
         lines = [f"squeal onset (linear): {P} = {self.onset:.10g}, {self.criticality} "
                  f"({'soft onset' if self.criticality == 'supercritical' else 'hard onset: jump to large squeal'})"]
-        if self.squeal_range is None:
+        if self.squeal_range is None and self.table and all(r["stable"] is None for r in self.table):
+            lines.append("stability not computed (or no verdict) on the computed branch")
+        elif self.squeal_range is None:
             lines.append("no stable limit cycle on the computed branch")
         else:
             lines.append(f"stable squeal on the computed branch for {P} in [{self.squeal_range[0]:.8g}, "
@@ -749,6 +752,7 @@ class SquealBranch:
         last = int(np.flatnonzero(ok)[-1]) if ok.any() else 0
         coords = [str(c) for c in ds["coord"].values]
         return {
+            "route": "shooting", "n_points": int(p.size),
             "hopf": self.hopf.to_dict(), "points": int(p.size), "status": self.branch.status,
             "message": self.branch.message, "contact_loss": self.contact_loss,
             "in_contact_up_to": float(p[last]),

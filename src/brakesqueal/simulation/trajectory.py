@@ -674,7 +674,7 @@ class Trajectory:
         s = summarize(self.status, t, y - y_s, self.modes, output_rate=fs, x_start=x_start,
                       integration_error=self.integration_error_bound(t, y - y_s), coordinates=self.n)  # fmt: skip
         soft = self.soft_quasi_static_pads
-        if soft and s.regime != "linear":
+        if soft and s.regime == "nonlinear":
             extra += (f"pads {', '.join(soft)} are quasi-static (ldot := 0; their k_ip is finite): exact in the "
                       "linear regime, only to first order beyond it; --pad-damping D keeps their rates "
                       "(docs/nonlinear.md)",)
