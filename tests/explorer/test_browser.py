@@ -175,7 +175,7 @@ def test_limit_cycles_end_at_the_contact_loss(page):
     assert s["cycles"]["points"] >= 3
     from brakesqueal.nonlinear.harmonic import harmonic_branch
 
-    hb = harmonic_branch(space, Axis("Omega", rng.low, rng.high, 2, rng.log))
+    hb = harmonic_branch(space, Axis("Omega", rng.low, rng.high, 2, rng.log), max_points=25, max_harmonics=40)
     assert hb.contact_loss is not None and s["cycles"]["contact_loss"] == pytest.approx(hb.contact_loss, rel=1e-9)
     assert s["cycles"]["contact_loss"] > onset.hopf.p0
     page.screenshot("cycles")
