@@ -147,6 +147,10 @@ def test_harmonic_balance_folds_agree_with_shooting():
     # located to the step: within 1 % of the fold's distance from the onset (2e-5 relative measured)
     assert abs(hb.folds[0] - lpc[0]) < 0.01 * abs(lpc[0] - p0), (hb.folds, lpc)
     assert hb.summary.folds == hb.folds and hb.summary.criticality == "subcritical"
+    # the fold lies past the contact loss: neither route's summary claims a hysteresis the bilateral model cannot
+    # describe (the shooting branch itself has one: unstable cycles turn stable at the fold)
+    assert shot.branch.hysteresis_range is not None
+    assert shot.summary.hysteresis_range is None and hb.summary.hysteresis_range is None
 
 
 def _hill_complex_companion(J, n, m, H, omega):

@@ -1048,7 +1048,8 @@ def squeal_summary(branch: SquealBranch) -> SquealSummary:
     SquealSummary
         The squeal range is the span of the stable points that are valid
         (every pad pressed for a bilateral branch); the hysteresis range is
-        the branch's (fold to Hopf point), or, for any fold of cycles on the
+        the branch's (fold to Hopf point; on a bilateral branch only if every
+        pad is pressed up to the fold), or, for any fold of cycles on the
         far side of the onset from the cycles' birth, the range between it
         and the onset.
     """
@@ -1067,6 +1068,10 @@ def squeal_summary(branch: SquealBranch) -> SquealSummary:
             rng = (min(rng[0], loss), max(rng[1], loss))  # stable up to the located contact loss
     folds = [float(v) for k, v in zip(ds["special_kind"].values, ds["special_p"].values) if str(k) == "LPC"]
     hyst = branch.branch.hysteresis_range
+    if hyst is not None and branch.contact == "bilateral":
+        lpc = [int(i) for k, i in zip(ds["special_kind"].values, ds["special_index"].values) if str(k) == "LPC"]
+        if lpc and not valid[:lpc[0] + 1].all():
+            hyst = None  # the fold lies past the first contact loss: the bilateral branch does not describe it
     if hyst is None and folds and h is not None and h.side:
         beyond = [f for f in folds if (f - onset) * h.side < 0]  # a fold on the linearly stable side
         if beyond and ok.any():
