@@ -305,3 +305,18 @@ def test_the_summary_reads_folds_verdicts_and_contact_like_shooting():
 def test_quasi_static_pads_do_not_combine_with_kept_rates(capsys):
     assert main(["cycles", *FIG3, "--pads", "quasi-static", "--pad-damping", "10"]) == 2
     assert "--pads quasi-static" in capsys.readouterr().err
+
+
+def test_the_bifurcation_diagram_marks_the_folds():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    b = _synthetic_branch([0.1, 0.2, 0.3, 0.34, 0.3, 0.2], [False, False, None, None, None, True], [2000.0] * 6)
+    fig = b.plot()
+    ax = fig.axes[0]
+    labels = ax.get_legend_handles_labels()[1]
+    assert "fold (LPC)" in labels and "Hopf point" in labels
+    (line,) = [ln for ln in ax.lines if ln.get_label() == "fold (LPC)"]
+    assert line.get_xdata()[0] == pytest.approx(b.folds[0]) and line.get_ydata()[0] == pytest.approx(4e-3)
+    plain = _synthetic_branch([0.1, 0.2, 0.3], [True] * 3, [2000.0] * 3, "supercritical")
+    assert "fold (LPC)" not in plain.plot().axes[0].get_legend_handles_labels()[1]

@@ -296,8 +296,8 @@ class HarmonicBranch:
     def plot(self, coord: str | None = None) -> Any:
         """Bifurcation diagram: first-harmonic amplitude and frequency against the parameter.
 
-        Stable orbits solid, unstable dashed, not judged grey; the Hopf point and a located contact loss or
-        sliding reversal are marked.
+        Stable orbits solid, unstable dashed, not judged grey; the Hopf point, the folds (located to the step,
+        :attr:`folds`) and a located contact loss or sliding reversal are marked.
 
         Parameters
         ----------
@@ -329,6 +329,9 @@ class HarmonicBranch:
                 ls, col = style[st[i]]
                 a.plot(p[i - 1:i + 1], yv[i - 1:i + 1], ls, color=col, lw=1.5)
         axes[0].plot([h.p0], [0.0], "s", color="k", ms=7, label="Hopf point", zorder=5)
+        turns = [i for i in range(1, p.size - 1) if (p[i] - p[i - 1]) * (p[i + 1] - p[i]) < 0]
+        for k, (i, f) in enumerate(zip(turns, self.folds)):  # at the fold's parameter, the turning orbit's amplitude
+            axes[0].plot([f], [amp[i]], "o", color="C1", ms=7, zorder=5, label="fold (LPC)" if k == 0 else None)
         for at, lab, col in ((self.contact_loss, "contact loss", "C6"), (self.sliding_reversal, "sliding reversal",
                                                                           "C5")):
             if at is not None:
