@@ -282,25 +282,7 @@ class HopfPoint:
         return d
 
 
-def _soft_quasi_static(sim: Any, params: Any) -> bool:
-    """Whether a pad the simulation treats quasi-statically has a finite tangential stiffness (not exact)."""
-    return bool(_soft_quasi_static_names(sim, params))
-
-
-def _soft_quasi_static_names(sim: Any, params: Any) -> list[str]:
-    kinds = dict(zip(sim.unknown_pads, sim.pad_kinds))
-    out = []
-    for pad in params.model.pads:
-        if kinds.get(pad.name) != "quasi-static":
-            continue
-        k = pad.k_ip
-        value = float(params[k]) if isinstance(k, str) else float(k)
-        if not math.isinf(value):
-            out.append(pad.name)
-    return out
-
-
-def soft_quasi_static_pads(space: Any, axis: Any = None, *, use_cache: bool = True) -> tuple[str, ...]:
+def soft_quasi_static_pads(space: Any, axis: Any = None) -> tuple[str, ...]:
     """Pads whose tangential rate the simulation drops (``ldot := 0``) although their ``k_ip`` is finite.
 
     These are the massless pads with Coulomb friction, no tangential damper and a finite ``k_ip``
@@ -313,26 +295,22 @@ def soft_quasi_static_pads(space: Any, axis: Any = None, *, use_cache: bool = Tr
         The model, preset and overrides.
     axis : Axis, optional
         A path; its two ends are checked as well as the preset's values.
-    use_cache : bool
-        Use the on-disk code cache.
 
     Returns
     -------
     tuple of str
         Pad names, in the model's order (empty when the simulated equations are exact).
     """
-    from ..simulation import simulation_model
+    from ..simulation.trajectory import soft_quasi_static_pads as soft_at
 
     params = space.resolve({})
-    sim = simulation_model(params.model, use_cache=use_cache)
     where = [params] + ([space.resolve({axis.name: float(v)}) for v in (axis.start, axis.stop)]
                         if axis is not None else [])
-    soft = {pad for pv in where for pad in _soft_quasi_static_names(sim, pv)}
+    soft = {pad for pv in where for pad in soft_at(pv)}
     return tuple(p.name for p in params.model.pads if p.name in soft)
 
 
-def cycle_route(space: Any, axis: Any = None, *, contact: str = "bilateral", pads: str = "auto",
-                use_cache: bool = True) -> str:
+def cycle_route(space: Any, axis: Any = None, *, contact: str = "bilateral", pads: str = "auto") -> str:
     """The route that computes limit cycles of a model with the pads' true tangential dynamics.
 
     Parameters
@@ -381,7 +359,7 @@ def cycle_route(space: Any, axis: Any = None, *, contact: str = "bilateral", pad
                                  "a tangential damper (--pad-damping D) or choose --pads quasi-static",
                                  parameter="pads")
         return "harmonic balance"
-    soft = soft_quasi_static_pads(space, axis, use_cache=use_cache)
+    soft = soft_quasi_static_pads(space, axis)
     if not soft:
         return "shooting"
     if contact == "bilateral":
@@ -432,6 +410,7 @@ def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = 
         a failed refinement) has ``hopf = None`` and a message.
     """
     from ..analysis.crossings import crossings
+    from ..simulation.trajectory import soft_quasi_static_pads as soft_at
     from .implicit import exact_lyapunov
 
     r = crossings(space, axis) if result is None else result
@@ -448,7 +427,7 @@ def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = 
             continue
         h = ex.hopf
         simulated, note = None, ""
-        soft = _soft_quasi_static(sim, space.resolve({axis.name: h.p0}))
+        soft = bool(soft_at(space.resolve({axis.name: h.p0})))
         if soft or tuple(h.state_names) != tuple(system.state_names or ()):
             # the simulated equations' own normal form (their state; with soft pads also their approximation)
             try:
@@ -818,6 +797,14 @@ def stiffness_ratio(system: SmoothSystem, x: np.ndarray, p: float, omega: float)
     return float(np.max(np.abs(ev))) / omega
 
 
+def _check_flow_method(flow_method: str | None) -> None:
+    from ..errors import ParameterError
+
+    if flow_method is not None and flow_method not in FLOW_METHODS:
+        raise ParameterError(f"The option 'flow_method' must be None or one of {', '.join(FLOW_METHODS)}; "
+                             f"got {flow_method!r}")
+
+
 def _shooting_flow(pw: PiecewiseSystem, h: Any, flow_method: str | None) -> tuple[Any, dict[str, Any]]:
     """The flow of a unilateral branch and what was chosen (stored in the branch's attrs).
 
@@ -827,12 +814,9 @@ def _shooting_flow(pw: PiecewiseSystem, h: Any, flow_method: str | None) -> tupl
     (with ``rtol``: 17 times faster at 1 N s/m, monodromy changed by 5e-11); Radau (rtol 1e-9, exact block
     Jacobian) was 1.4-1.6 times slower than that.  So the automatic choice stays DOP853 and relaxes the
     monodromy tolerance when the linearization is stiff (:data:`STIFF_RATIO`)."""
-    from ..errors import ParameterError
     from .flow import ScipyFlow
 
-    if flow_method is not None and flow_method not in FLOW_METHODS:
-        raise ParameterError(f"The option 'flow_method' must be None or one of {', '.join(FLOW_METHODS)}; "
-                             f"got {flow_method!r}")
+    _check_flow_method(flow_method)
     ratio = stiffness_ratio(pw.modes[0], h.x0, h.p0, abs(float(h.omega0)))
     stiff = ratio > STIFF_RATIO
     method = flow_method or "DOP853"
@@ -917,9 +901,7 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
 
     if contact not in ("bilateral", "unilateral"):
         raise ParameterError(f"The option 'contact' must be bilateral or unilateral; got {contact!r}")
-    if flow_method is not None and flow_method not in FLOW_METHODS:
-        raise ParameterError(f"The option 'flow_method' must be None or one of {', '.join(FLOW_METHODS)}; "
-                             f"got {flow_method!r}")
+    _check_flow_method(flow_method)
     if flow_method is not None and contact != "unilateral":
         raise ParameterError("The option 'flow_method' applies to contact='unilateral' (a bilateral branch is "
                              "shot with the compiled DOP853)")

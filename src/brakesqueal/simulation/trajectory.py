@@ -685,16 +685,8 @@ class Trajectory:
     @property
     def soft_quasi_static_pads(self) -> tuple[str, ...]:
         """Pads integrated quasi-statically (``ldot := 0``) although their ``k_ip`` is finite: exact only to
-        first order beyond the linear regime (``docs/nonlinear.md``)."""
-        quasi = {u for u in self.pad_unknowns if u not in self.dynamic}
-        out = []
-        for pad in self.params.model.pads:
-            if not ({f"l{pad.name}", f"l_{pad.name}"} & quasi):
-                continue
-            k = pad.k_ip
-            if not math.isinf(float(self.params[k]) if isinstance(k, str) else float(k)):
-                out.append(pad.name)
-        return tuple(out)
+        first order beyond the linear regime (:func:`soft_quasi_static_pads`)."""
+        return soft_quasi_static_pads(self.params)
 
     def integration_error_bound(self, t: np.ndarray, x: np.ndarray) -> float:
         """:func:`integration_error_bound` for this run over the samples ``x`` (deviations) at times ``t``.
@@ -914,3 +906,29 @@ class Trajectory:
                 w.setframerate(int(rate))
                 w.writeframes(pcm.tobytes())
         return int(pcm.size)
+
+
+def soft_quasi_static_pads(params: Any) -> tuple[str, ...]:
+    """Pads the simulation treats quasi-statically (``ldot := 0``, :func:`~._kernels.pad_treatment`) although
+    their ``k_ip`` is finite at ``params``: exact only to first order beyond the linear regime
+    (``docs/nonlinear.md``).
+
+    Parameters
+    ----------
+    params : Parameters
+        The model and its parameter values.
+
+    Returns
+    -------
+    tuple of str
+        Pad names, in the model's order.
+    """
+    from ._kernels import pad_treatment
+
+    spec = params.model
+    out = []
+    for pad, kind in zip([p for p in spec.pads if p.quasi_static], pad_treatment(spec)):
+        k = pad.k_ip
+        if kind == "quasi-static" and not math.isinf(float(params[k]) if isinstance(k, str) else float(k)):
+            out.append(pad.name)
+    return tuple(out)
