@@ -238,7 +238,7 @@ class HarmonicBranch:
         folds = self.folds
         hyst = None
         pv = np.array([h.p0] + [pt.p for pt in pts])
-        turns = [i for i in range(1, pv.size - 1) if (pv[i] - pv[i - 1]) * (pv[i + 1] - pv[i]) < 0]
+        turns = _turns(pv)
         if h.criticality == "subcritical" and turns:  # unstable cycles turning into stable ones (as shooting)
             # points[turns[0]] is the first orbit after the turn; take the first one with a verdict
             j = next((k for k in range(turns[0], len(pts)) if pts[k].stable is not None), None)
@@ -329,7 +329,7 @@ class HarmonicBranch:
                 ls, col = style[st[i]]
                 a.plot(p[i - 1:i + 1], yv[i - 1:i + 1], ls, color=col, lw=1.5)
         axes[0].plot([h.p0], [0.0], "s", color="k", ms=7, label="Hopf point", zorder=5)
-        turns = [i for i in range(1, p.size - 1) if (p[i] - p[i - 1]) * (p[i + 1] - p[i]) < 0]
+        turns = _turns(p)
         for k, (i, f) in enumerate(zip(turns, self.folds)):  # at the fold's parameter, the turning orbit's amplitude
             axes[0].plot([f], [amp[i]], "o", color="C1", ms=7, zorder=5, label="fold (LPC)" if k == 0 else None)
         for at, lab, col in ((self.contact_loss, "contact loss", "C6"), (self.sliding_reversal, "sliding reversal",
@@ -369,14 +369,17 @@ def turning_points(p: Any) -> list[float]:
     """
     v = np.asarray(p, dtype=float)
     out = []
-    for i in range(1, v.size - 1):
-        a, b = v[i] - v[i - 1], v[i + 1] - v[i]
-        if a * b < 0:
-            curv = v[i + 1] - 2 * v[i] + v[i - 1]
-            top = v[i] - (v[i + 1] - v[i - 1]) ** 2 / (8 * curv) if curv != 0 else v[i]
-            lo, hi = min(v[i - 1:i + 2]), max(v[i - 1:i + 2])
-            out.append(float(min(max(top, lo - (hi - lo)), hi + (hi - lo))))
+    for i in _turns(v):
+        curv = v[i + 1] - 2 * v[i] + v[i - 1]
+        top = v[i] - (v[i + 1] - v[i - 1]) ** 2 / (8 * curv) if curv != 0 else v[i]
+        lo, hi = min(v[i - 1:i + 2]), max(v[i - 1:i + 2])
+        out.append(float(min(max(top, lo - (hi - lo)), hi + (hi - lo))))
     return out
+
+
+def _turns(v: np.ndarray) -> list[int]:
+    """Indices of the interior extremes of ``v`` (where the sequence turns back)."""
+    return [i for i in range(1, v.size - 1) if (v[i] - v[i - 1]) * (v[i + 1] - v[i]) < 0]
 
 
 def _basis(theta: np.ndarray, H: int, order: int) -> np.ndarray:
