@@ -16,7 +16,6 @@ or directly: ``python benchmarks/bench_cli_startup.py [--repeat N]``.
 from __future__ import annotations
 
 import argparse
-import os
 import shutil
 import subprocess
 import sys
@@ -25,7 +24,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import BenchResult, emit  # noqa: E402
+from common import BenchResult, emit, user_env  # noqa: E402
 
 
 def wall(cmd: list[str], env: dict[str, str], repeat: int, *, fresh_cache: bool = False) -> float:
@@ -47,7 +46,7 @@ def wall(cmd: list[str], env: dict[str, str], repeat: int, *, fresh_cache: bool 
 def run(repeat: int = 5) -> list[BenchResult]:
     bq = [sys.executable, "-m", "brakesqueal"]
     with tempfile.TemporaryDirectory() as cache:
-        env = {**os.environ, "BRAKESQUEAL_CACHE_DIR": cache}
+        env = user_env(BRAKESQUEAL_CACHE_DIR=cache)
         subprocess.run([*bq, "linearize"], env=env, check=True, capture_output=True)  # warm the cache
         t_pass = wall([sys.executable, "-c", "pass"], env, repeat)
         t_numpy = wall([sys.executable, "-c", "import numpy"], env, repeat)

@@ -14,7 +14,6 @@ The worst latency over the interrupt moments is reported, with its ratio to the 
 
 from __future__ import annotations
 
-import os
 import shutil
 import signal
 import subprocess
@@ -24,7 +23,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import BenchResult, emit  # noqa: E402
+from common import BenchResult, emit, user_env  # noqa: E402
 
 
 def latency(cmd: list[str], delay: float, env: dict[str, str], cwd: str) -> tuple[float, int]:
@@ -46,7 +45,7 @@ def worst(cmd: list[str], delays: list[float], *, cold: bool) -> tuple[float, li
     times, codes = [], []
     for d in delays:
         tmp = tempfile.mkdtemp(prefix="brakesqueal-bench-int-")
-        env = {**os.environ, "MPLBACKEND": "Agg"}
+        env = user_env(MPLBACKEND="Agg")
         if cold:
             env.update(BRAKESQUEAL_CACHE_DIR=f"{tmp}/cache", NUMBA_CACHE_DIR=f"{tmp}/numba")
         try:

@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import BenchResult, emit  # noqa: E402
+from common import BenchResult, emit, user_env  # noqa: E402
 
 X, Y = "k_ip=1e5:1e10:1000:log", "mu=0.05:1:1000"
 _DATASET = ("import sys\n"
@@ -58,7 +58,7 @@ CPU: list[float] = []
 def run(repeat: int = 3) -> list[BenchResult]:
     res = []
     with tempfile.TemporaryDirectory() as d:
-        env = {**os.environ, "BRAKESQUEAL_CACHE_DIR": os.path.join(d, "cache")}
+        env = user_env(BRAKESQUEAL_CACHE_DIR=os.path.join(d, "cache"))
         cli = [sys.executable, "-m", "brakesqueal", "map", "--x", X, "--y", Y, "--out", os.path.join(d, "m.nc")]
         measure(cli, env, 1)  # fills the cache (code generation, numba)
         for label, extra, eigen, target in (("with max_real and frequency", [], "1", "<= 1.5 s, <= 250 MB"),

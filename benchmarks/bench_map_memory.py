@@ -35,7 +35,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_map_cli import CPU, measure  # noqa: E402
-from common import BenchResult, emit  # noqa: E402
+from common import BenchResult, emit, user_env  # noqa: E402
 
 SIZES = [(1000, 1000), (10000, 1000), (10000, 10000)]
 
@@ -44,7 +44,7 @@ def run() -> list[BenchResult]:
     big = os.environ.get("BRAKESQUEAL_BENCH_MAP_1E8", "1") != "0"
     res = []
     with tempfile.TemporaryDirectory() as d:
-        env = {**os.environ, "BRAKESQUEAL_CACHE_DIR": os.path.join(d, "cache")}
+        env = user_env(BRAKESQUEAL_CACHE_DIR=os.path.join(d, "cache"))
 
         def cli(nx: int, ny: int, *extra: str) -> list[str]:
             return [sys.executable, "-m", "brakesqueal", "map", "--x", f"k_ip=1e5:1e10:{nx}:log",

@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import BenchResult, best_time, emit  # noqa: E402
+from common import BenchResult, best_time, emit, user_env  # noqa: E402
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 FRAMES = "() => new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))"
@@ -93,7 +93,7 @@ def _launch(browser: Any) -> tuple[Any, Any, float, float]:
     port = _port()
     t0 = time.perf_counter()
     proc = subprocess.Popen([sys.executable, "-m", "brakesqueal", "explore", "--no-browser", "--port", str(port)],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=user_env())
     while True:
         try:
             socket.create_connection(("127.0.0.1", port), timeout=0.2).close()

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import time
 from dataclasses import asdict, dataclass, field
 from typing import Any, Callable
@@ -31,6 +32,19 @@ class BenchResult:
             if isinstance(d[k], float) and not math.isfinite(d[k]):
                 d[k] = None
         return d
+
+
+def user_env(**extra: str) -> dict[str, str]:
+    """The environment for a command timed as a user runs it: this one, with Python's bytecode cache allowed.
+
+    A user's installed package has its ``.pyc`` files (pip compiles them on install; an editable install
+    writes them on first import).  A shell that sets ``PYTHONDONTWRITEBYTECODE`` (some CI and container
+    images do) makes every start compile the package's sources again, about 40 ms of a ``linearize``: the
+    timed commands run without it, and the first (warm-up) run of each writes the bytecode.
+    """
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    env.update(extra)
+    return env
 
 
 def best_time(fn: Callable[[], Any], *, repeat: int = 5, min_time: float = 0.0) -> float:
