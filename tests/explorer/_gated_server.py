@@ -1,11 +1,13 @@
-"""``brakesqueal explore`` for the browser tests, with one deterministic gate for the cancel test.
+"""``brakesqueal explore`` for the browser tests, with deterministic gates for the cancel tests.
 
 A simulation asked for with ``t_end == GATED_T_END`` waits at its first progress
 report until the lane cancels it (its progress callback then raises
 ``Cancelled``), for at most ``GATE_SECONDS``; then it runs as usual.  So the
 cancel test does not race the simulation, which is now faster than a click
 under load (the race made CI fail once: the 5 s run finished before Cancel).
-Every other request runs the explorer unchanged.
+Likewise limit cycles asked for at ``Omega == GATED_OMEGA`` wait at their
+progress callback (the one the lane passes to ``cycles_view`` and on to the
+branch) until cancelled.  Every other request runs the explorer unchanged.
 """
 
 from __future__ import annotations
@@ -15,23 +17,37 @@ import time
 from typing import Any
 
 GATED_T_END = 4.375
+#: limit cycles of a state with this value of ``Omega`` are held at their progress callback
+GATED_OMEGA = 36.125
 GATE_SECONDS = 300.0
+
+
+def _hold(progress: Any) -> None:
+    """Report no progress until ``progress`` raises (the lane was cancelled), for at most GATE_SECONDS."""
+    deadline = time.monotonic() + GATE_SECONDS
+    while time.monotonic() < deadline:
+        progress(0.0)  # raises Cancelled once the lane is cancelled
+        time.sleep(0.01)
 
 
 def _install_gate() -> None:
     from brakesqueal.explorer import app
 
     real = app.simulation_view
+    real_cycles = app.cycles_view
 
     def gated(space: Any, t_end: float, *, progress: Any = None) -> Any:
         if progress is not None and t_end == GATED_T_END:
-            deadline = time.monotonic() + GATE_SECONDS
-            while time.monotonic() < deadline:
-                progress(0.0)  # raises Cancelled once the lane is cancelled
-                time.sleep(0.01)
+            _hold(progress)
         return real(space, t_end, progress=progress)
 
+    def gated_cycles(space: Any, along: str, rng: Any, *, progress: Any = None) -> Any:
+        if progress is not None and "Omega" in space.settable() and space.value("Omega") == GATED_OMEGA:
+            _hold(progress)
+        return real_cycles(space, along, rng, progress=progress)
+
     app.simulation_view = gated
+    app.cycles_view = gated_cycles
 
 
 if __name__ == "__main__":

@@ -153,6 +153,25 @@ def test_cancel_stops_a_simulation(page):
     page.page.get_by_text("simulation: cancelled").wait_for(timeout=30_000)
 
 
+def test_cancel_stops_the_limit_cycles(page):
+    from _gated_server import GATED_OMEGA
+
+    # the served explorer holds the cycles of a state at Omega = GATED_OMEGA at the progress callback the lane
+    # passes to the branch, until Cancel makes it raise (the continuation no longer ends with a dropped result)
+    page.open(f"preset=paper-fig3&set=mu1%3D0.5,mu2%3D0.5,Omega%3D{GATED_OMEGA:g}&along=Omega")
+    page.wait(lambda s: s["locus"]["state"]["along"] == "Omega")
+    page.page.get_by_role("button", name="Cycles").click()
+    page.page.get_by_text("Cancel stops it").wait_for(timeout=30_000)
+    bar = page.page.locator("progress.bs-cycles-progress")
+    bar.wait_for(state="visible", timeout=30_000)  # the branch's progress bar, shown while it runs
+    page.page.get_by_role("button", name="Cancel").click()
+    s = page.wait(lambda s: "cycles" in s, timeout=600)
+    assert s["cycles"].get("error") == "cancelled", s["cycles"]
+    assert f"Omega={GATED_OMEGA:g}" in s["cycles"]["state"]["set"]
+    page.page.get_by_text("limit cycles: cancelled").wait_for(timeout=30_000)
+    bar.wait_for(state="hidden", timeout=30_000)
+
+
 def test_limit_cycles_end_at_the_contact_loss(page):
     # paper-fig3 at mu1 = mu2 = 0.5 along Omega in [30, 40]: supercritical onset at 35.74 rad/s (hopf, cycles)
     page.open("preset=paper-fig3&set=mu1%3D0.5,mu2%3D0.5,Omega%3D36&along=Omega")

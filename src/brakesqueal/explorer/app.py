@@ -261,7 +261,8 @@ class Explorer:
         self.map_lane = LatestWorker(self._compute_map, self._show_map, schedule,
                                      progress=self._map_progress, name="explorer-map")
         self.info_lane = LatestWorker(self._compute_info, self._show_info, schedule, name="explorer-info")
-        self.cycles_lane = LatestWorker(self._compute_cycles, self._show_cycles, schedule, name="explorer-cycles")
+        self.cycles_lane = LatestWorker(self._compute_cycles, self._show_cycles, schedule,
+                                        progress=self._cycles_progress, name="explorer-cycles")
         self.sim_lane = LatestWorker(self._compute_sim, self._show_sim, schedule,
                                      progress=self._sim_progress, name="explorer-sim")
         self.page = self._layout()
@@ -385,6 +386,8 @@ class Explorer:
         self.cancel_button.on_click(self._on_cancel)
         self.map_progress = pn.indicators.Progress(value=0, max=100, width=150, visible=False)
         self.sim_progress = pn.indicators.Progress(value=0, max=100, width=150, visible=False)
+        self.cycles_progress = pn.indicators.Progress(value=0, max=100, width=150, visible=False,
+                                                      css_classes=["bs-cycles-progress"])
         self.leading_text = pn.pane.HTML("", sizing_mode="stretch_width")
         self.cs_text = pn.pane.HTML("critical speed: …", sizing_mode="stretch_width")
         self.hopf_text = pn.pane.HTML("Hopf: …", sizing_mode="stretch_width")
@@ -576,7 +579,7 @@ class Explorer:
                          pn.Row(self.along_select, self.x_select, self.y_select),
                          pn.Row(self.nx_input, self.ny_input, self.map_progress),
                          pn.Row(self.t_end_input, self.sim_button),
-                         pn.Row(self.cycles_button, self.cancel_button),
+                         pn.Row(self.cycles_button, self.cancel_button, self.cycles_progress),
                          self.sim_progress,
                          width=400)
         legend = pn.pane.HTML("<small>map: <span style='background:#a9cdf5'>&nbsp;stable&nbsp;</span> "
@@ -726,17 +729,20 @@ class Explorer:
     @_batched
     def _on_cycles(self, event: Any) -> None:
         self._ensure_dynamics()
-        self.cycles_text.object = "continuing the limit cycles … (Cancel drops the result)"
+        self.cycles_text.object = "continuing the limit cycles … (Cancel stops it)"
+        self.cycles_progress.value, self.cycles_progress.visible = 0, True
         self.cycles_lane.submit(self.state)
 
     def _compute_cycles(self, state: ViewState, check: Any) -> Any:
         space = self.origin.space_of(state)
         rng = self.ranges.get(state.along) or slider_range(space, state.along)
-        cv = cycles_view(space, state.along, rng)
-        check(1.0)  # the continuation has no progress reports: a cancel drops its result
-        return cv
+        return cycles_view(space, state.along, rng, progress=check)  # Cancel stops the branch at its next point
+
+    def _cycles_progress(self, fraction: float) -> None:
+        self.cycles_progress.value = int(100 * min(max(fraction, 0.0), 1.0))
 
     def _show_cycles(self, state: ViewState, cv: Any, error: BaseException | None) -> None:
+        self.cycles_progress.visible = False
         if error is not None:
             msg = "cancelled" if isinstance(error, Cancelled) else str(error)
             self.cycles_text.object = f"<b>limit cycles:</b> {html.escape(msg)}"

@@ -675,7 +675,8 @@ class CyclesView:
     judged: np.ndarray | None = None
 
 
-def cycles_view(space: Any, along: str, rng: SliderRange) -> CyclesView:
+def cycles_view(space: Any, along: str, rng: SliderRange, *,
+                progress: Callable[[float], None] | None = None) -> CyclesView:
     """Continue the limit cycles along the path with the pads' true tangential dynamics.
 
     The route is :func:`~brakesqueal.nonlinear.models.cycle_route`'s (bilateral): shooting
@@ -683,10 +684,28 @@ def cycles_view(space: Any, along: str, rng: SliderRange) -> CyclesView:
     harmonic balance (:func:`~brakesqueal.nonlinear.harmonic.harmonic_branch`) where massless Coulomb pads
     with a finite ``k_ip`` would be quasi-static.
 
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    along : str
+        The path's parameter.
+    rng : SliderRange
+        Its range (the branch is continued within it).
+    progress : callable, optional
+        ``progress(fraction)``, passed to the branch: called after each accepted branch point with the
+        fraction done in ``[0, 1]`` (never decreasing) and with 1.0 at the end; an exception it raises stops
+        the continuation and propagates (the explorer's Cancel).
+
+    Returns
+    -------
+    CyclesView
+        The branch's points, stability, contact loss and summary text.
+
     Raises
     ------
     ParameterError
-        No Hopf point with a cycle prediction on the path.
+        No Hopf point with a cycle prediction on the path, or ``progress`` not callable.
     """
     from ..analysis.maps import Axis
     from ..nonlinear.models import cycle_route, squeal_branch
@@ -696,9 +715,10 @@ def cycles_view(space: Any, along: str, rng: SliderRange) -> CyclesView:
     if harmonic:
         from ..nonlinear.harmonic import harmonic_branch
 
-        br: Any = harmonic_branch(space, axis, max_points=25, max_harmonics=40)  # bounded: an interactive view
+        br: Any = harmonic_branch(space, axis, max_points=25, max_harmonics=40,  # bounded: an interactive view
+                                  progress=progress)
     else:
-        br = squeal_branch(space, axis)
+        br = squeal_branch(space, axis, progress=progress)
     s = br.summary
     rows = list(s.table) if s is not None else []
     p = np.array([float(r["p"]) for r in rows])

@@ -45,6 +45,7 @@ label     test function                                               event
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Sequence
 
@@ -506,6 +507,52 @@ def _bisect_events(eng: _Engine, a: _Point, b: _Point, ev_a: tuple[str, ...]) ->
     return best
 
 
+def _check_progress(progress: Any) -> None:
+    """``ParameterError`` naming ``progress`` unless it is ``None`` or callable."""
+    if progress is not None and not callable(progress):
+        raise ParameterError(f"The option 'progress' must be a callable taking the fraction done, or None; "
+                             f"got {progress!r}", parameter="progress")
+
+
+class _Progress:
+    """The fraction of a branch done, reported to ``progress(fraction)`` (``None``: nothing reported).
+
+    The fraction is the running maximum of ``points / max_points`` and of the parameter's distance from
+    ``p_start`` towards ``p_far`` over ``|p_far - p_start|`` (a branch can turn at a fold), clipped to
+    ``[0, 1]``: it never decreases.  Whatever ``progress`` raises propagates (the explorer's Cancel).
+    """
+
+    def __init__(self, progress: Callable[[float], None] | None, max_points: int, p_start: float = 0.0,
+                 p_far: float = 0.0) -> None:  # fmt: skip
+        self.progress = progress
+        self.max_points = max(int(max_points), 1)
+        self.p_start = float(p_start)
+        self.reach = float(p_far) - float(p_start)
+        self.last = 0.0
+
+    def report(self, fraction: float) -> None:
+        """Report ``max(fraction, the last fraction)`` clipped to ``[0, 1]``."""
+        if math.isfinite(fraction):
+            self.last = max(self.last, min(1.0, max(0.0, float(fraction))))
+        if self.progress is not None:
+            self.progress(self.last)
+
+    def point(self, n_points: int, p: float) -> None:
+        """Report after an accepted branch point (``n_points`` so far, the last at parameter ``p``)."""
+        f = n_points / self.max_points
+        if self.reach != 0 and math.isfinite(p):
+            f = max(f, (float(p) - self.p_start) / self.reach)
+        self.report(f)
+
+    def again(self) -> None:
+        """Report the last fraction again (a long step after the continuation: a cancel is seen there)."""
+        self.report(self.last)
+
+    def done(self) -> None:
+        """Report 1.0."""
+        self.report(1.0)
+
+
 def _hopf_y(hopf: HopfResult, r: float, m: int) -> np.ndarray:
     dp = hopf.side * r * r * abs(hopf.c1.real / hopf.dRe_lambda_dp)
     g = hopf.cycle_guess(hopf.p0 + dp, n_segments=m)
@@ -531,6 +578,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
                     max_angle: float = 0.3, start_amplitude: float = 0.02, direction: int = 1,
                     max_period: float | None = None, detect: Iterable[str] = ("LPC", "PD", "NS", "BPC", "GR"),
                     p_scale: float | None = None, ds_event: float | None = None,
+                    progress: Callable[[float], None] | None = None,
                     ) -> CycleBranch:  # fmt: skip
     r"""Continue a branch of periodic orbits from a Hopf point (or an orbit) in the parameter ``p``.
 
@@ -584,6 +632,13 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
     ds_event : float, optional
         Largest step across an event (a sign change of a test function or a change of the switching
         events): a longer step that crosses one is halved and redone (default ``ds_max / 10``).
+    progress : callable, optional
+        ``progress(fraction)`` is called after each accepted branch point (special points included) with
+        the fraction done in ``[0, 1]``, never decreasing: the running maximum of ``points / max_points``
+        and of the distance covered in the parameter from the start towards the far end of ``p_range``
+        (the end the cycles grow towards from a Hopf point, the end of ``direction`` from an orbit); and
+        with 1.0 at the end.  An exception it raises stops the continuation and propagates (the
+        explorer's Cancel).
 
     Returns
     -------
@@ -593,10 +648,11 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
     Raises
     ------
     ParameterError
-        Bad range, options, or a degenerate Hopf point (no prediction).
+        Bad range, options (``progress`` not callable), or a degenerate Hopf point (no prediction).
     ShootingError
         The first orbit cannot be computed.
     """
+    _check_progress(progress)
     flow = _make_flow(system, flow)
     system = _system_of(flow)
     n = system.n
@@ -650,6 +706,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
         if reach <= 0:
             raise ParameterError(f"the cycles exist for {hopf.parameter_name} {'>' if hopf.side > 0 else '<'} "
                                  f"{hopf.p0:.12g}, outside p_range = {p_range!r}")  # fmt: skip
+        tracker = _Progress(progress, max_points, hopf.p0, hi if hopf.side > 0 else lo)
         if p_scale is not None:
             reach = min(reach, float(p_scale))
         acoef = hopf.amplitude_coefficients
@@ -682,8 +739,10 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
         )  # fmt: skip
         points.append(_Point(y=yH, tangent=first.tangent, orbit=hopf_orbit, iterations=0, label="H",
                              events=first.events))  # fmt: skip
+        tracker.point(len(points), points[-1].y[-1])
         special.append(("H", 0, f"Hopf point, l1 = {hopf.l1:.6g} ({hopf.criticality})"))
         points.append(first)
+        tracker.point(len(points), points[-1].y[-1])
         base_amp = float(np.max(first.orbit.amplitude / xs))
     else:
         if not isinstance(start, PeriodicOrbit):
@@ -694,6 +753,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
             raise ParameterError(
                 f"The option 'p_range' must contain the start orbit's p = {start.p:.12g}; got {p_range!r}"
             )
+        tracker = _Progress(progress, max_points, start.p, hi if direction > 0 else lo)
         X0 = np.array(start.x, dtype=float, ndmin=2)
         if X0.shape[0] != m:
             fr = flow(X0[0], start.period, start.p, sensitivities=False, n_samples=m)
@@ -712,6 +772,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
 
             raise ShootingError(f"the start orbit did not converge: {exc}") from None
         points.append(eng.rephase(first))
+        tracker.point(len(points), points[-1].y[-1])
         base_amp = float(np.max(first.orbit.amplitude / xs))
     max_period = 50 * T0 if max_period is None else float(max_period)
     status, message = "max_points", f"reached max_points = {max_points}"
@@ -772,19 +833,23 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
             for s, pt_s, kind, desc in sorted(found, key=lambda f: f[0]):
                 pt_s.label = kind
                 points.append(eng.with_samples(pt_s))
+                tracker.point(len(points), points[-1].y[-1])
                 special.append((kind, len(points) - 1, desc))
             if pt is not None:
                 pt.label = "EP"
                 points.append(eng.with_samples(pt))
+                tracker.point(len(points), points[-1].y[-1])
                 special.append(("EP", len(points) - 1, f"end of p_range at {bound:.12g}"))
             status, message = "range", f"reached the end of p_range at {bound:.12g}"
             break
         for s, pt_s, kind, desc in sorted(found, key=lambda f: f[0]):
             pt_s.label = kind
             points.append(eng.with_samples(pt_s))
+            tracker.point(len(points), points[-1].y[-1])
             special.append((kind, len(points) - 1, desc))
         b = eng.rephase(b)
         points.append(b)
+        tracker.point(len(points), points[-1].y[-1])
         # stopping tests
         amp = float(np.max(b.orbit.amplitude / xs))
         if b.orbit.period > max_period:
@@ -802,6 +867,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
                                               f"{p_end:.6g} (another Hopf point)")  # fmt: skip
             break
         ds_cur = ds_next
+    tracker.done()
     return _build(eng, points, special, status, message, hopf, system)
 
 

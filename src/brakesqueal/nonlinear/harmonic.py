@@ -41,6 +41,7 @@ modes (a pad whose rate enters its balance on the orbit has a first-order mode o
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -559,7 +560,8 @@ def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics:
                     max_points: int = 40, harmonic_tol: float = 1e-6, tol: float = 1e-10,
                     ds: float = 0.05, ds_max: float = 0.2, start_offset: float = 1e-4,
                     stability: bool = True, use_cache: bool = True,
-                    stop_at_contact_loss: bool = True) -> HarmonicBranch:
+                    stop_at_contact_loss: bool = True,
+                    progress: Callable[[float], None] | None = None) -> HarmonicBranch:
     """Limit cycles of the implicit equations (exact massless Coulomb pads) by harmonic balance.
 
     Parameters
@@ -592,6 +594,13 @@ def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics:
         ``True`` (default): the branch ends at the located contact loss, where the bilateral equations stop
         describing the brake.  ``False``: the contact loss is located and recorded, and the continuation goes on
         along the bilateral equations (a study of the smooth model, as shooting's bilateral branches do).
+    progress : callable, optional
+        ``progress(fraction)`` is called after each accepted branch point with the fraction done in
+        ``[0, 1]``, never decreasing (the running maximum of ``points / max_points`` and of the distance
+        covered in the parameter from the Hopf point towards the far end of the range: a branch can turn
+        at a fold), with the last fraction before each orbit of the location of the contact loss or the
+        sliding reversal, and with 1.0 at the end.  An exception it raises stops the continuation and
+        propagates (the explorer's Cancel).
 
     Returns
     -------
@@ -600,13 +609,15 @@ def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics:
     Raises
     ------
     ParameterError
-        A bad option (naming it), an axis outside the parameter's allowed range, or no Hopf point with a
-        cycle prediction on the path.
+        A bad option (naming it; ``progress`` not callable), an axis outside the parameter's allowed range,
+        or no Hopf point with a cycle prediction on the path.
     BrakesquealError
         The first orbit cannot be found.
     """
     from ..simulation import simulation_model
+    from .continuation import _check_progress, _Progress
 
+    _check_progress(progress)
     for nm, v, lo in (("harmonics", harmonics, 1), ("max_points", max_points, 2)):
         if not isinstance(v, (int, np.integer)) or isinstance(v, bool) or v < lo:
             raise ParameterError(f"The option '{nm}' must be an integer >= {lo}; got {v!r}")
@@ -701,7 +712,14 @@ def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics:
         C, omega, p = bal.unpack(y)
         return _make_point(bal, sim, C, omega, p, err, coords, stability)
 
-    points = [point(y, err)]
+    tracker = _Progress(progress, max_points, h.p0, far)
+    points: list[HarmonicPoint] = []
+
+    def accept(P: HarmonicPoint) -> None:
+        points.append(P)
+        tracker.point(len(points), P.p)
+
+    accept(point(y, err))
     status, message = "max_points", f"reached max_points = {max_points}"
     loss = rev = None
     t_prev: np.ndarray | None = None
@@ -742,7 +760,7 @@ def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics:
             P = point(y_new, err)
             g_prev = indicators(points[-1])
             if all(v > 0 for v in indicators(P)) or not all(v > 0 for v in g_prev):
-                points.append(P)
+                accept(P)
                 status, message = "range", f"reached the end of the range at {axis.name} = {pe:.10g}"
                 break
         else:
@@ -755,12 +773,13 @@ def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics:
             # the first event along the branch: locate each by Illinois on p between the two orbits
             found = []
             for i, nm in events:
-                pv, Pe = _locate(bal, cont, sim, coords, points[-1], P, y, y_new, i, fixed_p, adapt, stability)
+                pv, Pe = _locate(bal, cont, sim, coords, points[-1], P, y, y_new, i, fixed_p, adapt, stability,
+                                 tick=tracker.again)
                 found.append((abs(pv - points[-1].p), pv, nm, Pe))
             found.sort(key=lambda r: r[0])
             ended = False
             for _, pv, nm, Pe in found:
-                points.append(Pe)
+                accept(Pe)
                 if nm == "contact_loss":
                     loss = pv
                     if not stop_at_contact_loss:
@@ -779,18 +798,19 @@ def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics:
             if K_new != bal.K:  # the location raised the harmonics: carry the new orbit over
                 y_new = resized(y_new, (K_new - 1) // 2, bal.H)
         if bal.H == max_harmonics and err > harmonic_tol:
-            points.append(P)
+            accept(P)
             status = "truncation"
             message = (f"the truncation error {err:.3g} exceeds harmonic_tol = {harmonic_tol:g} with "
                        f"max_harmonics = {max_harmonics} at {axis.name} = {P.p:.10g}; raise max_harmonics")
             break
-        points.append(P)
+        accept(P)
         t_prev = t if bal.H == Hcur else _resize_vec(t, bal.N, 2 * Hcur + 1, bal.K)
         y = y_new
         if its <= 3:
             step = min(ds_max, 1.5 * step)
     if stability:
         points = _near_onset_verdicts(points, ex.hopf, coords)
+    tracker.done()
     return HarmonicBranch(axis.name, ex, tuple(points), status, message, loss, rev, coords, pads,
                           "Hill's method" if stability else "not computed")
 
@@ -1063,8 +1083,11 @@ def hill_accuracy(omega: float, trivial: float) -> float:
 
 def _locate(bal: _Balance, cont: _Continuation, sim: Any, coords: tuple[str, ...], Pa: HarmonicPoint,
             Pb: HarmonicPoint, ya: np.ndarray, yb: np.ndarray, which: int, fixed_p: Any, adapt: Any,
-            stability: bool) -> tuple[float, HarmonicPoint]:
-    """Where indicator ``which`` (0: smallest F_n, 1: sliding margin) reaches 0 between two orbits (Illinois)."""
+            stability: bool, tick: Callable[[], None] | None = None) -> tuple[float, HarmonicPoint]:
+    """Where indicator ``which`` (0: smallest F_n, 1: sliding margin) reaches 0 between two orbits (Illinois).
+
+    ``tick()`` is called before each orbit (whatever it raises propagates: the explorer's Cancel).
+    """
     def g(P: HarmonicPoint) -> float:
         return min(P.F_n_min) if which == 0 else P.sliding_margin_min
 
@@ -1083,6 +1106,8 @@ def _locate(bal: _Balance, cont: _Continuation, sim: Any, coords: tuple[str, ...
     side = 0
     best = (pb, Pb)
     for _ in range(60):
+        if tick is not None:
+            tick()
         pc = pb - gb * (pb - pa) / (gb - ga) if gb != ga else 0.5 * (pa + pb)
         fr = (pc - pa) / (pb - pa) if pb != pa else 0.5
         yc, _ = cont.newton(resize(ya) + fr * (resize(yb) - resize(ya)), fixed_p(pc))

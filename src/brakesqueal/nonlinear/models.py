@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -527,10 +528,12 @@ def predicted_contact_loss(space: Any, name: str, hopf: Any) -> float | None:
 
 
 def _refine_event(system: Any, indicator: Any, pa: float, ga: float, guess_a: tuple[np.ndarray, float],
-                  pb: float, gb: float, guess_b: tuple[np.ndarray, float], *, ptol: float) -> float:
+                  pb: float, gb: float, guess_b: tuple[np.ndarray, float], *, ptol: float,
+                  tick: Callable[[], None] | None = None) -> float:
     """Zero of ``indicator(orbit)`` in ``p`` between two branch points (Illinois method on ``p``; each
     evaluation a periodic orbit shot at fixed ``p`` from the nearer known orbit).  Returns the located ``p``
-    (the linear interpolation of the bracket if a shooting fails)."""
+    (the linear interpolation of the bracket if a shooting fails).  ``tick()`` is called before each
+    shooting (whatever it raises propagates: the explorer's Cancel)."""
     from .periodic import ShootingError, find_periodic_orbit
 
     lo, glo, ylo = pa, ga, guess_a
@@ -541,6 +544,8 @@ def _refine_event(system: Any, indicator: Any, pa: float, ga: float, guess_a: tu
         p = best
         if not (min(lo, hi) < p < max(lo, hi)):
             p = 0.5 * (lo + hi)
+        if tick is not None:
+            tick()
         w = (p - lo) / (hi - lo)
         x_guess = (1 - w) * ylo[0] + w * yhi[0]
         T_guess = (1 - w) * ylo[1] + w * yhi[1]
@@ -830,7 +835,8 @@ def _shooting_flow(pw: PiecewiseSystem, h: Any, flow_method: str | None) -> tupl
 def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: bool = True,
                   tol: float = 1e-8, contact: str = "bilateral", ds: float | None = None,
                   ds_max: float = 0.05, pad_slope: float | None = None,
-                  stick_speed: float | None = None, flow_method: str | None = None) -> SquealBranch:
+                  stick_speed: float | None = None, flow_method: str | None = None,
+                  progress: Callable[[float], None] | None = None) -> SquealBranch:
     """Continue the limit cycles from the first Hopf point on a path and find where a pad loses contact.
 
     Parameters
@@ -874,6 +880,12 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
         implicit methods run at ``rtol = 1e-9`` with the augmented Jacobian.  The choice is stored in the
         data's attrs (``flow_method``, ``flow_choice``, ``stiffness_ratio``, ``flow_rtol``,
         ``flow_atol_monodromy``, ``integrator``).
+    progress : callable, optional
+        ``progress(fraction)``: passed to :func:`~.continuation.continue_cycles` (called after each
+        accepted branch point with the fraction done in ``[0, 1]``, never decreasing), then called with the
+        last fraction before each shooting of the location of the contact loss and the end of validity,
+        and with 1.0 at the end.  An exception it raises stops the continuation and propagates (the
+        explorer's Cancel).
 
     Notes
     -----
@@ -894,11 +906,13 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
     Raises
     ------
     ParameterError
-        No Hopf point with a cycle prediction on the path, a bad ``contact`` or ``flow_method``.
+        No Hopf point with a cycle prediction on the path, a bad ``contact``, ``flow_method`` or
+        ``progress`` (not callable).
     """
     from ..errors import ParameterError
-    from .continuation import continue_cycles
+    from .continuation import _check_progress, _Progress, continue_cycles
 
+    _check_progress(progress)
     if contact not in ("bilateral", "unilateral"):
         raise ParameterError(f"The option 'contact' must be bilateral or unilateral; got {contact!r}")
     _check_flow_method(flow_method)
@@ -924,8 +938,9 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
     assert h is not None
     predicted = predicted_contact_loss(space, axis.name, h)
     p_scale = 20 * abs(predicted - h.p0) if predicted is not None else None
+    tracker = _Progress(progress, max_points)  # relays the continuation's fractions and keeps the last
     opts: dict[str, Any] = {"max_points": max_points, "tol": tol, "p_scale": p_scale, "ds_max": ds_max,
-                            "ds": min(0.02, ds_max) if ds is None else ds}
+                            "ds": min(0.02, ds_max) if ds is None else ds, "progress": tracker.report}
     system = model_system(space, axis.name, use_cache=use_cache)
     sim = system.simulation_model  # type: ignore[attr-defined]
     flow_info: dict[str, Any] = {}
@@ -980,7 +995,7 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
 
         ptol = 1e-9 * max(1.0, abs(float(p[i])))
         return _refine_event(system, indicator, float(p[i - 1]), float(values[i - 1]), guess(i - 1),
-                             float(p[i]), float(values[i]), guess(i), ptol=ptol)
+                             float(p[i]), float(values[i]), guess(i), ptol=ptol, tick=tracker.again)
 
     loss = located(worst, 0)  # the grazing orbit is a bilateral orbit: shot with the smooth system
     end = located(margin, 1) if contact == "bilateral" and not stick else None
@@ -1014,6 +1029,7 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
     out = SquealBranch(hp, br, loss, tuple(sim.pads), contact)
     summ = squeal_summary(out)
     ds.attrs["summary"] = json.dumps(summ.to_dict(), default=float)
+    tracker.done()
     return SquealBranch(hp, br, loss, tuple(sim.pads), contact, summ)
 
 
