@@ -83,3 +83,31 @@ def test_critical_speeds_at_the_magnitude_bound_agree_with_exact_hurwitz(charpol
             assert _exact_verdict(charpoly, values, omega) == expected, (name, value, omega, d)
         if k < len(roots):
             expected = "unstable" if expected == "stable" else "stable"
+
+
+@pytest.mark.parametrize("preset,hi", [("paper-fig3", 1e300), ("paper-fig2", 1e150)])
+def test_a_range_past_omegas_bound_is_undecided_there_and_agrees_with_crossings(preset, hi):
+    # |Omega| <= 1e100 (the parameter table): a verdict beyond it would be on invalid parameter sets.  Both
+    # critical-speed routes and `crossings` must list that piece as undecided and agree on everything else.
+    import numpy as np
+
+    from brakesqueal.analysis.crossings import critical_speeds_many, crossings
+    from brakesqueal.analysis.maps import Axis
+    from brakesqueal.status import PointStatus
+
+    space = ParameterSpace.from_preset(preset)
+    r = critical_speeds(space, 1.0, hi)
+    c = crossings(space, Axis("Omega", 1.0, hi, 2, True))
+    assert not r.complete and r.undecided_ranges, r.to_dict()
+    assert any(a <= 1e100 and b >= hi for a, b in r.undecided_ranges), r.undecided_ranges
+    assert r.undecided_ranges == c.undecided_ranges and r.crossings == c.crossings
+    assert r.stable_at_start == c.stable_at_start
+    # the onset below the bound is still established
+    within = critical_speeds(space, 1.0, 1e100)
+    assert within.complete and r.Omega_crit == pytest.approx(within.Omega_crit, rel=1e-10)  # kernel: 1e-10
+    assert r.Omega_crit_certain
+    _, _, counts, _, status = critical_speeds_many(space, {"mu": np.array([0.3])} if preset == "paper-fig2"
+                                                   else {"mu1": np.array([0.3])}, 1.0, hi, return_status=True)
+    assert (status == int(PointStatus.UNDECIDED)).all(), status
+    _, _, _, _, status_in = critical_speeds_many(space, {}, 1.0, 1e100, return_status=True)
+    assert (status_in == int(PointStatus.OK)).all()

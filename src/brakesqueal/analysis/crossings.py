@@ -147,9 +147,9 @@ def exact_crossings(qn: QuarticNumerators, lo: float, hi: float, log: bool = Tru
     valid : callable, optional
         ``valid(x: float) -> bool``; a piece between candidates is decided at
         a valid test point (the verdict is constant on the piece) and, if
-        one of its test points was invalid, reported in the undecided ranges
-        too (it holds invalid parameter sets); a piece without a valid test
-        point is undecided.
+        one of its test points or an end of the range (``lo``, ``hi``) was
+        invalid, reported in the undecided ranges too (it holds invalid
+        parameter sets); a piece without a valid test point is undecided.
 
     Returns
     -------
@@ -183,6 +183,11 @@ def exact_crossings(qn: QuarticNumerators, lo: float, hi: float, log: bool = Tru
     pieces = [(edges[2 * k], edges[2 * k + 1]) for k in range(len(merged) + 1)]
     verdicts: list[int | None] = []
     partly_invalid: list[tuple[float, float]] = []
+    # an end of the range outside the allowed values (e.g. |Omega| > 1e100): its piece holds invalid sets even
+    # when the test points below happen to be valid
+    for a, b in (pieces[0], pieces[-1]):
+        if valid is not None and b > a and not (valid(float(a)) and valid(float(b))):
+            partly_invalid.append((float(a), float(b)))
     for a, b in pieces:
         v = None
         if b > a:
@@ -440,7 +445,9 @@ def critical_speeds(space: Any, lo: float = 1.0, hi: float = 1e5) -> object:
     :func:`crossings` along a logarithmic Ω axis (exact or numeric).  The
     smallest destabilizing Ω is the critical speed ``Omega_crit`` of the
     paper's Fig. 3.  Any range ``0 < lo < hi`` is handled (split into
-    sub-ranges internally).
+    sub-ranges internally); a range reaching past Ω's allowed values goes
+    through :func:`crossings`, which lists the piece holding invalid
+    parameter sets in ``undecided_ranges``.
 
     Parameters
     ----------
@@ -470,7 +477,9 @@ def critical_speeds(space: Any, lo: float = 1.0, hi: float = 1e5) -> object:
     if not (0 < lo):
         raise ParameterError(f"the Omega range needs 0 < START < STOP; got {lo!r}:{hi!r}")
     space.resolve({name: lo})
-    if _omega_batchable(space, name):
+    # a range reaching past the allowed values of Omega (|Omega| <= 1e100) goes the way of `crossings`, which
+    # reports the part holding invalid parameter sets as undecided (the kernel would claim a verdict there)
+    if _omega_batchable(space, name) and _valid_fn(space, name)(hi):
         from .equilibrium import parameter_vector
 
         p = np.array([parameter_vector(space.resolve({}))])
@@ -568,7 +577,8 @@ def critical_speeds_many(space: Any, changes: dict[str, np.ndarray], lo: float =
     start = np.zeros(n_pts, dtype=bool)
     status = np.zeros(n_pts, dtype=np.int8)
     fast = np.zeros(n_pts, dtype=bool)
-    if omega_kernel_available(space.model) and not any(name in names_in(e) for e in space.tied.values()):
+    if (omega_kernel_available(space.model) and not any(name in names_in(e) for e in space.tied.values())
+            and _valid_fn(space, name)(hi)):  # else per set by critical_speeds (invalid parts undecided)
         fast = _is_trivial(_Model.of(space.model), P)
     ix = np.flatnonzero(fast)
     if ix.size:
