@@ -37,7 +37,7 @@ def test_no_arguments_prints_the_help(capsys):
 
 
 def test_long_commands_report_progress_on_a_non_terminal(tmp_path):
-    """simulate, map and sweep print one-line progress on a pipe (here every update: the interval set to 0)."""
+    """simulate, map, sweep and cycles print one-line progress on a pipe (here every update: the interval set to 0)."""
     import os
     import subprocess
     import sys
@@ -49,7 +49,10 @@ def test_long_commands_report_progress_on_a_non_terminal(tmp_path):
     env = {**os.environ, "BRAKESQUEAL_PROGRESS_EVERY": "0", "MPLBACKEND": "Agg"}
     for label, args in (("simulate", ["simulate", "--t-end", "0.05"]),
                         ("map", ["map", "--x", "k_ip=1e5:1e10:30:log", "--y", "mu=0.05:1:30", "--out", "m.nc"]),
-                        ("sweep", ["sweep", str(study), "--out", "s.zarr"])):
+                        ("sweep", ["sweep", str(study), "--out", "s.zarr"]),
+                        ("cycles (harmonic balance)", ["cycles", "--preset", "paper-fig3", "--set", "mu1=0.5",
+                                                       "--set", "mu2=0.5", "--along", "Omega=30:36.3",
+                                                       "--max-points", "8"])):
         r = subprocess.run([sys.executable, "-m", "brakesqueal", *args], cwd=tmp_path, env=env, capture_output=True,
                            text=True, timeout=600)
         assert r.returncode == 0, r.stderr

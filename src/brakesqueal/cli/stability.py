@@ -252,6 +252,7 @@ def cycles(
     max_harmonics: Annotated[int, typer.Option("--max-harmonics", min=1, max=400, help="Harmonic-balance route: "
                                                "largest number of harmonics (the branch stops where more are "
                                                "needed).")] = 60,
+    progress: ProgressOpt = None,
 ) -> None:
     """Limit cycles from the first Hopf point on a path: amplitude, frequency, stability, where a pad lifts off."""
     from ..analysis.maps import parse_axis
@@ -275,13 +276,16 @@ def cycles(
     if cycle_route(space, axis, contact=contact, pads=pads) == "harmonic balance":
         _cycles_exact_pads(axis, base, fmt=fmt, max_points=max_points, harmonics=harmonics,
                            max_harmonics=max_harmonics, contact=contact, pad_slope=pad_slope,
-                           stick_speed=stick_speed, pad_damping=pad_damping, plot=plot, out=out)
+                           stick_speed=stick_speed, pad_damping=pad_damping, plot=plot, out=out, progress=progress)
         return
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     if out:
         check_output(out, what="--out", suffixes=(".nc",))
-    b = squeal_branch(space, axis, max_points=max_points, contact=contact)
+    from ._progress import progress as _progress
+
+    with _progress("cycles", progress) as cb:
+        b = squeal_branch(space, axis, max_points=max_points, contact=contact, progress=cb)
     if out:
         ds = b.data.copy()
         ds.attrs = {k: (json.dumps(v) if isinstance(v, (dict, list, tuple)) or v is None else v)
@@ -321,7 +325,8 @@ def cycles(
 
 def _cycles_exact_pads(axis: Any, space: Any, *, fmt: OutFormat, max_points: int, harmonics: int,
                        max_harmonics: int, contact: str, pad_slope: float | None, stick_speed: float | None,
-                       pad_damping: float | None, plot: str | None, out: str | None) -> None:
+                       pad_damping: float | None, plot: str | None, out: str | None,
+                       progress: bool | None = None) -> None:
     """``cycles --exact-pads``: the harmonic-balance branch of the implicit equations (text or JSON, ``--out``
     NetCDF, ``--plot`` bifurcation diagram)."""
     from ..nonlinear.harmonic import harmonic_branch
@@ -340,7 +345,11 @@ def _cycles_exact_pads(axis: Any, space: Any, *, fmt: OutFormat, max_points: int
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     if out:
         check_output(out, what="--out", suffixes=(".nc",))
-    b = harmonic_branch(space, axis, max_points=max_points, harmonics=harmonics, max_harmonics=max_harmonics)
+    from ._progress import progress as _progress
+
+    with _progress("cycles (harmonic balance)", progress) as cb:
+        b = harmonic_branch(space, axis, max_points=max_points, harmonics=harmonics, max_harmonics=max_harmonics,
+                            progress=cb)
     if out:
         ds = b.data
         ds = ds.assign_coords(coord=ds["coord"].astype("S"), pad=ds["pad"].astype("S"))
