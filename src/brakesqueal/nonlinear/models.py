@@ -45,7 +45,7 @@ from .system import PiecewiseSystem, SmoothSystem, Transition
 
 __all__ = ["model_system", "model_piecewise_system", "hopf_points", "HopfPoint",
            "squeal_branch", "SquealBranch", "SquealSummary", "squeal_summary",
-           "PAD_TREATMENTS", "soft_quasi_static_pads", "cycle_route"]
+           "PAD_TREATMENTS", "soft_quasi_static_pads", "cycle_route", "limit_cycles"]
 
 #: Pad treatments a limit-cycle computation can be asked for (:func:`cycle_route`).
 PAD_TREATMENTS: tuple[str, ...] = ("auto", "exact", "quasi-static")
@@ -370,6 +370,89 @@ def cycle_route(space: Any, axis: Any = None, *, contact: str = "bilateral", pad
         "tangential rate has no defined value through lift-off (the rate balance folds before F_n = 0). Choose "
         "--pad-damping D (the rates kept, a damper beside each pad; converges as D -> 0, e.g. 10 N s/m) or "
         "--pads quasi-static (ldot := 0, exact to first order at the onset)", parameter="pads")
+
+
+#: Options of :func:`limit_cycles` each route takes (beyond ``max_points`` and ``progress``).
+_ROUTE_OPTIONS: dict[str, frozenset[str]] = {
+    "shooting": frozenset({"use_cache", "tol", "ds", "ds_max", "pad_slope", "stick_speed", "flow_method"}),
+    "harmonic balance": frozenset({"use_cache", "tol", "ds", "ds_max", "harmonics", "max_harmonics",
+                                   "harmonic_tol", "start_offset", "stability", "stop_at_contact_loss"}),
+}
+
+
+def limit_cycles(space: Any, axis: Any, *, contact: str = "bilateral", pads: str = "auto",
+                 max_points: int | None = None, progress: Callable[[float], None] | None = None,
+                 **options: Any) -> Any:
+    """Limit cycles from the first Hopf point on a path, by the route ``brakesqueal cycles`` takes.
+
+    The library's counterpart of the command: the pads' true tangential dynamics by default
+    (:func:`cycle_route`), so a call needs no knowledge of which route keeps them.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides (after any pad option such as
+        :func:`~brakesqueal.model.options.damped_pads`).
+    axis : Axis
+        The path: the first Hopf point with a cycle prediction in it is continued within it.
+    contact : {"bilateral", "unilateral"}
+        As in :func:`squeal_branch` (unilateral: shooting only).
+    pads : {"auto", "exact", "quasi-static"}
+        As in :func:`cycle_route`.  ``options["pad_slope"]`` (a rising law that keeps the rates) takes the
+        shooting route and does not combine with ``"exact"`` or ``"quasi-static"``.
+    max_points : int, optional
+        Largest number of branch points (default: the route's own, 60 for shooting, 40 for harmonic
+        balance).
+    progress : callable, optional
+        ``progress(fraction)`` after each branch point (see :func:`squeal_branch`); what it raises stops
+        the branch and propagates.
+    **options
+        Options of the route taken: shooting (:func:`squeal_branch`): ``use_cache``, ``tol``, ``ds``,
+        ``ds_max``, ``pad_slope``, ``stick_speed``, ``flow_method``; harmonic balance
+        (:func:`~.harmonic.harmonic_branch`): ``use_cache``, ``tol``, ``ds``, ``ds_max``, ``harmonics``,
+        ``max_harmonics``, ``harmonic_tol``, ``start_offset``, ``stability``, ``stop_at_contact_loss``.
+
+    Returns
+    -------
+    SquealBranch or HarmonicBranch
+        The shooting branch or the harmonic-balance branch; both carry ``summary`` (a
+        :class:`SquealSummary`), ``contact_loss``, ``plot()`` and ``to_dict()`` (whose ``route`` names the
+        route).
+
+    Raises
+    ------
+    ParameterError
+        A bad ``contact`` or ``pads``, a combination :func:`cycle_route` refuses, an option the route taken
+        does not have (naming it and the route), or any error of the route's own validation.
+    """
+    from ..errors import ParameterError
+
+    slope = options.get("pad_slope")
+    if slope is not None or options.get("stick_speed") is not None:
+        if pads != "auto":
+            raise ParameterError(f"The option 'pad_slope' (a rising law that keeps the pads' rates, shooting) "
+                                 f"cannot be combined with pads = {pads!r}", parameter="pads")
+        if contact not in ("bilateral", "unilateral"):
+            raise ParameterError(f"The option 'contact' must be bilateral or unilateral; got {contact!r}",
+                                 parameter="contact")
+        route = "shooting"
+    else:
+        route = cycle_route(space, axis, contact=contact, pads=pads)
+    bad = sorted(set(options) - _ROUTE_OPTIONS[route])
+    if bad:
+        other = "harmonic balance" if route == "shooting" else "shooting"
+        raise ParameterError(f"The option {bad[0]!r} does not apply to the {route} route this model and path "
+                             f"take (pads = {pads!r}); it is an option of "
+                             + (f"the {other} route" if bad[0] in _ROUTE_OPTIONS[other] else "neither route"),
+                             parameter=bad[0])
+    kw = dict(options)
+    if max_points is not None:
+        kw["max_points"] = max_points
+    if route == "harmonic balance":
+        from .harmonic import harmonic_branch
+
+        return harmonic_branch(space, axis, progress=progress, **kw)
+    return squeal_branch(space, axis, contact=contact, progress=progress, **kw)
 
 
 def _hopf_dict(h: HopfResult) -> dict[str, Any]:

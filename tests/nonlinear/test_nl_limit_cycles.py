@@ -1,0 +1,59 @@
+"""``limit_cycles``: the library call that takes the route ``brakesqueal cycles`` takes.
+
+Each result is compared with a direct call of the route :func:`cycle_route` names (same options), so the
+dispatcher can only pass if it picks that route and forwards the options unchanged; refusals name the option.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from brakesqueal.analysis.maps import Axis
+from brakesqueal.errors import ParameterError
+from brakesqueal.model.parameters import ParameterSpace
+from brakesqueal.nonlinear.harmonic import HarmonicBranch, harmonic_branch
+from brakesqueal.nonlinear.models import SquealBranch, cycle_route, limit_cycles, squeal_branch
+
+#: paper-fig3 at mu1 = mu2 = 0.5 (onset ~35.6 rigid / 35.74 with k_ip = 1e8; contact loss near 36.04 / 36.19)
+RIGID = {"mu1": 0.5, "mu2": 0.5, "k_ip": math.inf}
+SOFT = {"mu1": 0.5, "mu2": 0.5}
+AXIS = Axis("Omega", 30.0, 36.3)
+
+
+def test_soft_coulomb_pads_take_harmonic_balance_like_the_command():
+    space = ParameterSpace.from_preset("paper-fig3", SOFT)
+    assert cycle_route(space, AXIS) == "harmonic balance"
+    calls: list[float] = []
+    b = limit_cycles(space, AXIS, max_points=12, max_harmonics=30, progress=calls.append)
+    ref = harmonic_branch(space, AXIS, max_points=12, max_harmonics=30)
+    assert isinstance(b, HarmonicBranch) and b.to_dict()["route"] == "harmonic balance"
+    assert [pt.p for pt in b.points] == [pt.p for pt in ref.points]
+    assert b.contact_loss == ref.contact_loss
+    assert calls and calls[-1] == 1.0
+
+
+def test_rigid_pads_take_shooting_and_quasi_static_is_asked_for_by_name():
+    rigid = ParameterSpace.from_preset("paper-fig3", RIGID)
+    b = limit_cycles(rigid, Axis("Omega", 30.0, 36.2), max_points=8)
+    ref = squeal_branch(rigid, Axis("Omega", 30.0, 36.2), max_points=8)
+    assert isinstance(b, SquealBranch) and b.to_dict()["route"] == "shooting"
+    assert list(b.data["p"].values) == list(ref.data["p"].values)
+    soft = ParameterSpace.from_preset("paper-fig3", SOFT)
+    q = limit_cycles(soft, AXIS, pads="quasi-static", max_points=6)
+    assert isinstance(q, SquealBranch) and q.hopf.simulated is not None  # the quasi-static pads, on request
+
+
+@pytest.mark.parametrize("kwargs,name", [
+    ({"harmonics": 8}, "harmonics"),                      # a harmonic-balance option on the shooting route
+    ({"flow_method": "Radau"}, "flow_method"),            # a shooting option on the harmonic-balance route
+    ({"bogus": 1}, "bogus"),
+    ({"pads": "exact", "pad_slope": 1e-4}, "pads"),
+    ({"contact": "unilateral"}, "pads"),                  # soft Coulomb pads through lift-off: a choice to make
+])
+def test_refusals_name_the_option(kwargs, name):
+    space = ParameterSpace.from_preset("paper-fig3", RIGID if name == "harmonics" else SOFT)
+    with pytest.raises(ParameterError) as e:
+        limit_cycles(space, AXIS, **kwargs)
+    assert e.value.parameter == name, e.value
