@@ -148,3 +148,36 @@ def test_boundary_bisection_by_the_route_equals_the_eigenvalue_route():
     assert done.mean() > 0.9
     np.testing.assert_array_equal(codes[done] == STABLE, top.real[done] < 0)
     np.testing.assert_array_less(np.abs(mr - top.real)[done], 1e-9 * np.abs(top[done]))
+
+
+def test_charpoly_route_refused_quickly_for_transcendental_entries(tmp_path):
+    """A Stribeck law puts exp(-Omega r / v_s) into the pencil: not rational in an Omega axis.
+
+    Before, the exact determinant's lcm and expansion of those entries grew without bound (a 400-point map of the
+    docs' caliper-stribeck example ran out of memory; the explorer's stribeck-drop preset took gigabytes).  The
+    route must decline at once, and the map take the certified per-point route.
+    """
+    import re
+    import time
+    from pathlib import Path
+
+    from brakesqueal.model import load_model
+
+    text = Path(__file__).resolve().parents[2].joinpath("docs", "model-format.md").read_text()
+    toml = re.search(r"```toml\n(.*?caliper-stribeck.*?)```", text, re.S).group(1)
+    f = tmp_path / "caliper.toml"
+    f.write_text(toml)
+    spec = load_model(f)
+    space = resolve_space(spec, "stribeck-drop")
+    t0 = time.perf_counter()
+    assert charpoly_table(space, "Omega", "mu") is None
+    assert time.perf_counter() - t0 < 60  # declined before any expansion (minutes and gigabytes before)
+    x, y = Axis("mu", 0.05, 1.0, 5), Axis("Omega", 1.0, 1000.0, 5, True)
+    m = stability_map(space, x, y, boundary=False)
+    assert m.data.attrs["method"] != CHARPOLY_ROUTE
+    arr = space.arrays({"Omega": y.values()[:, None], "mu": x.values()[None, :]})
+    ref = evaluate_arrays(space, arr)  # the per-point certified route, point by point
+    np.testing.assert_array_equal(m.data["status"].values, ref.status)
+    ok = ref.status == 0
+    assert ok.any()
+    np.testing.assert_array_equal(m.data["stable"].values[ok], ref.stable[ok])

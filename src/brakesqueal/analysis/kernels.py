@@ -1554,6 +1554,10 @@ def _charpoly_exact(space: ParameterSpace, names: tuple[str, str]) -> dict[str, 
     rows = []
     for i in range(n):
         ent = [(exact(M[i, j]), exact(D[i, j]), exact(K[i, j])) for j in range(n)]
+        # only entries rational in the axes (e.g. not exp(-Omega r / v_s) of a Stribeck law): the lcm and the
+        # expansion of transcendental entries grow without bound (memory), and the route would not apply anyway
+        if not all(e.is_rational_function(*X) for t in ent for e in t):
+            return None
         dens = [sp.fraction(e)[1] for t in ent for e in t]
         lcm = sp.lcm(dens) if dens else sp.Integer(1)
         rows.append([sp.expand(lcm * (lam ** 2 * a + lam * b_ + c)) for a, b_, c in ent])
