@@ -101,6 +101,50 @@ def pencil_eigenvalues(E: np.ndarray, A: np.ndarray, sweeps: int = 20) -> np.nda
     return lam
 
 
+#: Largest descriptor size whose eigenvalues :func:`descriptor_eigenvalues` computes in extended precision.
+EXTENDED_MAX_SIZE = 24
+
+
+def descriptor_eigenvalues(E: np.ndarray, A: np.ndarray, dps: int = 40) -> np.ndarray:
+    """Finite eigenvalues of ``lambda E - A`` with the pads' own modes, accurate for every scale at once.
+
+    A massless pad's mode can be 1e15 times the structural modes.  No double-precision route gets both right:
+    QZ of the equilibrated pencil (:func:`pencil_eigenvalues`) keeps the slow modes but was measured 4 % off on a
+    1.9e15 pad mode, and the balanced ``E^-1 A`` keeps that mode but moved a slow mode's real part by 16 %.  For
+    a nonsingular ``E`` of size up to :data:`EXTENDED_MAX_SIZE` the eigenvalues of ``E^-1 A`` are computed with
+    mpmath at ``dps`` digits from the float matrices taken exactly (about 10 ms at size 6), otherwise by
+    :func:`pencil_eigenvalues`.
+
+    Parameters
+    ----------
+    E, A : ndarray, shape (m, m)
+        The pencil (:attr:`LinearModel.descriptor`).
+    dps : int
+        Decimal digits of the extended-precision route.
+
+    Returns
+    -------
+    ndarray of complex
+        The finite eigenvalues (unsorted).
+    """
+    E, A = np.asarray(E, dtype=float), np.asarray(A, dtype=float)
+    m = E.shape[0]
+    if m > EXTENDED_MAX_SIZE or not (np.all(np.isfinite(E)) and np.all(np.isfinite(A))):
+        return pencil_eigenvalues(E, A)
+    import mpmath
+
+    with mpmath.workdps(dps):
+        try:
+            S = mpmath.inverse(mpmath.matrix(E.tolist())) * mpmath.matrix(A.tolist())
+            ev = mpmath.eig(S, left=False, right=False)
+        except (ZeroDivisionError, mpmath.libmp.NoConvergence):  # a singular E, or no convergence
+            return pencil_eigenvalues(E, A)
+        lam = np.array([complex(z) for z in ev])
+    tiny = np.abs(lam.imag) <= 1e-30 * np.abs(lam)  # a real eigenvalue's imaginary part at the dps noise
+    lam[tiny] = lam[tiny].real
+    return lam
+
+
 def _sort(lam: np.ndarray) -> np.ndarray:
     return lam[np.lexsort((-lam.imag, -lam.real))]
 
@@ -230,7 +274,7 @@ class LinearModel(ModalMixin):
             if not self.pad_states:
                 lam = np.linalg.eigvals(self.A)
             else:
-                lam = pencil_eigenvalues(*self.descriptor)
+                lam = descriptor_eigenvalues(*self.descriptor)
             self._eig.append(_sort(lam))
         return self._eig[0]
 
