@@ -62,6 +62,26 @@ def test_link_reproduces_the_view(page):
     assert page.page.locator("#bs-leading").text_content() == library_leading(["mu=0.3", "k_ip=1e7"])
 
 
+def test_a_link_made_in_a_session_reproduces_its_map_and_hopf_line(page):
+    # found in review: slider ranges (so the map's extent and the Hopf search path) came from the link's values,
+    # not from the session's, so the same link showed another map (41.7 % against 25.8 % stable)
+    page.open()
+    page.wait(lambda s: "map" in s and s["locus"]["state"]["set"] == "")
+    box = page.page.locator(".bs-input-mu input")
+    box.fill("0.8")
+    box.press("Enter")
+    # the map does not depend on mu (an axis): it is not recomputed; the Hopf line and critical speed are
+    session = page.wait(lambda s: "map" in s and s.get("info_state", {}).get("set") == "mu=0.8" and "hopf" in s)
+    page.page.wait_for_function("() => new URLSearchParams(location.search).get('set') === 'mu=0.8'",
+                                timeout=30_000)
+    link = urlparse(page.page.url).query
+    page.open(link)
+    linked = page.wait(lambda s: "map" in s and s.get("info_state", {}).get("set") == "mu=0.8" and "hopf" in s)
+    assert linked["map"]["stable_fraction"] == session["map"]["stable_fraction"]
+    assert linked["map"]["points"] == session["map"]["points"]
+    assert linked["hopf"] == session["hopf"] and linked["cs"] == session["cs"]
+
+
 def test_map_click_moves_every_view(page):
     page.open()
     before = page.wait(lambda s: "map" in s and "cs" in s and "hopf" in s)

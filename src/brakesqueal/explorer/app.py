@@ -250,7 +250,7 @@ class Explorer:
         self._hopf_key: Any = None
         self._building = False
         self._sync_shown: ViewState | None = None
-        self.ranges: dict[str, SliderRange] = {n: slider_range(self.space, n) for n in self.space.settable()}
+        self.ranges: dict[str, SliderRange] = self._preset_ranges()
         self._map_logs = (self.ranges[state.x].log, self.ranges[state.y].log)
         self._map_axes = (state.x, state.y)
         self._make_widgets()
@@ -411,6 +411,18 @@ class Explorer:
         finally:
             self._building = False
 
+    def _preset_ranges(self) -> dict[str, SliderRange]:
+        """Slider ranges (and so the map's extent and the path of the locus and Hopf search) of every settable name.
+
+        Taken around the preset's own values, not the current ones: the page a link opens (its values in
+        ``set``) then has the ranges of the session that made the link, so the link reproduces the view.
+        """
+        try:
+            base = self.origin.space_of(replace(self.state, values={}))
+        except ParameterError:  # the preset's own values with this view's axes: should not happen; fall back
+            base = self.space
+        return {n: slider_range(base, n) for n in self.space.settable()}
+
     def _rebuild_parameters(self) -> None:
         """One slider and one typed input per free name; typed inputs for the fixed names."""
         pn = self.pn
@@ -418,11 +430,9 @@ class Explorer:
 
         self.sliders: dict[str, Any] = {}
         self.inputs: dict[str, Any] = {}
-        self.ranges: dict[str, SliderRange] = {}
+        self.ranges: dict[str, SliderRange] = self._preset_ranges()
         rows = []
         space = self.space
-        for name in space.settable():
-            self.ranges[name] = slider_range(space, name)
         for name in space.preset.free:
             rng = self.ranges[name]
             value = space.value(name)
