@@ -139,3 +139,43 @@ def test_non_loopback_host_warns():
         proc.wait(10)
     assert lines[0].startswith("brakesqueal: warning: serving on 0.0.0.0, not loopback")
     assert lines[-1].startswith("brakesqueal: explorer at http://0.0.0.0:")
+
+
+def test_hopf_line_names_the_predicted_lift_off_and_drops_the_amplitude_beyond_it():
+    # found in review: at mu = 0.5 the line gave an amplitude "here" although `brakesqueal hopf` predicts the
+    # pads lift off at mu = 0.41027, beyond which the normal form of the bilateral equations does not hold
+    from brakesqueal.analysis.maps import Axis
+    from brakesqueal.explorer.state import SliderRange, hopf_scan, hopf_text
+    from brakesqueal.nonlinear.models import hopf_points
+
+    space = resolve_space(None, "paper-fig2", None, [])
+    rng = SliderRange(0.01, 1.0, False)
+    pts = hopf_scan(space, "mu", rng)
+    ref = next(h for h in hopf_points(space, Axis("mu", 0.01, 1.0, 2)) if h.hopf is not None)
+    assert ref.contact_loss is not None and ref.hopf.p0 < ref.contact_loss < 0.5
+    near = hopf_text(pts, "mu", 0.5 * (ref.hopf.p0 + ref.contact_loss), rng)
+    far = hopf_text(pts, "mu", 0.5, rng)
+    assert " here" in near and "does not hold" not in near and f"{ref.contact_loss:.6g}" in near
+    assert "does not hold here" in far and " = " not in far.split("sqrt(")[1].split(";")[0]
+
+
+def test_critical_speed_line_says_unstable_at_start(tmp_path):
+    # the docs' caliper-stribeck model is unstable below 18.0 rad/s, then stable up to its Omega_crit = 34.92
+    # (review: the line read "Omega_crit = 34.9196" with no word of the instability below)
+    import re
+    from pathlib import Path
+
+    from brakesqueal.analysis.crossings import critical_speeds
+    from brakesqueal.explorer.state import critical_speed_text
+    from brakesqueal.model import load_model
+
+    text = Path(__file__).resolve().parents[2].joinpath("docs", "model-format.md").read_text()
+    f = tmp_path / "caliper.toml"
+    f.write_text(re.search(r"```toml\n(.*?caliper-stribeck.*?)```", text, re.S).group(1))
+    space = resolve_space(load_model(f), None, None, [])
+    r = critical_speeds(space)
+    assert not r.stable_at_start and r.crossings[0][1] == "stabilizing"
+    line = critical_speed_text(space)
+    assert line.startswith("critical speed: unstable at 1 rad/s; ")
+    stable = critical_speed_text(resolve_space(None, "paper-fig3", None, []))
+    assert "unstable at" not in stable

@@ -428,7 +428,8 @@ def critical_speed_text(space: Any) -> str:
     parts = [f"{v:.6g} rad/s ({d})" for v, d in r.crossings]
     crit = "" if r.Omega_crit is None else f"{name}_crit = {r.Omega_crit:.6g} rad/s; "
     certain = "" if r.Omega_crit_certain else " (not certain: undecided ranges)"
-    return f"critical speed: {crit}changes at " + ", ".join(parts) + certain
+    start = "" if r.stable_at_start else f"unstable at {r.start:g} rad/s; "
+    return f"critical speed: {start}{crit}changes at " + ", ".join(parts) + certain
 
 
 def hopf_scan(space: Any, along: str, rng: SliderRange) -> list[Any] | str:
@@ -463,8 +464,13 @@ def hopf_text(points: list[Any] | str, along: str, current: float, rng: SliderRa
         a = float(h.amplitude_coefficients[0])
         dp = abs(current - h.p0)
         here = dp > 0 and h.side != 0 and (h.side > 0) == (current > h.p0) and h.criticality == "supercritical"
+        loss = hp.contact_loss  # the leading-order prediction of the first lift-off, as `brakesqueal hopf` prints
+        lifted = loss is not None and here and abs(current - h.p0) >= abs(loss - h.p0)
         amp = (f"; predicted amplitude of {names[0]} ≈ {a:.3g}·sqrt(|{along} − {h.p0:.4g}|)"
-               + (f" = {a * math.sqrt(dp):.3g} here" if here else ""))
+               + (f" = {a * math.sqrt(dp):.3g} here" if here and not lifted else ""))
+        if loss is not None:
+            amp += (f"; a pad lifts off at {along} ≈ {loss:.6g} (predicted)"
+                    + (": the prediction does not hold here" if lifted else ""))
     return (f"Hopf at {along} = {h.p0:.6g} ({hp.direction}, {h.frequency0_hz:.6g} Hz): {h.criticality}, "
             f"l1 = {h.l1:.3g}; cycles for {side}{amp}")
 
