@@ -153,6 +153,19 @@ def test_bad_input_shows_the_message_and_keeps_the_view(page):
     assert page.page.locator("#bs-leading").text_content() == library_leading([])
 
 
+@pytest.mark.parametrize("query,expect", [("along=zzz", "zzz"), ("x=N0", "N0"), ("t_end=-1", "t_end"),
+                                          ("t_end=nan", "t_end")])
+def test_a_bad_link_shows_its_message_and_the_command_lines_view(page, query, expect):
+    # found in review: unknown or tied axis names were silently replaced by the defaults, and a bad t_end was
+    # only refused at Simulate
+    page.open(query)
+    s = page.wait(lambda s: "locus" in s)
+    assert s["locus"]["state"]["along"] == "mu" and s["locus"]["state"]["t_end"] == "0.5"
+    message = page.page.locator(".bs-alert").get_by_text("link:")
+    message.wait_for(timeout=30_000)
+    assert expect in message.text_content()
+
+
 def test_caps_are_explained_in_the_page(page):
     page.open("nx=2000&ny=1000")
     s = page.wait(lambda s: "map" in s)

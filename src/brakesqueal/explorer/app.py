@@ -36,6 +36,7 @@ from .state import (
     SimulationView,
     SliderRange,
     ViewState,
+    check_t_end,
     critical_speed_text,
     cycles_view,
     format_eigenvalue,
@@ -233,6 +234,12 @@ class Explorer:
         state = origin.initial_state()
         try:
             state = origin.complete(ViewState.from_query(query, state)) if query else state
+            for key in ("along", "x", "y"):  # a name the link gives is checked, not replaced by the default
+                if query.get(key) and getattr(state, key) != query[key]:
+                    origin.space_of(replace(state, **{key: query[key]}))  # the one-line message naming it
+                    raise ParameterError(f"'{key}' = {query[key]!r} in the link is not a settable name here")
+            if query.get("t_end"):
+                check_t_end(state.t_end)
             origin.space_of(state)
         except BrakesquealError as exc:
             self.errors["link"] = f"link: {exc}; showing the command line's view"
