@@ -83,6 +83,8 @@ def server() -> Iterator[str]:
 def browser() -> Iterator[Any]:
     """Debian's chromium, headless, driven by Playwright."""
     why = browser_missing()
+    if why and os.environ.get("BRAKESQUEAL_REQUIRE_BROWSER") == "1":  # CI (.ci/run): the browser tests must run
+        pytest.fail(f"BRAKESQUEAL_REQUIRE_BROWSER=1 but {why}")
     if why:
         pytest.skip(why)
     from playwright.sync_api import sync_playwright
