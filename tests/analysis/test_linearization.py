@@ -200,7 +200,9 @@ def test_descriptor_eigenvalue_table_agrees_with_the_verdict_at_random_tilted_si
             assert smin <= 1e-12 * (abs(z) * nE + nA), (z, smin)
         from brakesqueal.analysis.eigen import eigen_analysis
 
-        v = eigen_analysis(lm).verdict()
+        ea = eigen_analysis(lm)
+        np.testing.assert_array_equal(ea.eigenvalues, lam)  # `eigen` lists what `linearize` lists
+        v = ea.verdict()
         assert abs(lam.real.max() - v.max_real) <= max(v.error_bound, 1e-12 * abs(v.max_real)), (lam[:2], v)
         checked += 1
     assert checked >= 6
