@@ -102,7 +102,7 @@ def pencil_eigenvalues(E: np.ndarray, A: np.ndarray, sweeps: int = 20) -> np.nda
 
 
 #: Largest descriptor size whose eigenvalues :func:`descriptor_eigenvalues` computes in extended precision.
-EXTENDED_MAX_SIZE = 24
+EXTENDED_MAX_SIZE = 12
 
 
 def descriptor_eigenvalues(E: np.ndarray, A: np.ndarray, dps: int = 40) -> np.ndarray:
