@@ -65,3 +65,25 @@ def test_modes_command_json_and_bad_input(tmp_path, capsys):
     rc = main(["modes", "--along", "kip=1:2"])
     err = capsys.readouterr().err
     assert rc == 2 and "did you mean 'k_ip'" in err
+
+
+def test_a_path_on_which_the_pads_states_come_and_go():
+    """paper-fig3 with h10 = 0.012 along mu1 in [0, 1.2] (the explorer's slider range): at mu1 = 0 the silent
+    motion keeps no pad state, elsewhere both pads' rates are kept (2n + 2 first-order states).  The tracking
+    compared vectors of different lengths and raised a NumPy ValueError (found through the explorer's root
+    locus); it now compares their shared mechanical part, and every path point's eigenvalues are on a track."""
+    from brakesqueal.analysis.linear import linearize
+
+    space = resolve_space(None, "paper-fig3", None, ["h10=0.012"])
+    values = np.linspace(0.0, 1.2, 60)
+    kept = {len(linearize(space.resolve({"mu1": float(v)})).pad_states) for v in values}
+    assert len(kept) > 1, kept  # the path does mix both forms
+    tr = modes_along(space, "mu1", 0.0, 1.2, num=60, log=False)
+    lam = np.asarray(tr.eigenvalues)
+    assert lam.shape[0] == values.size
+    for i, v in enumerate(values):
+        lm = linearize(space.resolve({"mu1": float(v)}))
+        ref = np.asarray(lm.eigenvalues)
+        ref = ref[ref.imag >= -1e-12 * np.maximum(np.abs(ref), 1.0)]
+        got = lam[i][np.isfinite(lam[i])]
+        assert got.size == ref.size

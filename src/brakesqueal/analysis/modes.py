@@ -170,6 +170,10 @@ def track_modes(values: Sequence[float], linear: Callable[[float], Any], *, para
     for i in range(1, vals.size):
         w, v = _first_order(linear(float(vals[i])))
         scale = max(float(np.abs(prev_w).max()), float(np.abs(w).max()), 1e-300)
+        # the pads' states come and go along a path (kept where the silent motion tilts, not at a point where it
+        # is trivial): compare the mechanical part [q, qdot] of the vectors, which both forms share
+        rows_common = min(prev_v.shape[0], v.shape[0])
+        prev_v, v = prev_v[:rows_common], v[:rows_common]
         cost = (1.0 - _mac(prev_v, v)) + np.abs(prev_w[:, None] - w[None, :]) / scale
         rows, cols = linear_sum_assignment(cost)
         col_of = np.full(w.size, -1)
