@@ -692,6 +692,12 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
         width = float(p_scale)
     hopf = start if isinstance(start, HopfResult) else None
     points: list[_Point] = []
+
+    def add(pt: _Point) -> None:
+        """Append a branch point and report the progress (``tracker``: set below, once the start is known)."""
+        points.append(pt)
+        tracker.point(len(points), pt.y[-1])
+
     special: list[tuple[str, int, str]] = []  # (kind, point index, description)
     if hopf is not None:
         if hopf.side == 0:
@@ -737,12 +743,10 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
             x_max=hopf.x0.copy(), x_min=hopf.x0.copy(), state_names=tuple(system.state_names),
             parameter_name=system.parameter_name,
         )  # fmt: skip
-        points.append(_Point(y=yH, tangent=first.tangent, orbit=hopf_orbit, iterations=0, label="H",
-                             events=first.events))  # fmt: skip
-        tracker.point(len(points), points[-1].y[-1])
+        add(_Point(y=yH, tangent=first.tangent, orbit=hopf_orbit, iterations=0, label="H",
+                   events=first.events))  # fmt: skip
         special.append(("H", 0, f"Hopf point, l1 = {hopf.l1:.6g} ({hopf.criticality})"))
-        points.append(first)
-        tracker.point(len(points), points[-1].y[-1])
+        add(first)
         base_amp = float(np.max(first.orbit.amplitude / xs))
     else:
         if not isinstance(start, PeriodicOrbit):
@@ -771,8 +775,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
             from .periodic import ShootingError
 
             raise ShootingError(f"the start orbit did not converge: {exc}") from None
-        points.append(eng.rephase(first))
-        tracker.point(len(points), points[-1].y[-1])
+        add(eng.rephase(first))
         base_amp = float(np.max(first.orbit.amplitude / xs))
     max_period = 50 * T0 if max_period is None else float(max_period)
     status, message = "max_points", f"reached max_points = {max_points}"
@@ -832,24 +835,20 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
             found = [f for f in found if f[0] < (_s_of(eng, a, pt) if pt is not None else ds_cur)]
             for s, pt_s, kind, desc in sorted(found, key=lambda f: f[0]):
                 pt_s.label = kind
-                points.append(eng.with_samples(pt_s))
-                tracker.point(len(points), points[-1].y[-1])
+                add(eng.with_samples(pt_s))
                 special.append((kind, len(points) - 1, desc))
             if pt is not None:
                 pt.label = "EP"
-                points.append(eng.with_samples(pt))
-                tracker.point(len(points), points[-1].y[-1])
+                add(eng.with_samples(pt))
                 special.append(("EP", len(points) - 1, f"end of p_range at {bound:.12g}"))
             status, message = "range", f"reached the end of p_range at {bound:.12g}"
             break
         for s, pt_s, kind, desc in sorted(found, key=lambda f: f[0]):
             pt_s.label = kind
-            points.append(eng.with_samples(pt_s))
-            tracker.point(len(points), points[-1].y[-1])
+            add(eng.with_samples(pt_s))
             special.append((kind, len(points) - 1, desc))
         b = eng.rephase(b)
-        points.append(b)
-        tracker.point(len(points), points[-1].y[-1])
+        add(b)
         # stopping tests
         amp = float(np.max(b.orbit.amplitude / xs))
         if b.orbit.period > max_period:

@@ -432,10 +432,7 @@ def limit_cycles(space: Any, axis: Any, *, contact: str = "bilateral", pads: str
         if pads != "auto":
             raise ParameterError(f"The option 'pad_slope' (a rising law that keeps the pads' rates, shooting) "
                                  f"cannot be combined with pads = {pads!r}", parameter="pads")
-        if contact not in ("bilateral", "unilateral"):
-            raise ParameterError(f"The option 'contact' must be bilateral or unilateral; got {contact!r}",
-                                 parameter="contact")
-        route = "shooting"
+        route = cycle_route(space, axis, contact=contact, pads="quasi-static")  # checks contact; "shooting"
     else:
         route = cycle_route(space, axis, contact=contact, pads=pads)
     bad = sorted(set(options) - _ROUTE_OPTIONS[route])
