@@ -179,3 +179,19 @@ def test_critical_speed_line_says_unstable_at_start(tmp_path):
     assert line.startswith("critical speed: unstable at 1 rad/s; ")
     stable = critical_speed_text(resolve_space(None, "paper-fig3", None, []))
     assert "unstable at" not in stable
+
+
+@pytest.mark.parametrize("text, expect", [
+    ("nan", "d_t = nan: not a number"),
+    ("1e999", "d_t = 1e999: the number overflows"),
+    ("", "d_t: enter a number or an expression"),
+    ("abc", "value of 'd_t' = abc: unknown name 'abc'"),
+    ("-1", "The parameter 'd_t'"),
+])
+def test_page_messages_name_the_field_not_command_line_options(origin, text, expect):
+    """A value typed into the page is named by its parameter; the command line's ``--set`` is not mentioned."""
+    with pytest.raises(ParameterError) as excinfo:
+        origin.space_of(origin.initial_state().with_values({"d_t": text}))
+    message = str(excinfo.value)
+    assert message.startswith(expect) and "--set" not in message and "\n" not in message
+    assert excinfo.value.parameter == "d_t"

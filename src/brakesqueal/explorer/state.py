@@ -632,10 +632,10 @@ class Origin:
         spec = self.spec(state.model)
         if spec is self.space.model and state.preset == self.space.label \
                 and state.preset not in spec.preset_names():
-            space = ParameterSpace(self.space.preset, parse_sets(state.sets()))
+            space = ParameterSpace(self.space.preset, parse_sets(state.sets(), option=""))
             space.resolve({})
         else:
-            space = resolve_space(spec, state.preset or None, None, state.sets())
+            space = resolve_space(spec, state.preset or None, None, parse_sets(state.sets(), option=""))
         for name in (state.along, state.x, state.y):
             if name:
                 space.check_axis(name)

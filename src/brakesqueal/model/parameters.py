@@ -569,13 +569,17 @@ class ParameterSpace:
                 for n in self.model.parameters]
 
 
-def parse_sets(sets: Sequence[str]) -> dict[str, Value]:
+def parse_sets(sets: Sequence[str], *, option: str = "--set") -> dict[str, Value]:
     """Parse repeated ``--set NAME=VALUE`` options (values: floats where plain numbers, else expressions).
 
     Parameters
     ----------
     sets : sequence of str
         The ``NAME=VALUE`` texts.
+    option : str, optional
+        How messages name the source of the texts (default ``"--set"``); ``""``
+        for values typed into named fields (the explorer), whose messages
+        name the parameter only.
 
     Returns
     -------
@@ -587,22 +591,30 @@ def parse_sets(sets: Sequence[str]) -> dict[str, Value]:
     ParameterError
         A malformed assignment, a number that overflows, or a name given twice.
     """
+
+    def says(name: str, value: str) -> str:
+        return f"{option} {name}={value}" if option else f"{name} = {value}"
+
     overrides: dict[str, Value] = {}
     for text in sets:
         name, sep, value = str(text).partition("=")
         name, value = name.strip(), value.strip()
         if not sep or not name.isidentifier() or not value:
-            raise ParameterError(f"malformed --set {text!r}: expected NAME=VALUE")
+            if not option and name.isidentifier():
+                raise ParameterError(f"{name}: enter a number or an expression (e.g. 0.4, inf, 16*pi)",
+                                     parameter=name)
+            raise ParameterError(f"malformed {option or 'value'} {text!r}: expected NAME=VALUE")
         if name in overrides:
-            raise ParameterError(f"--set '{name}' is given more than once")
+            raise ParameterError(f"{option or 'value'} '{name}' is given more than once", parameter=name)
         try:
             number = float(value)
         except ValueError:
             overrides[name] = value
             continue
         if math.isinf(number) and value.lower().lstrip("+-") not in ("inf", "infinity"):
-            raise ParameterError(f"--set {name}={value}: the number overflows (write inf for an infinite value)")
+            raise ParameterError(f"{says(name, value)}: the number overflows (write inf for an infinite value)",
+                                 parameter=name)
         if math.isnan(number):
-            raise ParameterError(f"--set {name}={value}: not a number")
+            raise ParameterError(f"{says(name, value)}: not a number", parameter=name)
         overrides[name] = number
     return overrides
