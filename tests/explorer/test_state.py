@@ -195,3 +195,21 @@ def test_page_messages_name_the_field_not_command_line_options(origin, text, exp
     message = str(excinfo.value)
     assert message.startswith(expect) and "--set" not in message and "\n" not in message
     assert excinfo.value.parameter == "d_t"
+
+
+def test_default_axes_pass_over_names_the_verdict_cannot_depend_on():
+    """The belt's zero-state M = m, D = d_ip - N0 slope, K = k_ip (``brakesqueal derive --model belt``) hold neither
+    the disk's thickness, Omega, r nor mu0: the default map's axes are names the verdict depends on, and its map
+    holds both verdicts (the first two free names, h10/h20, gave a map unstable everywhere)."""
+    from brakesqueal.explorer.state import default_axes, map_view, stability_names
+
+    space = resolve_space("belt", None, None, [])
+    names = stability_names(space, list(space.preset.free))
+    assert not {"h10", "h20", "Omega", "r", "mu0"} & set(names)
+    assert {"N0", "d_ip", "slope"} <= set(names)
+    along, x, y = default_axes(space)
+    assert along == y and {x, y} <= set(names)
+    mv = map_view(space, x, y, slider_range(space, x), slider_range(space, y), 20, 20)
+    assert 0.05 < mv.stable[mv.status <= 1].mean() < 0.95
+    # a preset's two free names stay the axes (Fig. 2)
+    assert default_axes(resolve_space(None, "paper-fig2", None, [])) == ("mu", "k_ip", "mu")

@@ -32,8 +32,8 @@ from ..errors import ParameterError
 __all__ = ["MAX_MAP_POINTS", "MAX_T_END", "LOCUS_POINTS", "AUDIO_RATE", "SliderRange", "ViewState",
            "slider_range", "format_eigenvalue", "leading_eigenvalue", "MapView", "map_view", "LocusView",
            "locus_view", "locus_lines", "critical_speed_text", "hopf_scan", "hopf_text", "SimulationView",
-           "simulation_view", "check_map_size", "check_t_end", "Origin", "audio_samples", "default_axes", "CyclesView",
-           "cycles_view"]
+           "simulation_view", "check_map_size", "check_t_end", "Origin", "audio_samples", "default_axes",
+           "stability_names", "CyclesView", "cycles_view"]
 
 #: Largest number of map points the explorer computes (``brakesqueal map`` has no such cap).
 MAX_MAP_POINTS = 1_000_000
@@ -239,9 +239,17 @@ class ViewState:
 
 
 def default_axes(space: Any) -> tuple[str, str, str]:
-    """Default ``(along, x, y)`` of a space: the first free name, and the first two settable names."""
+    """Default ``(along, x, y)`` of a space: its first two free names that move the least-stable eigenvalue.
+
+    A preset with two free names (``paper-fig2``: ``mu``, ``k_ip``) keeps
+    them.  With more, names on which the verdict cannot depend at the current
+    point are passed over (:func:`stability_names`; e.g. the ``belt``'s disk
+    thickness, whose map would be uniformly unstable).
+    """
     names = list(space.settable())
     free = list(space.preset.free) or names
+    if len(free) > 2:
+        free = stability_names(space, free) or free
     along = free[0]
     if len(free) >= 2:
         x, y = free[1], free[0]
@@ -249,6 +257,34 @@ def default_axes(space: Any) -> tuple[str, str, str]:
         others = [n for n in names if n != along]
         x, y = (others[0] if others else along), along
     return along, x, y
+
+
+def stability_names(space: Any, names: list[str]) -> list[str]:
+    """The names (in their order) whose slider range's ends move the least-stable eigenvalue or the status.
+
+    One batched :func:`~brakesqueal.analysis.points.evaluate` of the two ends
+    of every name's :func:`slider_range` with the others at their current
+    values.  Empty when the current point itself is not decided.
+    """
+    from ..analysis.points import evaluate
+    from ..errors import BrakesquealError
+
+    k = len(names)
+    base = {n: space.value(n) for n in names}
+    cols = {n: np.full(2 * k + 1, base[n], dtype=float) for n in names}
+    for i, n in enumerate(names):
+        r = slider_range(space, n)
+        cols[n][2 * i:2 * i + 2] = (r.low, r.high)
+    try:
+        pts = evaluate(space, cols)
+    except BrakesquealError:
+        return []
+    if pts.status[-1] > 1:
+        return []
+    ref = float(pts.max_real[-1])
+    tol = 1e-9 * max(abs(ref), 1e-300)
+    moved = (pts.status[:-1] != pts.status[-1]) | (np.abs(np.nan_to_num(pts.max_real[:-1], nan=np.inf) - ref) > tol)
+    return [n for i, n in enumerate(names) if moved[2 * i] or moved[2 * i + 1]]
 
 
 # ---------------------------------------------------------------------------------------------- root locus
