@@ -161,7 +161,12 @@ def test_evaluate_arrays_batched_equals_per_point(model, preset, sets, axes, mon
     r = pts.evaluate_arrays(space, arr)
     monkeypatch.undo()
     batched = np.count_nonzero(r.status == int(PointStatus.OK_NONTRIVIAL)) - len(calls)
-    assert batched > 0  # the batched route decided these
+    if model == "in-plane-pad":
+        # no normal dampers: the pads' rate coefficients cancel to O(q^2) and are not resolved in double
+        # precision, so the batched route hands every tilted point to the accurate per-point route
+        assert batched == 0 and len(calls) > 0
+    else:
+        assert batched > 0  # the batched route decided these
     m = pts._Model.of(space.model)
     shape = r.status.shape
     nontrivial = 0

@@ -117,15 +117,24 @@ class EigenAnalysis:
         Routh for 2-DOF models, eigenvalues with condition bounds otherwise),
         the same as maps, sweeps and the command line report; ``error_bound``
         is the first-order estimate ``safety · κ · ε · ‖A‖`` of the least-stable
-        eigenvalue's error (for information).
+        eigenvalue's error (for information); for a descriptor model (pad
+        states) of size up to
+        :data:`~.robust.EXTENDED_VERDICT_MAX_SIZE` it is the componentwise
+        bound of :func:`~.robust.extended_descriptor_verdict`.
         """
         from .points import linear_verdict
-        from .robust import STABLE, UNSTABLE
+        from .robust import EXTENDED_VERDICT_MAX_SIZE, STABLE, UNSTABLE, extended_descriptor_verdict
 
-        code, mr, _ = linear_verdict(self.model)
-        A = self.model.A
+        lm = self.model
+        code, mr, _ = linear_verdict(lm)
         i = int(np.argmax(self.eigenvalues.real))
-        bound = safety * float(self.condition[i]) * _EPS * float(np.linalg.norm(A, 2))
+        E, A = lm.descriptor
+        if lm.pad_states and E.shape[0] <= EXTENDED_VERDICT_MAX_SIZE:
+            # componentwise bound of the extended-precision route: the norm-wise one below is dominated by the
+            # pads' own modes (up to 1e25 at tilted silent motions) and says nothing about the slow modes
+            bound = extended_descriptor_verdict(E, A, len(lm.pad_states))[3]
+        else:
+            bound = safety * float(self.condition[i]) * _EPS * float(np.linalg.norm(lm.A, 2))
         status = "stable" if code == STABLE else "unstable" if code == UNSTABLE else "undecided"
         return Verdict(status, mr, bound, mr / abs(self.eigenvalues[i]))
 

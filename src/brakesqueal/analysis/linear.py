@@ -32,7 +32,7 @@ import numpy as np
 from .equilibrium import SilentMotion, as_parameters, parameter_vector, silent_motion
 
 __all__ = ["ModalMixin", "LinearModel", "linearize", "state_matrix", "jacobian_blocks_at", "pad_rate_eigenvalues",
-           "PAD_RATES"]
+           "PAD_RATES", "accurate_jacobian", "eliminate_algebraic", "descriptor_eigenvalues"]
 
 #: Treatments of the pads' tangential rates (see the module docstring).
 PAD_RATES = ("kept", "quasi-static")
@@ -143,6 +143,58 @@ def descriptor_eigenvalues(E: np.ndarray, A: np.ndarray, dps: int = 40) -> np.nd
     tiny = np.abs(lam.imag) <= 1e-30 * np.abs(lam)  # a real eigenvalue's imaginary part at the dps noise
     lam[tiny] = lam[tiny].real
     return lam
+
+
+def eliminate_algebraic(E: np.ndarray, A: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Eliminate the algebraic pad equations of a descriptor system (rows of ``E`` that are exactly zero).
+
+    A kept pad whose tangential balance has no rate term at this point
+    (e.g. a rigid support, ``1/k_ip = 0``: its row of ``E`` vanishes exactly)
+    is an algebraic relation ``A_r xi = 0``; its deformation ``l_a`` is
+    solved from it and substituted (with its derivative) into the other
+    rows: ``E' = E_rest - E_la A_r,la^-1 A_r,rest``, ``A' = A_rest - A_la
+    A_r,la^-1 A_r,rest``.  The finite eigenvalues are unchanged (the pencil
+    loses exactly its infinite ones), so ``E'`` is regular where the reduced
+    system is.
+
+    Parameters
+    ----------
+    E, A : ndarray, shape (m, m)
+        The descriptor (:attr:`LinearModel.descriptor
+        <brakesqueal.analysis.linear.LinearModel.descriptor>`).
+    k : int
+        Number of pad states (the trailing ``k`` unknowns; only these are eliminated).
+
+    Returns
+    -------
+    E, A : ndarray
+        The reduced descriptor (unchanged when no row of ``E`` vanishes, or
+        when the algebraic rows cannot be solved for pad states: the
+        verdict is then undecided).
+    """
+    E, A = np.array(E, dtype=float), np.array(A, dtype=float)
+    m = E.shape[0]
+    rows = np.flatnonzero(np.all(E == 0.0, axis=1))
+    if rows.size == 0 or rows.size > k:
+        return E, A
+    pads = np.arange(m - k, m)
+    # pick as many pad unknowns as algebraic rows: the best-conditioned columns of A[rows, pads]
+    import scipy.linalg
+
+    _, _, piv = scipy.linalg.qr(A[np.ix_(rows, pads)], pivoting=True)
+    cols = pads[np.sort(piv[:rows.size])]
+    keep_r = np.setdiff1d(np.arange(m), rows)
+    keep_c = np.setdiff1d(np.arange(m), cols)
+    Arl = A[np.ix_(rows, cols)]
+    try:
+        X = np.linalg.solve(Arl, A[np.ix_(rows, keep_c)])  # l_a = -X xi_rest
+    except np.linalg.LinAlgError:
+        return E, A
+    if not np.all(np.isfinite(X)):
+        return E, A
+    E2 = E[np.ix_(keep_r, keep_c)] - E[np.ix_(keep_r, cols)] @ X
+    A2 = A[np.ix_(keep_r, keep_c)] - A[np.ix_(keep_r, cols)] @ X
+    return E2, A2
 
 
 def _sort(lam: np.ndarray) -> np.ndarray:
@@ -260,11 +312,27 @@ class LinearModel(ModalMixin):
         return E, A
 
     @property
+    def reduced_descriptor(self) -> tuple[np.ndarray, np.ndarray]:
+        """:attr:`descriptor` with the kept pads' algebraic equations eliminated (:func:`eliminate_algebraic`).
+
+        A kept pad whose own balance has no rate term at this point (a rigid
+        support, ``1/k_ip = 0``, while its rate still enters the disk's
+        equations) makes ``E`` singular; the reduced pencil has the same
+        finite eigenvalues and, where the system is regular, a nonsingular
+        ``E`` in ``(delta Q, delta Qdot, pad states left)``.
+        """
+        E, A = self.descriptor
+        if not self.pad_states:
+            return E, A
+        return eliminate_algebraic(E, A, len(self.pad_states))
+
+    @property
     def A(self) -> np.ndarray:
-        """First-order state matrix ``E^-1 A`` (``2n + k`` square)."""
+        """First-order state matrix ``E^-1 A`` of :attr:`reduced_descriptor` (``2n + k`` square, less the pads
+        eliminated there); its first ``2n`` components are ``(delta Q, delta Qdot)``."""
         if not self.pad_states:
             return state_matrix(self.M, self.D, self.K)
-        E, A = self.descriptor
+        E, A = self.reduced_descriptor
         return np.linalg.solve(E, A)
 
     @property
@@ -274,7 +342,7 @@ class LinearModel(ModalMixin):
             if not self.pad_states:
                 lam = np.linalg.eigvals(self.A)
             else:
-                lam = descriptor_eigenvalues(*self.descriptor)
+                lam = descriptor_eigenvalues(*self.reduced_descriptor)
             self._eig.append(_sort(lam))
         return self._eig[0]
 
@@ -306,10 +374,60 @@ class LinearModel(ModalMixin):
         }
 
 
+_MP_NAMESPACES: dict[str, dict[str, Any]] = {}
+
+#: Relative agreement of the Jacobian at two precisions that :func:`accurate_jacobian` accepts.
+JACOBIAN_AGREEMENT = 1e-15
+
+
+def accurate_jacobian(cm: Any, x: Any, p: Any) -> np.ndarray:
+    """``d(R, G)/dx`` at ``x`` with every entry correct to rounding, as an ``(n + m, 3n + 2m)`` array.
+
+    At a tilted silent motion several entries are differences of terms that
+    cancel to ``O(q^2)``: e.g. the pads' rate coefficient ``G_Ldot`` of
+    rate-independent friction without normal dampers is about ``1e-24`` of
+    the terms it is computed from.  Evaluated in double precision it is
+    rounding noise of either sign (or exactly 0), and the pad mode
+    ``-G_L/G_Ldot`` it implies a spurious ``±1e20``.  The generated source
+    is therefore evaluated in mpmath from the same float ``x`` and ``p``
+    (taken exactly) at 40 and 80 digits, doubling until two successive
+    precisions agree to :data:`JACOBIAN_AGREEMENT` in every entry (a few
+    milliseconds).
+
+    Raises
+    ------
+    FloatingPointError
+        If no precision up to 640 digits gives agreement (not met in practice).
+    """
+    import mpmath
+
+    ns = _MP_NAMESPACES.get(cm.source)
+    if ns is None:
+        ns = dict(sin=mpmath.sin, cos=mpmath.cos, tan=mpmath.tan, sqrt=mpmath.sqrt, exp=mpmath.exp,
+                  log=mpmath.log, abs=abs, pi=mpmath.pi)
+        exec(compile(cm.source, "<brakesqueal generated model (mpmath)>", "exec"), ns)
+        _MP_NAMESPACES[cm.source] = ns
+    jac = ns["jacobians"]
+
+    def at(dps: int) -> np.ndarray:
+        with mpmath.workdps(dps):
+            vals = jac([mpmath.mpf(float(v)) for v in x], [mpmath.mpf(float(v)) for v in p])
+            return np.array([float(v) for v in vals], dtype=float)
+
+    prev, dps = at(40), 80
+    while dps <= 640:
+        cur = at(dps)
+        if np.all(np.abs(cur - prev) <= JACOBIAN_AGREEMENT * np.abs(cur)):
+            return cur.reshape(cm.n + cm.m, cm.nx)
+        prev, dps = cur, 2 * dps
+    raise FloatingPointError("the Jacobian at the silent motion could not be evaluated accurately")
+
+
 def _blocks(cm: Any, x: list[float] | None, p: list[float]) -> dict[str, np.ndarray]:
-    """Jacobian blocks at ``x`` (``None``: the zero state, with its structural zeros exact)."""
+    """Jacobian blocks at ``x`` (``None``: the zero state, with its structural zeros exact; otherwise
+    :func:`accurate_jacobian`)."""
     n, m = cm.n, cm.m
-    J = cm.zero_jacobian_matrix(p) if x is None else cm.jacobian_matrix(x, p)
+    J = cm.zero_jacobian_matrix(p) if x is None else accurate_jacobian(cm, x, p)
     cols = {"Q": slice(0, n), "dQ": slice(n, 2 * n), "ddQ": slice(2 * n, 3 * n), "L": slice(3 * n, 3 * n + m),
             "dL": slice(3 * n + m, 3 * n + 2 * m)}
     out = {}

@@ -60,8 +60,10 @@ import numpy as np
 
 from ..errors import ParameterError, SilentMotionError
 from ..status import PointStatus, status_of_error
+from .linear import eliminate_algebraic
 from .robust import (
-    STABLE, UNDECIDED, UNSTABLE, descriptor_verdicts, eigen_verdicts, matrix_verdicts, trivial_verdicts,
+    EXTENDED_VERDICT_MAX_SIZE, STABLE, UNDECIDED, UNSTABLE, descriptor_verdicts, eigen_verdicts,
+    extended_descriptor_verdict, matrix_verdicts, trivial_verdicts,
 )
 
 __all__ = ["PointVerdict", "Points", "evaluate", "evaluate_arrays", "evaluate_point", "linear_verdict",
@@ -265,6 +267,12 @@ def linear_verdict(lm: Any) -> tuple[int, float, float]:
     if lm.pad_states:
         E, A = eliminate_algebraic(*lm.descriptor, len(lm.pad_states))
         c, mr, fr = descriptor_verdicts(E[None], A[None])
+        if int(c[0]) == UNDECIDED and lm.descriptor[0].shape[0] <= EXTENDED_VERDICT_MAX_SIZE:
+            # the norm-wise bound cannot separate slow modes from a huge pad mode: extended precision with
+            # componentwise bounds (every eigenvalue at its own scale)
+            code, m1, f1, _, lam = extended_descriptor_verdict(*lm.descriptor, len(lm.pad_states))
+            if lam.size:
+                return code, m1, f1
     elif lm.n == 2:
         c, mr, fr = matrix_verdicts(lm.M, lm.D, lm.K)
     else:
@@ -291,58 +299,6 @@ def _point_of(lm: Any) -> PointVerdict | None:
         return evaluate_point(ParameterSpace.from_parameters(params))
     except (ParameterError, SilentMotionError):
         return None
-
-
-def eliminate_algebraic(E: np.ndarray, A: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
-    """Eliminate the algebraic pad equations of a descriptor system (rows of ``E`` that are exactly zero).
-
-    A kept pad whose tangential balance has no rate term at this point
-    (e.g. a rigid support, ``1/k_ip = 0``: its row of ``E`` vanishes exactly)
-    is an algebraic relation ``A_r xi = 0``; its deformation ``l_a`` is
-    solved from it and substituted (with its derivative) into the other
-    rows: ``E' = E_rest - E_la A_r,la^-1 A_r,rest``, ``A' = A_rest - A_la
-    A_r,la^-1 A_r,rest``.  The finite eigenvalues are unchanged (the pencil
-    loses exactly its infinite ones), so ``E'`` is regular where the reduced
-    system is.
-
-    Parameters
-    ----------
-    E, A : ndarray, shape (m, m)
-        The descriptor (:attr:`LinearModel.descriptor
-        <brakesqueal.analysis.linear.LinearModel.descriptor>`).
-    k : int
-        Number of pad states (the trailing ``k`` unknowns; only these are eliminated).
-
-    Returns
-    -------
-    E, A : ndarray
-        The reduced descriptor (unchanged when no row of ``E`` vanishes, or
-        when the algebraic rows cannot be solved for pad states: the
-        verdict is then undecided).
-    """
-    E, A = np.array(E, dtype=float), np.array(A, dtype=float)
-    m = E.shape[0]
-    rows = np.flatnonzero(np.all(E == 0.0, axis=1))
-    if rows.size == 0 or rows.size > k:
-        return E, A
-    pads = np.arange(m - k, m)
-    # pick as many pad unknowns as algebraic rows: the best-conditioned columns of A[rows, pads]
-    import scipy.linalg
-
-    _, _, piv = scipy.linalg.qr(A[np.ix_(rows, pads)], pivoting=True)
-    cols = pads[np.sort(piv[:rows.size])]
-    keep_r = np.setdiff1d(np.arange(m), rows)
-    keep_c = np.setdiff1d(np.arange(m), cols)
-    Arl = A[np.ix_(rows, cols)]
-    try:
-        X = np.linalg.solve(Arl, A[np.ix_(rows, keep_c)])  # l_a = -X xi_rest
-    except np.linalg.LinAlgError:
-        return E, A
-    if not np.all(np.isfinite(X)):
-        return E, A
-    E2 = E[np.ix_(keep_r, keep_c)] - E[np.ix_(keep_r, cols)] @ X
-    A2 = A[np.ix_(keep_r, keep_c)] - A[np.ix_(keep_r, cols)] @ X
-    return E2, A2
 
 
 def _nontrivial_point(model: _Model, values: dict[str, float]) -> tuple[int, bool, float, float]:
@@ -407,6 +363,46 @@ def _nontrivial_batch(model: _Model, P: np.ndarray
     return status, stable, mr, fr, redo
 
 
+#: Relative agreement of the pads' rate coefficients in double and extended precision that
+#: :func:`_unresolved_rates` accepts (the extended values, about 2048 times closer, are then used).
+RATE_AGREEMENT = 1e-4
+
+
+def _unresolved_rates(cm: Any, P: np.ndarray, Z: np.ndarray, Jf: np.ndarray) -> np.ndarray:
+    """Points whose pad-rate Jacobian entries (``R_Ldot``, ``G_Ldot``) are not resolved in double precision.
+
+    At a tilted silent motion a pad's rate coefficient can be a difference of terms that cancel to ``O(q^2)``
+    (rate-independent friction without normal dampers): in double precision it is rounding noise of either
+    sign or exactly 0, posing as a pad mode of ``+-1e20`` (or hiding one).  The entries are evaluated again in
+    NumPy's extended precision (``longdouble``, 11 more bits on x86-64) from the same inputs: a resolved entry
+    agrees to :data:`RATE_AGREEMENT`, noise does not (it shrinks 2048 times).  The extended values replace
+    the double ones in ``Jf`` (in place).  On a platform whose ``longdouble`` is double, every point with pad
+    states is reported (the per-point route is accurate).
+    """
+    N = P.shape[0]
+    n, m, nx = cm.n, cm.m, cm.nx
+    if np.finfo(np.longdouble).eps >= np.finfo(np.float64).eps:
+        return np.ones(N, dtype=bool)
+    x: list[Any] = [np.zeros(N, dtype=np.longdouble)] * nx
+    for i in range(n):
+        x[i] = Z[:, i].astype(np.longdouble)
+    for j in range(m):
+        x[3 * n + j] = Z[:, n + j].astype(np.longdouble)
+    p = [P[:, k].astype(np.longdouble) for k in range(P.shape[1])]
+    cols = np.arange(3 * n + m, nx)
+    with np.errstate(all="ignore"):
+        vals = cm.vectorized.jacobians(x, p)
+        J = np.empty((N, n + m, cols.size), dtype=np.longdouble)
+        for r in range(n + m):
+            for c_i, c in enumerate(cols):
+                J[:, r, c_i] = np.broadcast_to(np.asarray(vals[r * nx + c], dtype=np.longdouble), (N,))
+        Jd = Jf.reshape(N, n + m, nx)[:, :, cols]
+        bad = np.abs(Jd - J) > RATE_AGREEMENT * np.abs(J)
+        bad |= ~np.isfinite(J)
+    Jf.reshape(N, n + m, nx)[:, :, cols] = J.astype(float)
+    return np.any(bad, axis=(1, 2))
+
+
 def _linear_batch(cm: Any, P: np.ndarray, Z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Batched :func:`~.linear.linearize` at silent motions ``Z = (Q0, L0)`` and :func:`linear_verdict`.
 
@@ -437,10 +433,18 @@ def _linear_batch(cm: Any, P: np.ndarray, Z: np.ndarray) -> tuple[np.ndarray, np
     if m == 0:
         second_order(np.arange(N), M, D, K)
         return codes, mr, fr, back
+    # a pad's rate coefficients at a tilted silent motion may be differences of terms that cancel to O(q^2)
+    # (rate-independent friction without normal dampers): in double precision they are noise of either sign or
+    # exactly 0, posing as a pad mode of +-1e20 (or hiding one).  Points where double and extended precision
+    # disagree go to the per-point route, which evaluates the Jacobian accurately (linear.accurate_jacobian)
+    back |= _unresolved_rates(cm, P, Z, Jf)
+    noisy = back.copy()
     dyn_all = np.any(R_dL != 0.0, axis=1) | np.any(G_dL != 0.0, axis=1) | np.any(G_dL != 0.0, axis=2)
     patterns, which = np.unique(dyn_all, axis=0, return_inverse=True)
     for g, dyn in enumerate(patterns):
-        idx = np.flatnonzero(which.reshape(-1) == g)
+        idx = np.flatnonzero((which.reshape(-1) == g) & ~noisy)
+        if idx.size == 0:
+            continue
         qs = ~dyn
         Mg, Dg, Kg = M[idx], D[idx], K[idx]
         RL, RdL, GQ, GdQ, GddQ, GL, GdL = (X[idx] for X in (R_L, R_dL, G_Q, G_dQ, G_ddQ, G_L, G_dL))
