@@ -501,13 +501,14 @@ def test_parameters_are_the_chosen_set(tmp_path, angled_path):
     want = [float(v) for v in resolve_space(None, "paper-fig3", None, ["mu1=0.7"]).resolve({}).vector()]
     assert list(_import(path).parameters()) == want
     assert "preset paper-fig3, --set mu1=0.7" in path.read_text()
-    path = tmp_path / "bs_eight.py"
-    assert main(["export", "--to", "python", "--model", "eight-dof", "--set", "k_ip1=inf", "--set", "m_c=5",
+    # a rigid support (k_ip = inf) of a massless pad is the compliance 0 (pads with a tangential DOF refuse inf)
+    path = tmp_path / "bs_paper.py"
+    assert main(["export", "--to", "python", "--model", "paper", "--set", "k_ip1=inf", "--set", "N0=5",
                  "--out", str(path)]) == 0  # fmt: skip
-    want = resolve_space("eight-dof", None, None, ["k_ip1=inf", "m_c=5"]).resolve({}).vector()
+    want = resolve_space("paper", None, None, ["k_ip1=inf", "N0=5"]).resolve({}).vector()
     got = _import(path).parameters()
-    assert list(got) == [float(v) for v in want] and got[list(get_model("eight-dof").parameters).index("k_ip1")] == 0
-    assert "model eight-dof, preset eight-dof, --set k_ip1=inf m_c=5" in path.read_text()
+    assert list(got) == [float(v) for v in want] and got[list(get_model("paper").parameters).index("k_ip1")] == 0
+    assert "model paper, preset paper, --set k_ip1=inf N0=5" in path.read_text()
 
 
 def test_paper_closed_form_is_the_general_case():

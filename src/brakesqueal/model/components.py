@@ -102,7 +102,7 @@ _POS_INF = (0.0, _INF, True, False)  # (0, inf]
 
 
 def param(default: Any, unit: str, description: str, interval: tuple[float, float, bool, bool], note: str = "",
-          *, unless: str | None = None) -> Any:
+          *, unless: str | None = None, finite_if: Callable[[Any], str | None] | None = None) -> Any:
     """A component field holding a number or a parameter name: its *role* and schema note in the field's metadata.
 
     Parameters
@@ -118,9 +118,14 @@ def param(default: Any, unit: str, description: str, interval: tuple[float, floa
     unless : str, optional
         A flag field of the component; when it is false the field does not enter the equations (still
         checked; its role comes after the used ones).
+    finite_if : callable, optional
+        For an interval that allows ``+inf``: ``finite_if(component)`` is ``None`` where ``inf`` is allowed in
+        this component, else why it is not (``"a pad with a tangential DOF needs a finite k_ip ..."``);
+        the parameter's role in such a component is then the interval without ``inf``
+        (:func:`.roles.parameter_roles`), so every input channel refuses it.
     """
     return field(default=default, metadata={"role": FieldDef(unit, description, *interval), "note": note,
-                                            "unless": unless})
+                                            "unless": unless, "finite_if": finite_if})
 
 
 def attribute(schema: Mapping[str, Any], default: Any = dataclasses.MISSING, *,
@@ -340,6 +345,13 @@ class Disk:
                 "V_support": sm.Rational(1, 2) * v(self.k_t) * (q1**2 + q2**2)}
 
 
+def _k_ip_finite(pad: Pad) -> str | None:
+    """Why a pad's ``k_ip`` must be finite (``None``: ``inf``, a rigid tangential support, is allowed)."""
+    if "tangential" in pad.dofs:
+        return "a pad with a tangential DOF needs a finite k_ip (a rigid tangential support would remove that DOF)"
+    return None
+
+
 @dataclass(frozen=True)
 class Pad:
     """One brake pad in point contact with a disk face."""
@@ -358,7 +370,7 @@ class Pad:
     d: Value = param("d", "N s/m", "normal support damping of {owner}", _NONNEG)
     preload: Value = param("N0", "N", "normal preload of {owner}", _POS)
     k_ip: Value = param(math.inf, "N/m", "tangential support stiffness of {owner} (inf = rigid)", _POS_INF,
-                        " Default 'inf' (rigid); a tangential DOF needs a finite k_ip.")
+                        " Default 'inf' (rigid); a tangential DOF needs a finite k_ip.", finite_if=_k_ip_finite)
     d_ip: Value = param(0.0, "N s/m", "tangential support damping of {owner}", _NONNEG,
                         " In parallel with the tangential spring; needs a finite k_ip. On a massless pad it makes "
                         "the pad's tangential rate a state that stays determined through lift-off (not in the "
@@ -506,7 +518,7 @@ class Pad:
             raise ParameterError(f"{c}: a pad mass needs at least one DOF ('normal' and/or 'tangential')")
         if "normal" in self.dofs and self.k_c is None:
             raise ParameterError(f"{c}: a normal DOF needs a contact stiffness k_c")
-        if "tangential" in self.dofs and isinstance(self.k_ip, float) and math.isinf(self.k_ip):
+        if _k_ip_finite(self) and isinstance(self.k_ip, float) and math.isinf(self.k_ip):
             raise ParameterError(f"{c}: a tangential DOF without stiffness (k_ip = inf): give a finite k_ip")
         if self.d_ip != 0.0 and isinstance(self.k_ip, float) and math.isinf(self.k_ip):
             raise ParameterError(f"{c}: a tangential damper d_ip needs a finite tangential stiffness k_ip (a "

@@ -10,6 +10,12 @@ parameter files, ``--set``, model files, map and sweep axes, the explorer)
 validates through :func:`problems` (scalars) or :func:`valid_mask` (arrays),
 so a value is accepted or refused the same way everywhere.
 
+A field whose interval allows ``inf`` may refuse it in some components (its
+``finite_if`` rule, :func:`.components.param`): a pad's tangential stiffness
+``k_ip`` may be ``inf`` (a rigid support) unless the pad has a tangential
+DOF.  The role of a parameter in such a component is the interval without
+``inf`` (:attr:`Role.finite` says why), so every channel refuses it there.
+
 Besides each role's interval, two rules hold for every parameter:
 
 * finite values must have a magnitude of at most :data:`MAX_MAGNITUDE`
@@ -52,9 +58,13 @@ class Role(FieldDef):
     key : str
         ``"<component>.<field>"``, e.g. ``"pad.k_ip"``; the other attributes are those of the FieldDef (a
         ``description`` template with ``{owner}``; ``high = inf`` with ``high_open = False`` allows ``+inf``).
+    finite : str
+        ``""``, or why ``+inf`` is refused here although the field's interval allows it (the field's
+        ``finite_if`` rule for its component, :func:`.components.param`); the interval is then open at ``inf``.
     """
 
     key: str = ""
+    finite: str = ""
 
     @property
     def allows_inf(self) -> bool:
@@ -196,6 +206,13 @@ class ParameterRoles:
         return bool(roles) and all(r.allows_inf for r, _ in roles)
 
 
+def _component_role(role: Role, f: dataclasses.Field[Any], comp: Any) -> Role:
+    """The role of field ``f`` in component ``comp``: without ``inf`` where its ``finite_if`` rule says so."""
+    rule = f.metadata.get("finite_if")
+    why = rule(comp) if rule is not None and role.allows_inf else None
+    return dataclasses.replace(role, high_open=True, finite=why) if why else role
+
+
 def parameter_roles(spec: Any) -> ParameterRoles:
     """Collect the roles of the named parameters of ``spec`` (a :class:`~.components.ModelSpec`)."""
     from .components import COMPONENTS, FrictionLaw, components
@@ -211,7 +228,8 @@ def parameter_roles(spec: Any) -> ParameterRoles:
             v, unless = getattr(comp, f.name), f.metadata.get("unless")
             if "role" in f.metadata:
                 later = unless and not getattr(comp, unless)
-                (unused if later else used).append((table[f"{kind.key}.{f.name}"], v, owner))
+                (unused if later else used).append((_component_role(table[f"{kind.key}.{f.name}"], f, comp), v,
+                                                    owner))
             elif isinstance(v, FrictionLaw):
                 used += [(table[f"friction.{name}"], x, owner) for name, x in v.values().items()]
     for role, value, owner in (*used, *unused):
@@ -258,7 +276,8 @@ def role_message(role: Role, owner: str, subject: str, v: float) -> str | None:
         return (f"{subject} ({what}) must have a magnitude of at most {MAX_MAGNITUDE:.0e}"
                 f"{' or be inf' if role.allows_inf else ''}; got {v!r}")
     unit = f" {role.unit}" if role.unit else ""
-    return f"{subject} ({what}) must be in {role.interval()}{unit}; got {v!r}"
+    why = f": {role.finite}" if role.finite and v == _INF else ""
+    return f"{subject} ({what}) must be in {role.interval()}{unit}{why}; got {v!r}"
 
 
 def _value_message(name: str, value: Any, roles: ParameterRoles) -> str | None:
