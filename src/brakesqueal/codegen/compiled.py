@@ -237,7 +237,9 @@ def _simplified_rate_columns(jac0: list[Any], eq: Any) -> list[Any]:
     Omega^2 r^2/|Omega r|^3``), whose rounding noise would otherwise pose as a
     tiny non-zero rate coefficient and a spurious pad mode of order
     ``1/noise``; simplified with SymPy (parameters positive, except the disk
-    faces' distances) the cancellation is done exactly.
+    faces' distances) the cancellation is done exactly, and exponentials stay
+    in the numerators (:func:`~brakesqueal.symbolic.linearize.simplify_entry`:
+    a Stribeck decay ``exp(-v/v_s)`` is never evaluated as ``1/exp(v/v_s)``).
     """
     n, m = len(eq.coords), len(eq.algebraic)
     nx = 3 * n + 2 * m
@@ -249,6 +251,8 @@ def _simplified_rate_columns(jac0: list[Any], eq: Any) -> list[Any]:
     import sympy as sp
     import symengine as se
 
+    from ..symbolic.linearize import simplify_entry
+
     spec = eq.spec
     real = {v for v in (spec.disk.h_upper, spec.disk.h_lower) if isinstance(v, str)}
     pos = {sp.Symbol(str(p)): (sp.Symbol(str(p), real=True) if name in real else sp.Symbol(str(p), positive=True))
@@ -256,7 +260,7 @@ def _simplified_rate_columns(jac0: list[Any], eq: Any) -> list[Any]:
     back = {v: k for k, v in pos.items()}
     out = list(jac0)
     for k in todo:
-        v = sp.factor_terms(sp.cancel(sp.sympify(str(jac0[k])).xreplace(pos))).xreplace(back)
+        v = simplify_entry(sp.sympify(str(jac0[k])).xreplace(pos)).xreplace(back)
         out[k] = se.sympify(v)
     return out
 

@@ -469,7 +469,7 @@ def _linear_functions(spec: Any) -> tuple[tuple[ExportFunction, ...], dict[str, 
     import sympy as sp
 
     from ..symbolic.assemble import build_equations
-    from ..symbolic.linearize import model_closed_form
+    from ..symbolic.linearize import model_closed_form, simplify_entry
 
     eq = build_equations(spec, "symengine")
     cf = model_closed_form(spec)
@@ -493,7 +493,7 @@ def _linear_functions(spec: Any) -> tuple[tuple[ExportFunction, ...], dict[str, 
     def entries(mat: Any) -> list[Any]:
         out = []
         for e in list(mat):
-            e = sp.factor_terms(sp.cancel(sp.sympify(e).xreplace(back))).xreplace(final)
+            e = simplify_entry(sp.sympify(e).xreplace(back)).xreplace(final)
             stray = {str(s) for s in e.free_symbols} - avoid
             if stray:  # pragma: no cover - a programming error
                 raise BrakesquealError(f"export: closed form of model '{spec.name}' has unknown symbols {stray}")

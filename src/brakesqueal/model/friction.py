@@ -27,6 +27,15 @@ and sliding reversals (the pad faster than the disk) are ordinary motion.  With
 ``slope < 0`` (a rising term) a massless pad's tangential rate is a regular
 state whose balance has a root for every spring force.  The error against
 set-valued Coulomb stick-slip is O(``v_reg``) plus O(``slope``) (``docs/simulation.md``, stick-slip).
+
+The speed scales ``v_s`` and ``v_reg`` lie in :data:`SPEED_SCALE`, ``(1e-50, 1e50)`` m/s:
+the generated code evaluates ``v / v_s^2`` (the derivative of ``exp(-v / v_s)``
+with respect to ``v_s``) and ``(v^2 + v_reg^2)^2`` (the pads' simplified rate
+terms of ``stick``), which overflow beyond (the latter also at sliding speeds
+beyond 1e77 m/s).  A decay ``exp(-v / v_s)`` stays the exponential of a
+non-positive number in every generated function (the symbolic simplifications
+keep it in the numerators, :func:`brakesqueal.symbolic.linearize.simplify_entry`),
+so at sliding speeds of many ``v_s`` it vanishes instead of overflowing.
 """
 
 from __future__ import annotations
@@ -37,9 +46,13 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
 
-__all__ = ["FieldDef", "LawDef", "LAWS"]
+__all__ = ["FieldDef", "LawDef", "LAWS", "SPEED_SCALE"]
 
 _INF = math.inf
+
+#: Allowed interval ``(low, high, low_open, high_open)`` of a law's speed scale (``v_s``, ``v_reg``) [m/s]: within
+#: it ``v / v_s^2`` (sliding speeds ``v`` up to 1e100 m/s) and ``v_reg^4`` of the generated code stay finite.
+SPEED_SCALE = (1e-50, 1e50, True, True)
 
 
 @dataclass(frozen=True)
@@ -101,10 +114,10 @@ LAWS: Mapping[str, LawDef] = MappingProxyType({law.name: law for law in (
            lambda sm, v, f: f["mu"] - f["slope"] * v, rate_dependent=True, text="mu(v) = mu - slope * v"),
     LawDef("stribeck", {"mu_s": FieldDef("", "static friction coefficient (Stribeck) at {owner}", 0.0, _INF,
                                          False, True),
-                        "v_s": FieldDef("m/s", "Stribeck speed at {owner}", 0.0, _INF, True, True)},
+                        "v_s": FieldDef("m/s", "Stribeck speed at {owner}", *SPEED_SCALE)},
            lambda sm, v, f: f["mu"] + (f["mu_s"] - f["mu"]) * sm.exp(-v / f["v_s"]), rate_dependent=True,
            text="mu(v) = mu + (mu_s - mu) * exp(-v / v_s)"),
-    LawDef("stick", {"v_reg": FieldDef("m/s", "stick-slip regularisation speed at {owner}", 0.0, _INF, True, True),
+    LawDef("stick", {"v_reg": FieldDef("m/s", "stick-slip regularisation speed at {owner}", *SPEED_SCALE),
                      "slope": FieldDef("s/m", "friction slope -dmu/dv (beyond stick) at {owner}", -_INF, _INF,
                                        True, True)},
            # written as v * (...) so that mu(v) v_r / v cancels symbolically: the force is defined at v_r = 0

@@ -33,6 +33,7 @@ __all__ = [
     "ClosedForm",
     "closed_form",
     "model_closed_form",
+    "simplify_entry",
 ]
 
 Case = Literal["general", "symmetric", "asymmetric-friction", "minimal"]
@@ -42,6 +43,41 @@ CASES: tuple[str, ...] = ("general", "symmetric", "asymmetric-friction", "minima
 BLOCKS: tuple[str, ...] = ("psi_q", "psi_dq", "psi_ddq", "psi_l", "psi_dl", "g_q", "g_dq", "g_l", "g_dl")
 _GROUPS = ("Q", "dQ", "ddQ", "L", "dL")
 _OLD = {"R": "psi", "G": "g", "Q": "q", "dQ": "dq", "ddQ": "ddq", "L": "l", "dL": "dl"}
+
+
+def simplify_entry(e: Any) -> Any:
+    """``factor_terms(cancel(e))`` with every exponential kept as written: no ``exp`` moves to a denominator.
+
+    SymPy's ``cancel`` writes ``exp(-x)`` as ``1/exp(x)`` (``as_numer_denom``)
+    and multiplies the other terms by ``exp(x)``.  Generated from that, a
+    decaying term such as the Stribeck law's ``exp(-v/v_s)`` at a sliding
+    speed of many ``v_s`` evaluates ``exp`` of a large positive argument,
+    which overflows to ``inf/inf = nan``.  Here each exponential is a
+    positive atom while the rest is cancelled, so the result evaluates only
+    the exponentials of the model (a friction law's decay: at most 1).
+    Without exponentials this is ``factor_terms(cancel(e))`` itself.
+
+    Parameters
+    ----------
+    e : sympy.Expr
+        The expression (SymPy; symbols with their signs).
+
+    Returns
+    -------
+    sympy.Expr
+        Equal to ``e``.
+    """
+    import sympy as sp
+
+    e = sp.sympify(e)
+    atoms = e.atoms(sp.exp)
+    if not atoms:
+        return sp.factor_terms(sp.cancel(e))
+    # one atom per exponent (cancelled, so that equal exponents written differently share it)
+    exps = {a: sp.exp(sp.cancel(a.args[0])) for a in atoms}
+    mask = {x: sp.Dummy("E", positive=True) for x in set(exps.values())}
+    masked = e.xreplace({a: mask[x] for a, x in exps.items()})
+    return sp.factor_terms(sp.cancel(masked)).xreplace({d: x for x, d in mask.items()})
 
 
 def _equations(eq: Any) -> Any:
@@ -201,7 +237,7 @@ def closed_form(case: Case = "general") -> ClosedForm:
 
     The blocks are derived with symengine, then converted to SymPy with
     positive symbols, the case's parameter relations substituted and each
-    entry simplified (``cancel`` then ``factor_terms``).
+    entry simplified (``cancel`` then ``factor_terms``, :func:`simplify_entry`).
 
     Parameters
     ----------
@@ -229,7 +265,7 @@ def closed_form(case: Case = "general") -> ClosedForm:
 
     def conv(m: Any) -> Any:
         out = sp.Matrix(sp.sympify(m)).xreplace({sp.Symbol(n): S[n] for n in names})
-        return out.xreplace(subs).applyfunc(lambda e: sp.factor_terms(sp.cancel(e)))
+        return out.xreplace(subs).applyfunc(simplify_entry)
 
     return ClosedForm(case=case, M=conv(M), D=conv(D), K=conv(K), assumptions=_ASSUMPTIONS[case], symbols=S)
 
@@ -254,7 +290,7 @@ def model_closed_form(spec: Any) -> ClosedForm:
     -------
     ClosedForm
         ``case = "model:<name>"``; entries simplified with ``cancel`` and
-        ``factor_terms``.
+        ``factor_terms`` (:func:`simplify_entry`: exponentials stay in the numerators).
     """
     import sympy as sp
 
@@ -269,7 +305,7 @@ def model_closed_form(spec: Any) -> ClosedForm:
         back[sp.Symbol(pn)] = 1 / S[n] if pn != n else S[n]
 
     def conv(m: Any) -> Any:
-        return sp.Matrix(sp.sympify(m)).xreplace(back).applyfunc(lambda e: sp.factor_terms(sp.cancel(e)))
+        return sp.Matrix(sp.sympify(m)).xreplace(back).applyfunc(simplify_entry)
 
     sb = {k: conv(v) for k, v in blocks.items() if k[0] in "RG" and "_" in k and not k.startswith(("psi", "g_"))}
     n = len(eq.coords)
@@ -283,9 +319,8 @@ def model_closed_form(spec: Any) -> ClosedForm:
         if qs:
             GL = sb["G_L"].extract(qs, qs)
             P = sb["R_L"].extract(list(range(n)), qs) * GL.inv()
-            simp = lambda e: sp.factor_terms(sp.cancel(e))  # noqa: E731
-            D = (D - P * sb["G_dQ"].extract(qs, list(range(n)))).applyfunc(simp)
-            K = (K - P * sb["G_Q"].extract(qs, list(range(n)))).applyfunc(simp)
+            D = (D - P * sb["G_dQ"].extract(qs, list(range(n)))).applyfunc(simplify_entry)
+            K = (K - P * sb["G_Q"].extract(qs, list(range(n)))).applyfunc(simplify_entry)
         if dyn:
             rows, alln = list(range(n)), list(range(n))
             rate = {"pads": tuple(eq.algebraic[j] for j in dyn),
