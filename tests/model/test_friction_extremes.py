@@ -272,9 +272,6 @@ def test_parameter_space_refuses_tiny_stribeck_speed(models) -> None:
     assert space.valid(arr).tolist() == [False, True, False]
 
 
-@pytest.mark.xfail(strict=True, reason="analysis/kernels.py (_build_rates) still simplifies the pads' rate blocks "
-                                       "with plain sympy.cancel, which puts exp(v/v_s) in a denominator; use "
-                                       "brakesqueal.symbolic.linearize.simplify_entry there")
 def test_point_route_decides_the_adversarial_point(models) -> None:
     pv = evaluate_point(_space(models, "stribd"), {"Omega": 18927.0, "vs": 1.81})
     assert pv.status == PointStatus.OK and pv.stable and math.isfinite(pv.max_real)

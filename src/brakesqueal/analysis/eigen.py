@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from .linear import LinearModel, linearize
+from .linear import EXTENDED_MAX_SIZE, LinearModel, linearize
 
 __all__ = ["EigenAnalysis", "eigen_analysis", "Verdict"]
 
@@ -117,10 +117,12 @@ class EigenAnalysis:
         Routh for 2-DOF models, eigenvalues with condition bounds otherwise),
         the same as maps, sweeps and the command line report; ``error_bound``
         is the first-order estimate ``safety · κ · ε · ‖A‖`` of the least-stable
-        eigenvalue's error (for information); for a descriptor model (pad
-        states) of size up to
+        eigenvalue's error (for information); for state sizes up to
         :data:`~.robust.EXTENDED_VERDICT_MAX_SIZE` it is the componentwise
-        bound of :func:`~.robust.extended_descriptor_verdict`.
+        bound of :func:`~.robust.extended_descriptor_verdict`.  ``max_real``
+        is that of the listed eigenvalues (extended precision up to that
+        size); where they contradict the certified verdict the status is
+        ``"undecided"``.
         """
         from .points import linear_verdict
         from .robust import EXTENDED_VERDICT_MAX_SIZE, STABLE, UNSTABLE, extended_descriptor_verdict
@@ -129,13 +131,19 @@ class EigenAnalysis:
         code, mr, _ = linear_verdict(lm)
         i = int(np.argmax(self.eigenvalues.real))
         E, A = lm.descriptor
-        if lm.pad_states and E.shape[0] <= EXTENDED_VERDICT_MAX_SIZE:
+        if E.shape[0] <= EXTENDED_VERDICT_MAX_SIZE:
             # componentwise bound of the extended-precision route: the norm-wise one below is dominated by the
-            # pads' own modes (up to 1e25 at tilted silent motions) and says nothing about the slow modes
+            # largest modes (pads' own modes up to 1e25 at tilted silent motions) and says little of the slow ones
             bound = extended_descriptor_verdict(E, A, len(lm.pad_states))[3]
         else:
             bound = safety * float(self.condition[i]) * _EPS * float(np.linalg.norm(lm.A, 2))
         status = "stable" if code == STABLE else "unstable" if code == UNSTABLE else "undecided"
+        listed = float(self.eigenvalues[i].real)
+        if (code == STABLE and not listed < 0) or (code == UNSTABLE and not listed > 0):
+            # the listed eigenvalues (extended precision) and the route disagree: neither is reported as certain
+            status = "undecided"
+        if lm.pad_states or 2 * lm.n <= EXTENDED_MAX_SIZE:
+            mr = listed  # the verdict line names the largest real part of the listed eigenvalues
         return Verdict(status, mr, bound, mr / abs(self.eigenvalues[i]))
 
     # -------------------------------------------------------------- sensitivities
@@ -312,7 +320,7 @@ def eigen_analysis(model: Any) -> EigenAnalysis:
     w, vl, vr = _eig_left_right(A)
     order = np.lexsort((-w.imag, -w.real))
     w, vl, vr = w[order], vl[:, order], vr[:, order]
-    if lm.pad_states and lm.eigenvalues.size == w.size:
+    if (lm.pad_states or 2 * lm.n <= EXTENDED_MAX_SIZE) and lm.eigenvalues.size == w.size:
         # the eigenvalues themselves from the linear model (extended precision: double-precision E^-1 A moves the
         # structural modes' real parts by percents beside 1e15 pad modes), each with the vectors of its nearest
         # double-precision eigenvalue, so `eigen` lists what `linearize` lists

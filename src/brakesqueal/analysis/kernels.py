@@ -356,7 +356,7 @@ def _build_rates(spec: Any) -> RateBlocks:
     import symengine as se
 
     from ..symbolic.assemble import build_equations
-    from ..symbolic.linearize import model_closed_form
+    from ..symbolic.linearize import model_closed_form, simplify_entry
 
     eq = build_equations(spec, "symengine")
     n, m = len(eq.coords), len(eq.algebraic)
@@ -370,8 +370,8 @@ def _build_rates(spec: Any) -> RateBlocks:
     G = eq.G if eq.G is not None else se.zeros(0, 1)
 
     def clean(e: Any) -> Any:
-        v = sp.factor_terms(sp.cancel(sp.sympify(e.subs(zero)).xreplace(back)))
-        return sp.cancel(v.xreplace(fwd)) if fwd else v
+        v = simplify_entry(sp.sympify(e.subs(zero)).xreplace(back))
+        return simplify_entry(v.xreplace(fwd)) if fwd else v
 
     exprs = []
     for res, var, rows, cols in ((eq.R, eq.dL, n, m), (G, eq.dL, m, m), (G, eq.ddQ, m, n)):

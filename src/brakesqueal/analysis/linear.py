@@ -133,13 +133,28 @@ def descriptor_eigenvalues(E: np.ndarray, A: np.ndarray, dps: int = 40) -> np.nd
         return pencil_eigenvalues(E, A)
     import mpmath
 
-    with mpmath.workdps(dps):
-        try:
-            S = mpmath.inverse(mpmath.matrix(E.tolist())) * mpmath.matrix(A.tolist())
-            ev = mpmath.eig(S, left=False, right=False)
-        except (ZeroDivisionError, mpmath.libmp.NoConvergence):  # a singular E, or no convergence
+    def at(digits: int) -> list[Any] | None:
+        with mpmath.workdps(digits):
+            try:
+                S = mpmath.inverse(mpmath.matrix(E.tolist())) * mpmath.matrix(A.tolist())
+                return list(mpmath.eig(S, left=False, right=False))
+            except (ZeroDivisionError, mpmath.libmp.NoConvergence):  # a singular E, or no convergence
+                return None
+
+    # the matrices' entries may span 1e100 (extreme but valid parameters): the precision is doubled until two
+    # successive ones agree on every eigenvalue (each to 1e-12 of itself)
+    prev, digits = at(dps), 2 * dps
+    if prev is None:
+        return pencil_eigenvalues(E, A)
+    while True:
+        cur = at(digits)
+        if cur is None:
             return pencil_eigenvalues(E, A)
-        lam = np.array([complex(z) for z in ev])
+        agree = all(min(abs(z - w) for w in prev) <= 1e-12 * abs(z) for z in cur)
+        if agree or digits >= 16 * dps:
+            break
+        prev, digits = cur, 2 * digits
+    lam = np.array([complex(z) for z in cur])
     tiny = np.abs(lam.imag) <= 1e-30 * np.abs(lam)  # a real eigenvalue's imaginary part at the dps noise
     lam[tiny] = lam[tiny].real
     return lam
@@ -339,9 +354,9 @@ class LinearModel(ModalMixin):
     def eigenvalues(self) -> np.ndarray:
         """Finite eigenvalues [1/s] of the linear model, sorted by decreasing real part, then imaginary part."""
         if not self._eig:
-            if not self.pad_states:
+            if not self.pad_states and 2 * self.n > EXTENDED_MAX_SIZE:
                 lam = np.linalg.eigvals(self.A)
-            else:
+            else:  # every scale right at once (extreme parameters, huge pad modes): extended precision
                 lam = descriptor_eigenvalues(*self.reduced_descriptor)
             self._eig.append(_sort(lam))
         return self._eig[0]

@@ -277,6 +277,12 @@ def linear_verdict(lm: Any) -> tuple[int, float, float]:
         c, mr, fr = matrix_verdicts(lm.M, lm.D, lm.K)
     else:
         c, mr, fr = eigen_verdicts(lm.M[None], lm.D[None], lm.K[None])
+    if int(c[0]) == UNDECIDED and 2 * lm.n <= EXTENDED_VERDICT_MAX_SIZE:
+        # extreme but valid parameters (entries spanning 1e100): the matrices' own eigenvalues in extended
+        # precision with componentwise bounds
+        code, m1, f1, _, lam = extended_descriptor_verdict(*lm.descriptor, 0)
+        if code != UNDECIDED:
+            return code, m1, f1
     if int(c[0]) == UNDECIDED and getattr(getattr(lm, "silent", None), "trivial", False):
         # the float matrices cannot decide (a point on the boundary to rounding): the parameter point's own
         # route can (closed forms in exact arithmetic), and maps and sweeps report that verdict
