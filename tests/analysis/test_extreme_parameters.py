@@ -111,3 +111,37 @@ def test_a_range_past_omegas_bound_is_undecided_there_and_agrees_with_crossings(
     assert (status == int(PointStatus.UNDECIDED)).all(), status
     _, _, _, _, status_in = critical_speeds_many(space, {}, 1.0, 1e100, return_status=True)
     assert (status_in == int(PointStatus.OK)).all()
+
+
+def test_verdict_line_and_listed_eigenvalues_agree_at_extreme_values():
+    """``linearize`` printed "UNSTABLE: max Re = 0.0" beside a listed 1.29e30 (mu = 1e90, k_ip = inf), and a
+    verdict max Re of 1.55e11 beside a listed 0.0 (mu = 1e30): double-precision eigenvalues of matrices whose
+    entries span 1e100.  Reference: the roots of det(lambda^2 M + lambda D + K) from the float matrices taken as
+    exact rationals (SymPy), found by mpmath.polyroots at 120 digits."""
+    import mpmath
+    import numpy as np
+
+    from brakesqueal import linearize, resolve_space
+    from brakesqueal.analysis.eigen import eigen_analysis
+    from brakesqueal.analysis.robust import charpoly_exact
+
+    rng = np.random.default_rng(27)
+    cases = [("mu=1e90", "k_ip=inf"), ("k_ip=1e-100",), ("mu=1e30",), ("mu=1e50",), ("mu=0.4",)]
+    cases += [(f"mu={10 ** rng.uniform(-6, 90)!r}", f"k_ip={10 ** rng.uniform(-100, 100)!r}") for _ in range(6)]
+    for sets in cases:
+        lm = linearize(resolve_space(None, None, None, list(sets)).resolve({}))
+        coeffs = charpoly_exact(lm.M, lm.D, lm.K)
+        with mpmath.workdps(120):
+            c = [mpmath.mpf(f.numerator) / f.denominator for f in reversed(coeffs)]
+            ref = np.array([complex(z) for z in mpmath.polyroots(c, maxsteps=400, extraprec=2000)])
+        lam = lm.eigenvalues
+        assert lam.size == ref.size
+        for z in ref:
+            assert np.min(np.abs(lam - z)) <= 1e-9 * abs(z), sets
+        v = eigen_analysis(lm).verdict()
+        assert v.max_real == pytest.approx(ref.real.max(), rel=1e-9)
+        if v.status == "stable":
+            assert v.max_real < 0, sets
+        elif v.status == "unstable":
+            assert v.max_real > 0, sets
+        assert math.isfinite(v.error_bound)
