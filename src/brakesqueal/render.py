@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from typing import Any
 
 import numpy as np
@@ -63,8 +64,8 @@ def render_linear_model(lm: Any, fmt: str) -> str:
     v = eigen_analysis(lm).verdict()
     if fmt == "json":
         d = lm.to_dict()
-        d["verdict"] = {"status": v.status, "max_real": v.max_real, "error_bound": float(v.error_bound)}
-        return json.dumps(d, indent=2)
+        d["verdict"] = _verdict_dict(v)
+        return json.dumps(_json_safe(d), indent=2, allow_nan=False)
     sm = lm.silent
     lines = [f"Model '{lm.model.name}' ({lm.n} DOF: {', '.join(lm.coords)})", "Parameters:"]
     for k, val in lm.params.to_json_dict().items():
@@ -81,11 +82,37 @@ def render_linear_model(lm: Any, fmt: str) -> str:
     for z in lm.eigenvalues:
         f = abs(z.imag) / (2 * np.pi)
         zeta = -z.real / abs(z) if abs(z) > 0 else 0.0
-        lines.append(f"  {z.real: .6e} {z.imag:+.6e}j  {f:12.4f}  {zeta: .3e}")
+        lines.append(f"  {z.real: .6e} {z.imag:+.6e}j  {_hz(f)}  {zeta: .3e}")
     word = {"stable": "stable", "unstable": "UNSTABLE (squeal)", "undecided": "UNDECIDED"}[v.status]
     lines.append(f"Silent motion is {word}: max Re(lambda) = {v.max_real:.6e} 1/s "
-                 f"(error bound {float(v.error_bound):.1e} 1/s)")
+                 f"({_bound_text(v.error_bound, ' 1/s')})")
     return "\n".join(lines) + "\n"
+
+
+def _hz(f: float, width: int = 12) -> str:
+    """A frequency in a column (scientific notation from 1e9 Hz: a 1e46 pad mode took 46 digits)."""
+    return f"{f:{width}.4f}" if f < 1e9 else f"{f:{width}.4e}"
+
+
+def _bound_text(bound: float, unit: str = "") -> str:
+    return f"error bound {float(bound):.1e}{unit}" if math.isfinite(bound) else "no finite error bound"
+
+
+def _json_safe(obj: Any) -> Any:
+    """``obj`` with every non-finite float replaced by ``None`` (JSON has no Infinity or NaN)."""
+    if isinstance(obj, dict):
+        return {k: _json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_json_safe(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def _verdict_dict(v: Any) -> dict[str, Any]:
+    """The verdict as JSON (a non-finite error bound is ``null``: JSON has no Infinity)."""
+    b = float(v.error_bound)
+    return {"status": v.status, "max_real": v.max_real, "error_bound": b if math.isfinite(b) else None}
 
 
 def render_eigen(ea: Any, fmt: str, *, mode: int = 0) -> str:
@@ -95,9 +122,9 @@ def render_eigen(ea: Any, fmt: str, *, mode: int = 0) -> str:
     sens = ea.parameter_sensitivities()
     contrib = {} if lm.pad_states else {n: ea.contributions(n, mode) for n in lm.params.names}
     if fmt == "json":
-        return json.dumps({
+        return json.dumps(_json_safe({
             "model": lm.model.name, "parameters": lm.params.to_json_dict(), "coords": list(lm.coords),
-            "verdict": {"status": v.status, "max_real": v.max_real, "error_bound": float(v.error_bound)},
+            "verdict": _verdict_dict(v),
             "modes": [{"eigenvalue": [float(z.real), float(z.imag)], "frequency_hz": float(f),
                        "damping_ratio": float(zt), "condition": float(c),
                        "shape": [[float(x.real), float(x.imag)] for x in ea.modes[:, i]]}
@@ -105,15 +132,15 @@ def render_eigen(ea: Any, fmt: str, *, mode: int = 0) -> str:
                                                              ea.condition))],
             "sensitivities": {n: [[float(x.real), float(x.imag)] for x in s] for n, s in sens.items()},
             "attribution": {"mode": mode, "d_Re_lambda_d_ln_p": contrib},
-        }, indent=2) + "\n"
+        }), indent=2, allow_nan=False) + "\n"
     lines = [f"Model '{lm.model.name}': verdict {v.status}, max Re(lambda) = {v.max_real:.6e} 1/s "
-             f"(error bound {float(v.error_bound):.1e})", "",
+             f"({_bound_text(v.error_bound)})", "",
              "mode  Re(lambda) [1/s]   frequency [Hz]  damping ratio  condition   shape (|x|, largest first)"]
     for i, (z, f, zt, c) in enumerate(zip(ea.eigenvalues, ea.frequencies, ea.damping_ratios, ea.condition)):
         x = ea.modes[:, i]
         order = np.argsort(-np.abs(x))[:3]
         shape = ", ".join(f"{lm.coords[k]} {abs(x[k]):.3f}" for k in order)
-        lines.append(f"{i:4d}  {z.real: .6e}  {f:14.4f}  {zt: .3e}  {c:9.3g}   {shape}")
+        lines.append(f"{i:4d}  {z.real: .6e}  {_hz(f, 14)}  {zt: .3e}  {c:9.3g}   {shape}")
     lines += ["", f"Sensitivities d Re(lambda_{mode}) / d ln p [1/s]:"]
     ranked = sorted(sens.items(), key=lambda kv: -abs(kv[1][mode].real))
     for n, s in ranked:

@@ -50,3 +50,41 @@ def test_oversized_and_endless_files_are_refused(tmp_path, capsys, command):
     for path in (str(big), "/dev/zero"):
         rc, err = _run(capsys, *command, path)
         assert rc == 2 and len(err) == 1 and "larger than" in err[0], err
+
+
+@pytest.mark.parametrize("command", [("linearize",), ("eigen",), ("modes", "--along", "N0=1000:2000")])
+@pytest.mark.parametrize("setting", ["k_ip=1e-300", "Theta=1e-300", "Omega=1e-200", "mu=-1e-200"])
+def test_tiny_magnitudes_are_refused_with_one_line(capsys, command, setting):
+    """1e-300 overflowed in the generated equations' powers (LinAlgError, ZeroDivisionError tracebacks)."""
+    rc, err = _run(capsys, *command, "--set", setting)
+    assert rc == 2 and len(err) == 1 and "magnitude of at least 1e-100" in err[0], err
+
+
+def test_tiny_magnitudes_are_invalid_map_cells_and_zero_stays_allowed():
+    import numpy as np
+
+    from brakesqueal import resolve_space
+
+    space = resolve_space(None, "paper-fig2", None, [])
+    arr = space.arrays({"k_ip": np.array([1e-300, 1e-100, 1e6])})
+    assert space.valid(arr).tolist() == [False, True, True]
+    space.resolve({"d_t": 0.0})  # zero where the role allows it
+    arr = space.arrays({"d_t": np.array([0.0, 1e-200, 1e-3])})
+    assert space.valid(arr).tolist() == [True, False, True]
+
+
+@pytest.mark.parametrize("setting", ["Theta=1e-100", "mu=1e90"])
+def test_json_output_is_strict_json_at_extreme_values(capsys, setting):
+    """The error bound can be infinite there: JSON carries null, never the invalid token Infinity."""
+    import json
+
+    for command in ("linearize", "eigen"):
+        rc = main([command, "--set", setting, "--format", "json"])
+        out = capsys.readouterr().out
+
+        def refuse(token):
+            raise AssertionError(f"non-JSON token {token}")
+
+        assert rc == 0
+        d = json.loads(out, parse_constant=refuse)
+        assert d["verdict"]["status"] in ("stable", "unstable", "undecided")

@@ -512,15 +512,16 @@ def test_the_parameters_alias_re_exports_the_model_names() -> None:
 # ------------------------------------------------------------------------ properties
 
 positive = st.floats(min_value=1e-12, max_value=1e12, allow_nan=False)
-nonnegative = st.floats(min_value=0.0, max_value=1e12, allow_nan=False)
+nonnegative = st.one_of(st.just(0.0), positive)  # non-zero magnitudes below 1e-100 are refused (MIN_MAGNITUDE)
 stiffness = st.one_of(positive, st.just(math.inf))
 
 
 @st.composite
 def parameter_sets(draw: st.DrawFn) -> Parameters:
     """Draw any valid parameter set of the paper's model."""
-    h10 = draw(st.floats(min_value=-1.0, max_value=1.0, allow_nan=False))
-    h20 = draw(st.floats(min_value=-h10 + 1e-6, max_value=2.0, allow_nan=False))
+    h10 = draw(st.floats(min_value=-1.0, max_value=1.0, allow_nan=False).filter(lambda x: x == 0 or abs(x) >= 1e-100))
+    h20 = draw(st.floats(min_value=-h10 + 1e-6, max_value=2.0, allow_nan=False)
+               .filter(lambda x: x == 0 or abs(x) >= 1e-100))
     return Parameters(PAPER, dict(
         Theta=draw(positive), Phi=draw(positive), k_t=draw(nonnegative),
         d_t=draw(nonnegative), k1=draw(nonnegative), k2=draw(nonnegative),

@@ -332,8 +332,9 @@ def eigen_analysis(model: Any) -> EigenAnalysis:
             free.remove(j)
             pick.append(j)
         w, vl, vr = acc.copy(), vl[:, pick], vr[:, pick]
-    cond = np.array([np.linalg.norm(vl[:, i]) * np.linalg.norm(vr[:, i]) / abs(np.vdot(vl[:, i], vr[:, i]))
-                     for i in range(w.size)])
+    with np.errstate(divide="ignore", invalid="ignore"):  # a defective eigenvalue: infinite condition
+        cond = np.array([np.linalg.norm(vl[:, i]) * np.linalg.norm(vr[:, i]) / abs(np.vdot(vl[:, i], vr[:, i]))
+                         for i in range(w.size)])
     n = lm.n
     modes = np.zeros((n, w.size), dtype=complex)
     left = np.zeros((n, w.size), dtype=complex)

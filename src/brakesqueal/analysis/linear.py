@@ -134,7 +134,7 @@ def descriptor_eigenvalues(E: np.ndarray, A: np.ndarray, dps: int = 40) -> np.nd
         return pencil_eigenvalues(E, A)
     import mpmath
 
-    from .robust import scipy_balance
+    from .robust import balance_vector
 
     def at(digits: int) -> list[Any] | None:
         with mpmath.workdps(digits):
@@ -145,7 +145,7 @@ def descriptor_eigenvalues(E: np.ndarray, A: np.ndarray, dps: int = 40) -> np.nd
                 with np.errstate(all="ignore"), warnings.catch_warnings():
                     warnings.simplefilter("ignore")
                     Sd = np.array(S.tolist(), dtype=float)
-                    sc = scipy_balance(Sd) if np.all(np.isfinite(Sd)) else np.ones(m)
+                    sc = balance_vector(Sd) if np.all(np.isfinite(Sd)) else np.ones(m)
                 if np.all(np.isfinite(sc)) and np.all(sc > 0):
                     d = [mpmath.mpf(float(v)) for v in sc]
                     S = mpmath.matrix([[S[i, j] * d[j] / d[i] for j in range(m)] for i in range(m)])

@@ -70,7 +70,7 @@ __all__ = [
     "horner_bound", "isolate_real_roots", "isolate_real_roots_float", "quartic_interval", "eigen_verdicts",
     "charpoly_exact", "mp_roots_summary", "roots_summary", "trivial_verdicts", "matrix_verdicts", "reconcile",
     "exact_trivial_entries", "balance", "state_verdicts", "descriptor_verdicts", "extended_descriptor_verdict",
-    "EXTENDED_VERDICT_MAX_SIZE", "scipy_balance",
+    "EXTENDED_VERDICT_MAX_SIZE", "balance_vector",
 ]
 
 UNSTABLE, STABLE, UNDECIDED = 0, 1, 2
@@ -334,8 +334,14 @@ def balance(S: np.ndarray, iterations: int = 12) -> np.ndarray:
         The balanced matrices; off-diagonal row and column norms within a
         factor of about 2 of each other.
     """
+    return balance_scaling(S, iterations)[0]
+
+
+def balance_scaling(S: np.ndarray, iterations: int = 12) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`balance` and the diagonal ``t`` of its ``T`` (powers of 2), shape ``(N, m)``."""
     B = np.array(S, dtype=float, copy=True)
     m = B.shape[-1]
+    t = np.ones(B.shape[:-1])
     off = ~np.eye(m, dtype=bool)
     with np.errstate(all="ignore"):
         for _ in range(iterations):
@@ -348,7 +354,8 @@ def balance(S: np.ndarray, iterations: int = 12) -> np.ndarray:
                 break
             f = np.ldexp(1.0, e.astype(int))
             B *= f[..., None, :] / f[..., :, None]
-    return B
+            t *= f
+    return B, t
 
 
 def state_verdicts(S: np.ndarray, *, rel_input: float = INPUT_REL) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -512,11 +519,9 @@ def descriptor_verdicts(E: np.ndarray, A: np.ndarray, *, rel_input: float = INPU
     return codes, mr, fr
 
 
-def scipy_balance(S: np.ndarray) -> np.ndarray:
-    """Diagonal scaling (powers of 2) of LAPACK's balancing of ``S`` without permutation."""
-    import scipy.linalg
-
-    return np.asarray(scipy.linalg.matrix_balance(S, permute=False, separate=True)[1][0], dtype=float)
+def balance_vector(S: np.ndarray) -> np.ndarray:
+    """Diagonal of the power-of-2 similarity that balances one matrix (:func:`balance_scaling`, run to the end)."""
+    return balance_scaling(np.asarray(S, dtype=float)[None], iterations=200)[1][0]
 
 
 #: Largest descriptor size :func:`extended_descriptor_verdict` takes (about 30 ms at size 6).
@@ -608,7 +613,7 @@ def extended_descriptor_verdict(E: np.ndarray, A: np.ndarray, k: int, *, rel_inp
             with np.errstate(all="ignore"), warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 Sd = np.array(S.tolist(), dtype=float)
-                sc = (scipy_balance(Sd) if np.all(np.isfinite(Sd)) else np.ones(N))
+                sc = (balance_vector(Sd) if np.all(np.isfinite(Sd)) else np.ones(N))
             if not (np.all(np.isfinite(sc)) and np.all(sc > 0)):
                 sc = np.ones(N)
             dg = [mpmath.mpf(float(v)) for v in sc]

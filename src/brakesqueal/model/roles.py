@@ -20,7 +20,8 @@ Besides each role's interval, two rules hold for every parameter:
 
 * finite values must have a magnitude of at most :data:`MAX_MAGNITUDE`
   (larger ones overflow in products; write ``inf`` for a rigid support where
-  the role allows it);
+  the role allows it), and non-zero ones of at least :data:`MIN_MAGNITUDE`
+  (``1e-300`` overflowed in the generated equations' powers);
 * joint constraints: the disk thickness ``h_upper + h_lower`` is positive
   (eq. 58), a pad sits on the disk (``radius <= disk radius``), a caliper DOF
   has a stiffness.
@@ -40,11 +41,13 @@ import numpy as np
 
 from .friction import FieldDef
 
-__all__ = ["Role", "ROLES", "MAX_MAGNITUDE", "ParameterRoles", "parameter_roles", "problems", "valid_mask",
-           "format_interval", "role_message"]
+__all__ = ["Role", "ROLES", "MAX_MAGNITUDE", "MIN_MAGNITUDE", "ParameterRoles", "parameter_roles", "problems",
+           "valid_mask", "format_interval", "role_message"]
 
 #: Largest magnitude of a finite parameter value.
 MAX_MAGNITUDE = 1e100
+#: Smallest magnitude of a finite non-zero value (1e-300 overflowed in the generated equations' powers).
+MIN_MAGNITUDE = 1e-100
 
 _INF = math.inf
 
@@ -82,7 +85,8 @@ class Role(FieldDef):
         big = np.abs(v) > MAX_MAGNITUDE
         if self.allows_inf:
             big = big & ~(v == _INF)
-        return above & below & ~big
+        tiny = (v != 0) & (np.abs(v) < MIN_MAGNITUDE)
+        return above & below & ~big & ~tiny
 
 
 def _fmt(value: float) -> str:
@@ -272,6 +276,9 @@ def role_message(role: Role, owner: str, subject: str, v: float) -> str | None:
     if bool(role.contains(v)):
         return None
     what = role.description.format(owner=owner)
+    if v != 0 and abs(v) < MIN_MAGNITUDE and bool(role.contains(0.0) or role.low < MIN_MAGNITUDE):
+        zero = " be 0 or" if bool(role.contains(0.0)) else ""
+        return f"{subject} ({what}) must{zero} have a magnitude of at least {MIN_MAGNITUDE:.0e}; got {v!r}"
     if math.isfinite(v) and abs(v) > MAX_MAGNITUDE:
         return (f"{subject} ({what}) must have a magnitude of at most {MAX_MAGNITUDE:.0e}"
                 f"{' or be inf' if role.allows_inf else ''}; got {v!r}")
