@@ -23,6 +23,8 @@ __all__ = ["METHODS", "POINTS_PER_PERIOD", "START_AMPLITUDE", "SimulationModel",
 METHODS: tuple[str, ...] = ("DOP853-jit", "DOP853", "RK45", "RK23", "Radau", "BDF", "LSODA")
 #: Samples per period of the highest linear frequency in the estimation record (summary numbers).
 POINTS_PER_PERIOD = 20
+#: Largest number of output samples of one run (``sample_rate`` x duration).
+MAX_OUTPUT_SAMPLES = 50_000_000
 #: Largest deviation of the default start along the leading mode: tilt [rad] (a non-tilting disk: coordinate [m]).
 START_AMPLITUDE = 1e-5
 #: Wall time [s] of one call of the compiled integrator (between calls progress is reported, Ctrl-C acts and
@@ -556,15 +558,17 @@ def _default_atol(model: SimulationModel, params: Any, rtol: float, modes: Linea
 
 def _check_tolerances(rtol: float, atol: Any, default: np.ndarray) -> np.ndarray:
     if not (isinstance(rtol, (int, float)) and math.isfinite(rtol) and 1e-13 <= rtol <= 1e-2):
-        raise ParameterError(f"The option 'rtol' must be in [1e-13, 1e-2]; got {rtol!r}")
+        raise ParameterError(f"The option 'rtol' must be in [1e-13, 1e-2]; got {rtol!r}", parameter="rtol")
     if atol is None:
         return default
     try:
         a = np.broadcast_to(np.asarray(atol, dtype=float), default.shape).copy()
     except (ValueError, TypeError):
-        raise ParameterError(f"The option 'atol' must be one value or {default.size}; got {atol!r}") from None
+        raise ParameterError(f"The option 'atol' must be one value or {default.size}; got {atol!r}",
+                             parameter="atol") from None
     if not np.all(np.isfinite(a)) or np.any(a <= 0) or np.any(a > 1.0):
-        raise ParameterError(f"The option 'atol' must be in (0, 1] (one value or {default.size}); got {atol!r}")
+        raise ParameterError(f"The option 'atol' must be in (0, 1] (one value or {default.size}); got {atol!r}",
+                             parameter="atol")
     return a
 
 
@@ -800,11 +804,14 @@ def simulate(
     (``docs/simulation.md``).
     """
     if method not in METHODS:
-        raise ParameterError(f"The option 'method' must be one of {', '.join(METHODS)}; got {method!r}")
+        raise ParameterError(f"The option 'method' must be one of {', '.join(METHODS)}; got {method!r}",
+                             parameter="method")
     if events not in ("stop", "continue", "off"):
-        raise ParameterError(f"The option 'events' must be one of stop, continue, off; got {events!r}")
+        raise ParameterError(f"The option 'events' must be one of stop, continue, off; got {events!r}",
+                             parameter="events")
     if contact not in ("bilateral", "unilateral"):
-        raise ParameterError(f"The option 'contact' must be bilateral or unilateral; got {contact!r}")
+        raise ParameterError(f"The option 'contact' must be bilateral or unilateral; got {contact!r}",
+                             parameter="contact")
     if contact == "unilateral" and (method != "DOP853-jit" or events == "off"):
         raise ParameterError("contact='unilateral' needs method='DOP853-jit' and events 'stop' or 'continue'; got "
                              f"method={method!r}, events={events!r}")
@@ -813,12 +820,17 @@ def simulate(
     else:
         t0, t1 = (float(v) for v in t_span)  # type: ignore[union-attr]
     if not (math.isfinite(t0) and math.isfinite(t1) and t1 > t0):
-        raise ParameterError(f"The end time must be finite and greater than the start time {t0:g} s; got {t1!r}")
+        raise ParameterError(f"The end time must be finite and greater than the start time {t0:g} s; got {t1!r}",
+                             parameter="t_end")
     if not (math.isfinite(sample_rate) and sample_rate > 0):
-        raise ParameterError(f"The option 'sample_rate' must be a positive number; got {sample_rate!r}")
-    n_out = int(math.floor((t1 - t0) * sample_rate + 1e-9)) + 1
-    if n_out > 50_000_000:
-        raise ParameterError(f"{n_out} output samples requested; lower sample_rate or t_end")
+        raise ParameterError(f"The option 'sample_rate' must be a positive number; got {sample_rate!r}",
+                             parameter="sample_rate")
+    samples = (t1 - t0) * sample_rate  # a float: no overflow converting an enormous count to int
+    if not samples < MAX_OUTPUT_SAMPLES:
+        raise ParameterError(f"The options 'sample_rate' and 't_end' ask for {samples:.3g} output samples "
+                             f"(sample_rate x duration); at most {MAX_OUTPUT_SAMPLES:.0e} are allowed: lower "
+                             "'sample_rate' or 't_end'", parameter="sample_rate", names=("t_end",))
+    n_out = int(math.floor(samples + 1e-9)) + 1
     if not (max_step > 0):
         raise ParameterError(f"The option 'max_step' must be positive; got {max_step!r}")
     if not (isinstance(estimate_samples, (int, np.integer)) and 64 <= estimate_samples <= 50_000_000):
@@ -921,7 +933,7 @@ def _simulate(model, params, t0, t1, x0, perturbation, method, rtol, atol, sampl
         model=model.name, record=est.record(), modes=modes, sample_rate=float(sample_rate), y_start=y0.copy(),
         start=start, coords=model.coords, pads=model.pads, pad_unknowns=model.pad_unknowns, dynamic=model.dynamic,
         tilting=model.tilting, y_silent=st.y.copy(), l_rates=dL, event_pad=res.get("event_pad"),
-        contact_law=contact, engaged=engaged,
+        contact_law=contact, engaged=engaged, t_final=float(res["t_final"]),
     )  # fmt: skip
 
 
@@ -1100,7 +1112,9 @@ class _Run:
                 switches[int(ev_k[i]) % self.npad].append(float(ev_t[i]))
         te = float(t_event) if status == 1 else None
         st_, msg = self._status(status, t, k_event, te)
+        t_final = te if te is not None else (self.t1 if status == 0 else float(t))
         return {"status": st_, "message": msg, "Y": Y, "n": i_out, "nfev": int(stats[0]), "t_event": te,
+                "t_final": t_final,
                 "y_event": y_event.copy() if status == 1 else None, "event_times": recorded,
                 "event_pad": self._event_name(k_event)[1] if status == 1 else None, "switch_times": switches,
                 "stats": {"steps": int(stats[1]), "rejected": int(stats[2])}}  # fmt: skip
@@ -1201,7 +1215,8 @@ class _Run:
         st_, msg = self._status(code, t_end, k_event, t_event)
         if code == -2:
             msg = f"solve_ivp ({method}) failed: {sol_msg}"
-        return {"status": st_, "message": msg, "Y": Y, "n": n, "nfev": nfev, "t_event": t_event,
+        t_final = t_event if code == 1 and t_event is not None else (t1 if code == 0 else t_end)
+        return {"status": st_, "message": msg, "Y": Y, "n": n, "nfev": nfev, "t_event": t_event, "t_final": t_final,
                 "y_event": y_event,
                 "event_times": recorded if self.events == "continue" else (
                     {k_: v for k_, v in recorded.items() if k_.startswith("sliding-reversal")} if self.stick else {}),

@@ -590,7 +590,10 @@ def matrix_pencil(
             raise ParameterError(f"the order must be in [1, {L}]; got {order}")
     V = Vh[:r].conj().T  # (L+1, r)
     mu = np.linalg.eigvals(np.linalg.pinv(V[:-1]) @ V[1:])
-    mu = mu[np.abs(mu) > 0]
+    # poles whose exponential overflows over the window (spurious, fitted to noise at the ends) would make
+    # the amplitude fit non-finite, on which LAPACK's least squares does not return
+    with np.errstate(divide="ignore"):
+        mu = mu[(np.abs(mu) > 0) & (np.log(np.abs(mu)) * (N - 1) < 600.0)]
     lam = np.log(mu) / dt
     Z = np.exp(np.outer(t - t[0], lam))
     amp = np.linalg.lstsq(Z, x.astype(complex), rcond=None)[0]

@@ -175,6 +175,11 @@ class Summary:
     warnings : tuple of str
         Conditions that make a number doubtful (aliased output samples,
         a leading mode that does not dominate, disagreeing estimators, ...).
+    estimate_status : str
+        ``"ok"``; ``"too-few-samples"`` (fewer than :data:`MIN_ESTIMATE_SAMPLES`) or
+        ``"window-shorter-than-a-period"`` (the estimation window is shorter than one period of the
+        leading mode, linear or estimated): then growth rate, frequency and their uncertainties are not
+        estimated (NaN; ``None`` in :meth:`to_dict`) and a warning says why.
     """
 
     status: str
@@ -193,6 +198,7 @@ class Summary:
     regime: str = "unknown"
     cross_check: dict[str, Any] | None = None
     warnings: tuple[str, ...] = ()
+    estimate_status: str = "ok"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (non-finite numbers become ``None``; tuples become lists)."""
@@ -296,6 +302,24 @@ def _agree(a: float, sa: float, b: float, sb: float, slack: float) -> bool:
     return abs(a - b) <= tol
 
 
+#: Fewest samples of the estimation record from which growth rate and frequency are estimated.
+MIN_ESTIMATE_SAMPLES = 16
+
+
+def _window_too_short(status: str, t: np.ndarray, x: np.ndarray, n: int, lin_g: float | None, lin_f: float | None,
+                      f_lead: float) -> Summary:
+    """The summary of a record shorter than one period of the leading mode: no growth rate or frequency."""
+    amp = float(np.sqrt((x[:, :n] ** 2).sum(axis=1)).max())
+    duration = float(t[-1] - t[0])
+    warn = (f"the estimation window ({duration:.3g} s) is shorter than one period of the leading mode "
+            f"({1 / f_lead:.3g} s at {f_lead:.6g} Hz): growth rate and frequency cannot be estimated; simulate "
+            "for longer")
+    return Summary(status, math.nan, math.nan, amp, None, estimate_window=(float(t[0]), float(t[-1])),
+                   estimate_rate_hz=float((t.size - 1) / duration) if duration > 0 else math.nan,
+                   linear_growth_rate=lin_g, linear_frequency_hz=lin_f, warnings=(warn,),
+                   estimate_status="window-shorter-than-a-period")
+
+
 def summarize(
     status: str,
     t: np.ndarray,
@@ -350,12 +374,18 @@ def summarize(
     lin_g = lin_f = None
     if modes is not None:
         lin_g, lin_f = float(modes.leading.real), float(modes.leading.imag / (2 * math.pi))
-    if t.size < 16:
+    if t.size < MIN_ESTIMATE_SAMPLES:
         amp = nan if t.size == 0 else float(np.sqrt((x[:, :n] ** 2).sum(axis=1)).max())
         return Summary(status, nan, nan, amp, None, linear_growth_rate=lin_g, linear_frequency_hz=lin_f,
-                       warnings=(f"only {t.size} samples: no growth rate or frequency",))  # fmt: skip
+                       warnings=(f"only {t.size} samples (fewer than {MIN_ESTIMATE_SAMPLES}): growth rate and "
+                                 "frequency cannot be estimated",), estimate_status="too-few-samples")  # fmt: skip
+    duration = float(t[-1] - t[0])
+    if lin_f is not None and lin_f > 0 and duration * lin_f < 1:
+        return _window_too_short(status, t, x, n, lin_g, lin_f, lin_f)
     est: ModeEstimate = (modal_projection(t, x, modes, coordinates=n) if modes is not None
                          else dominant_mode(t, x, coordinates=n))
+    if modes is None and math.isfinite(est.frequency_hz) and duration * abs(est.frequency_hz) < 1:
+        return _window_too_short(status, t, x, n, lin_g, lin_f, abs(est.frequency_hz))
     warns.extend(est.warnings)
     ie = float(integration_error)
     terms = {"fit_growth": est.growth_rate_stderr, "fit_frequency": est.frequency_stderr, "integration": ie}
@@ -462,6 +492,8 @@ class Trajectory:
         ``"bilateral"`` or ``"unilateral"`` (:func:`~brakesqueal.simulation.simulate`'s ``contact``).
     engaged : ndarray of bool, shape (N, n_pads), or None
         Unilateral contact: whether each pad is pressed at each output sample.
+    t_final : float
+        Time [s] at which the integration ended (:attr:`t_end_reached`); NaN when not recorded.
     model : str
         The model's name.
     record : EstimationRecord or None
@@ -526,6 +558,21 @@ class Trajectory:
     event_pad: str | None = None
     contact_law: str = "bilateral"
     engaged: np.ndarray | None = None
+    t_final: float = math.nan
+
+    @property
+    def t_end_reached(self) -> float:
+        """Time [s] at which the integration ended: the end time, the terminal event's time or where it failed.
+
+        Not the last output sample (``t[-1]``), which lies up to one output interval earlier.  A trajectory
+        built without :attr:`t_final` (it is set by :func:`~brakesqueal.simulation.simulate`): the terminal
+        event's time, else the last output sample.
+        """
+        if math.isfinite(self.t_final):
+            return float(self.t_final)
+        if self.t_event is not None:
+            return float(self.t_event)
+        return float(self.t[-1]) if self.t.size else float(self.t_span[0])
 
     # ---------------------------------------------------------------- structure
     @property
