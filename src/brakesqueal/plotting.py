@@ -181,7 +181,7 @@ def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, 
     if boundary is not None and np.any(np.isfinite(boundary[0])):
         ax.plot(boundary[0], boundary[1], "k-", lw=1.2)
         handles.append(Line2D([], [], color="k", lw=1.2, label="stability boundary"))
-    elif 0 < np.nanmean(z) < 1:
+    elif np.any(np.isfinite(z)) and 0 < np.nanmean(z) < 1:  # all-NaN (no verdict anywhere): no boundary
         ax.contour(xs, ys, np.nan_to_num(z, nan=0.0), levels=[0.5], colors="k", linewidths=1.2)
         handles.append(Line2D([], [], color="k", lw=1.2, label="stability boundary (grid)"))
     if xlog:

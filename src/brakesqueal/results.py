@@ -717,22 +717,48 @@ class CriticalSpeedResult(CrossingResult):
             return False
         return not any(a < (oc if oc is not None else math.inf) for a, _ in self.undecided_ranges)
 
+    @property
+    def outcome(self) -> str:
+        """What the result says about squeal onsets, in one word shared by :meth:`text` and :meth:`to_dict`.
+
+        ``"onset"`` (:attr:`Omega_crit` found; :attr:`Omega_crit_certain` says whether a smaller one may be
+        missing); ``"unknown"`` (no onset found, but part of the range is undecided, or a grid search found
+        the motion stable: a pair of crossings closer together than the grid spacing may hide an onset);
+        ``"unstable_throughout"`` / ``"stable_throughout"`` (no stability change found, nothing undecided;
+        a grid search: unstable at every grid point, never "stable throughout");
+        ``"unstable_at_start"`` (unstable at the start, only re-stabilisations found, nothing undecided).
+        """
+        if self.Omega_crit is not None:
+            return "onset"
+        if self.undecided_ranges or (self.stable_at_start and not self.exhaustive):
+            return "unknown"
+        if not self.crossings:
+            return "stable_throughout" if self.stable_at_start else "unstable_throughout"
+        return "unstable_at_start"
+
     def to_dict(self) -> dict[str, Any]:
         d = super().to_dict()
         d["Omega_crit"] = self.Omega_crit
         d["Omega_crit_certain"] = self.Omega_crit_certain
+        d["outcome"] = self.outcome
         return d
 
     def text(self) -> str:
-        oc = self.Omega_crit
+        oc, outcome = self.Omega_crit, self.outcome
+        grid = "" if self.exhaustive else " (at every grid point; see the note below)"
         if oc is not None:
             head = f"Omega_crit = {oc:.12g} rad/s ({oc / (2 * math.pi):.6g} rev/s)"
             if not self.Omega_crit_certain:
                 head += " (NOT certain: a smaller onset may lie in an undecided range or between grid points)"
-        elif not self.stable_at_start and self.complete:
-            head = "Omega_crit = none in the range: unstable already at the start of the range"
-        elif self.complete:
-            head = "Omega_crit = none (no destabilizing crossing in the range)"
+        elif outcome == "unknown" and self.undecided_ranges:
+            head = "Omega_crit = UNKNOWN (no destabilizing crossing found, but part of the range is undecided)"
+        elif outcome == "unknown":
+            head = ("Omega_crit = UNKNOWN (stable at every grid point, but a grid search can miss a pair of crossings "
+                    "closer together than its spacing)")
+        elif outcome == "unstable_throughout":
+            head = f"Omega_crit = none in the range: unstable throughout the range{grid}"
+        elif outcome == "stable_throughout":
+            head = "Omega_crit = none (no destabilizing crossing in the range): stable throughout the range"
         else:
-            head = "Omega_crit = UNKNOWN (no destabilizing crossing found, but the range was not fully decided)"
+            head = f"Omega_crit = none in the range: unstable already at the start of the range{grid}"
         return head + "\n" + super().text()

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from enum import Enum, IntEnum
 
-__all__ = ["PointStatus", "RunStatus", "STATUS_MEANINGS", "status_of_error"]
+__all__ = ["PointStatus", "RunStatus", "STATUS_MEANINGS", "status_of_error", "DECIDED", "verdict_counts_text"]
 
 
 class PointStatus(IntEnum):
@@ -84,3 +84,39 @@ def status_of_error(exc: BaseException) -> PointStatus:
     if isinstance(exc, ParameterError):
         return PointStatus.INVALID
     raise TypeError(f"not a point failure: {exc!r}")
+
+
+#: The statuses whose points carry a verdict (stable or unstable).
+DECIDED = (PointStatus.OK, PointStatus.OK_NONTRIVIAL)
+
+
+def verdict_counts_text(points: int, stable: int, unstable: int, status_counts: dict[str, int]) -> str:
+    """One line about the verdicts of a map or sweep: stable and unstable points, and those without a verdict.
+
+    The percentages are of the points with a verdict; the points without one are counted by status, so
+    that a grid of undecided or invalid points never reads as "0% stable".
+
+    Parameters
+    ----------
+    points : int
+        Number of points.
+    stable, unstable : int
+        Points with the verdict stable / unstable.
+    status_counts : dict of str to int
+        Points per status meaning (:attr:`PointStatus.meaning`).
+
+    Returns
+    -------
+    str
+        E.g. ``"25 points: 5 stable, 15 unstable (25.0% / 75.0% of the 20 with a verdict); 5 without a
+        verdict (invalid_parameters 5)"``.
+    """
+    decided = stable + unstable
+    text = f"{points} points: {stable} stable, {unstable} unstable"
+    if decided:
+        text += f" ({100 * stable / decided:.1f}% / {100 * unstable / decided:.1f}% of the {decided} with a verdict)"
+    if points > decided:
+        ok = {s.meaning for s in DECIDED}
+        parts = ", ".join(f"{k} {v}" for k, v in status_counts.items() if k not in ok and v)
+        text += f"; {points - decided} without a verdict ({parts})"
+    return text

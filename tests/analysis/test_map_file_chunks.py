@@ -252,7 +252,7 @@ def test_kernel_exponent_by_blocks_equals_kernel_scaling(values):
 
 @pytest.mark.parametrize("ax", [
     Axis("k_ip", 1e5, 1e10, 1001, log=True), Axis("mu", -0.2, 1.0, 17), Axis("h", 1e-310, 2e-310, 7),  # subnormal
-    Axis("a", 3.0, 7.0, 2), Axis("b", 1e-300, 1e300, 9999, log=True), Axis("c", 0.1, 0.1 + 2e-16, 5),
+    Axis("a", 3.0, 7.0, 2), Axis("b", 1e-300, 1e300, 9999, log=True), Axis("c", 0.1, 0.1 + 2e-15, 5),  # near the resolution limit
 ])
 def test_axis_values_range_equals_a_slice_of_values(ax):
     rng = np.random.default_rng(ax.num)

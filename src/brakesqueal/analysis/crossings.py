@@ -269,7 +269,10 @@ def exact_omega_crossings(p: np.ndarray, lo: float, hi: float, spec: Any = None
 
 
 def _grid(axis: Axis, n: int) -> np.ndarray:
-    return Axis(axis.name, axis.start, axis.stop, n, axis.log).values()
+    """``n`` sampling points of a path (as :meth:`Axis.values`; a narrow path's samples may repeat)."""
+    if axis.log:
+        return np.logspace(math.log10(axis.start), math.log10(axis.stop), n)
+    return np.linspace(axis.start, axis.stop, n)
 
 
 def _profile(space: Any, axis: Axis, n: int = PROFILE_POINTS) -> tuple[np.ndarray, np.ndarray]:

@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -50,8 +50,8 @@ from .kernels import (
 )
 from .points import ROUTES, Points, closed_form_route, evaluate_arrays, valid_points
 
-__all__ = ["Axis", "parse_axis", "stability_map", "write_map", "MapSummary", "classify_grid", "STATUS", "MAX_POINTS",
-           "MAX_MAP_BYTES", "map_bytes"]
+__all__ = ["Axis", "parse_axis", "resolution_problem", "stability_map", "write_map", "MapSummary", "classify_grid",
+           "STATUS", "MAX_POINTS", "MAX_MAP_BYTES", "map_bytes"]
 
 #: Meaning of the ``status`` codes of a map (:class:`~brakesqueal.status.PointStatus`).
 STATUS = {int(s): s.meaning for s in PointStatus}
@@ -113,6 +113,9 @@ class Axis:
             raise ParameterError(f"{what}: a log axis needs positive bounds; got START = {self.start!r}")
         if self.num < 2:
             raise ParameterError(f"{what}: N must be at least 2; got {self.num}")
+        problem = resolution_problem(self.start, self.stop, self.num, self.log)
+        if problem:
+            raise ParameterError(f"{what}: {problem}", parameter=self.name)
 
     def values(self) -> np.ndarray:
         """The grid points."""
@@ -161,6 +164,43 @@ class Axis:
         if self.log:
             return math.sqrt(self.start * self.stop)
         return max(abs(self.start), abs(self.stop))
+
+
+def resolution_problem(start: float, stop: float, num: int, log: bool) -> str | None:
+    """Why ``num`` points from ``start`` to ``stop`` are finer than the floating-point resolution, or None.
+
+    The rule of every axis, path and study range: the step (of ``log10`` on a
+    log axis) must exceed 4 units in the last place of the bounds, so that the
+    points are distinct, increasing numbers.  Ranges that are empty, reversed,
+    not finite or (log) not positive are left to the caller's own checks.
+
+    Parameters
+    ----------
+    start, stop : float
+        The bounds.
+    num : int
+        Number of points including both ends (a path: 2).
+    log : bool
+        Logarithmic spacing.
+
+    Returns
+    -------
+    str or None
+        The reason (a clause for an error message), or None when the points are resolved.
+    """
+    if num < 2 or not (math.isfinite(start) and math.isfinite(stop) and stop > start) or (log and start <= 0):
+        return None
+    if log:
+        t0, t1 = math.log10(start), math.log10(stop)
+        eps = float(np.finfo(float).eps)
+        ok = (t1 - t0) / (num - 1) > 4 * eps * (max(1.0, abs(t0), abs(t1)) + 1)
+    else:
+        ok = (stop - start) / (num - 1) > 4 * float(np.spacing(max(abs(start), abs(stop))))
+    if ok:
+        return None
+    what = f"{num} points between" if num > 2 else "the bounds"
+    return (f"{what} {start!r} and {stop!r} are closer than the floating-point resolution (they would not be "
+            "distinct values); use " + ("fewer points or " if num > 2 else "") + "a wider range")
 
 
 def parse_axis(text: str, *, with_num: bool = True) -> Axis:
@@ -555,6 +595,11 @@ class MapSummary:
         The route (the file's ``method`` attribute).
     outer, inner : Axis
         The axes in the file's dimension order.
+    status_counts : dict of str to int
+        Number of points of each status (:class:`~brakesqueal.status.PointStatus` meanings, only those
+        that occur); the points of ``ok`` and ``ok_nontrivial_silent_motion`` have a verdict, the others none.
+    unstable : int
+        Number of points with a verdict ``unstable``.
     """
 
     points: int
@@ -562,6 +607,25 @@ class MapSummary:
     method: str
     outer: Axis
     inner: Axis
+    status_counts: dict[str, int] = field(default_factory=dict)
+    unstable: int = 0
+
+    @property
+    def stable(self) -> int:
+        """Number of points certified stable."""
+        return int(round(self.stable_fraction * self.points))
+
+    @property
+    def decided(self) -> int:
+        """Number of points with a verdict (stable or unstable)."""
+        return self.stable + self.unstable
+
+    def text(self) -> str:
+        """One line: stable and unstable points (percent of the decided ones) and the points without a verdict
+        (:func:`~brakesqueal.status.verdict_counts_text`)."""
+        from ..status import verdict_counts_text
+
+        return verdict_counts_text(self.points, self.stable, self.unstable, self.status_counts)
 
 
 def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False, eigen: bool = True,
@@ -612,11 +676,16 @@ def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False
     status = np.zeros((n_o, n_i), dtype=np.int8) if keep else None
     f = MapFile(path, space, plan.outer, plan.inner, eigen=eigen, float_dtype=plan.ftype, method=plan.method,
                 boundary=keep)
-    n_stable = 0
+    n_stable = n_unstable = 0
+    counts = np.zeros(len(PointStatus), dtype=np.int64)
     try:
         for r0, r1, c0, c1, st, ss, mr, fr in _rows(space, plan, eigen, chunk_points):
             f.write_rows(r0, r1, st, ss, mr, fr, c0=c0)
             n_stable += int(np.count_nonzero(st))
+            codes = np.asarray(ss, dtype=np.int64).ravel()
+            counts += np.bincount(codes, minlength=counts.size)[:counts.size]
+            decided = (codes == PointStatus.OK) | (codes == PointStatus.OK_NONTRIVIAL)
+            n_unstable += int(np.count_nonzero(decided & ~np.asarray(st, dtype=bool).ravel()))
             if stable is not None and status is not None:
                 stable[r0:r1, c0:c1] = st
                 status[r0:r1, c0:c1] = ss
@@ -631,4 +700,5 @@ def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False
         raise
     f.close()
     n = n_o * n_i
-    return MapSummary(n, n_stable / n, plan.method, plan.outer, plan.inner)
+    return MapSummary(n, n_stable / n, plan.method, plan.outer, plan.inner,
+                      {s.meaning: int(c) for s, c in zip(PointStatus, counts) if c}, n_unstable)

@@ -289,6 +289,11 @@ def modes_along(space: Any, name: str, start: float, stop: float, *, num: int = 
         raise ParameterError(f"path '{name}': a log path needs START > 0; got {start!r}")
     if not 3 <= num <= 100_000:
         raise ParameterError(f"path '{name}': the number of points must be in [3, 100000]; got {num}")
+    from .maps import resolution_problem
+
+    problem = resolution_problem(start, stop, num, log)
+    if problem:
+        raise ParameterError(f"path '{name}': {problem}", parameter=name)
     values = np.geomspace(start, stop, num) if log else np.linspace(start, stop, num)
     return track_modes(values, lambda v: linearize(space.resolve({name: v}), pad_rates=pad_rates),
                        parameter=name, log=log, model=space.model.name, units=space.preset.unit(name))

@@ -62,7 +62,6 @@ MAX_CHUNKS = 10**6
 #: points of one chunk, which is computed in memory: verdict-only grids (about 3 bytes per point
 #: of working memory) / eigenvalue quantities, samples or built models (about 600 bytes per point).
 MAX_CHUNK_POINTS = (1 << 26, 1 << 22)
-_EPS = float(np.finfo(float).eps)
 
 
 def _is_num(v: object) -> bool:
@@ -348,11 +347,11 @@ def _grid_axis(ctx: _Ctx, name: str, v: Any) -> GridAxis:
         raise ctx.err(nkey, f"{num} points ({num:.3g}) exceed the limit of {MAX_AXIS_POINTS:.0e} points per axis "
                             f"(its values alone would take {_size(8 * num)} of memory); use fewer points or split "
                             "the study")
+    _check_resolution(ctx, nkey, start, stop, num, log)
     try:
         ax = Axis(name, start, stop, num, log)
     except ParameterError as exc:
         raise ctx.err(key, str(exc)) from None
-    _check_resolution(ctx, nkey, start, stop, num, log)
     return GridAxis(name, ax.values(), "log" if log else "linear", (start, stop, num), ax.ref)
 
 
@@ -365,17 +364,13 @@ def _size(nbytes: float) -> str:
 
 
 def _check_resolution(ctx: _Ctx, key: str, start: float, stop: float, num: int, log: bool) -> None:
-    """Refuse a range whose ``num`` points would not be distinct floating-point numbers (with a margin)."""
-    if num < 2:
-        return
-    if log:
-        t0, t1 = math.log10(start), math.log10(stop)
-        ok = (t1 - t0) / (num - 1) > 4 * _EPS * (max(1.0, abs(t0), abs(t1)) + 1)
-    else:
-        ok = (stop - start) / (num - 1) > 4 * float(np.spacing(max(abs(start), abs(stop))))
-    if not ok:
-        raise ctx.err(key, f"{num} points between {start!r} and {stop!r} are closer than the floating-point "
-                           "resolution (they would not be distinct values); use fewer points or a wider range")
+    """Refuse a range whose ``num`` points would not be distinct floating-point numbers (the rule of every axis,
+    :func:`~brakesqueal.analysis.maps.resolution_problem`)."""
+    from ..analysis.maps import resolution_problem
+
+    problem = resolution_problem(start, stop, num, log)
+    if problem:
+        raise ctx.err(key, problem)
 
 
 def _default_chunks(shape: tuple[int, ...], points: int) -> tuple[int, ...]:
