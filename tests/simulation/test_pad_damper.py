@@ -175,7 +175,7 @@ def test_the_command_line_option(capsys: Any) -> None:
     from brakesqueal.cli import main
 
     assert main(["cycles", "--set", "k_ip=1e6", "--along", "Omega=60:120", "--pad-damping", "0"]) == 2
-    assert "'pad_damping' must be in (0, 1e+06] N s/m" in capsys.readouterr().err
+    assert "'--pad-damping' must be in (0, 1e+06] N s/m" in capsys.readouterr().err  # the option's name
     assert main(["simulate", "--preset", "paper-fig3", "--set", "k_ip=1e6", "--set", "mu1=0.5", "--set", "mu2=0.5",
                  "--set", "Omega=160", "--pad-damping", "10", "--q0", "5e-3,0", "--contact", "unilateral",
                  "--events", "continue", "--t-end", "0.004", "--format", "json"]) == 0

@@ -130,6 +130,12 @@ def eigen(
     from ..render import render_eigen
 
     ea = eigen_analysis(space_from(model, preset, params, set_).resolve({}))
+    n_modes = int(ea.eigenvalues.size)
+    if mode >= n_modes:
+        from ..errors import ParameterError
+
+        raise ParameterError(f"--mode must be in [0, {n_modes - 1}] (the {n_modes} eigenvalues listed, 0 = least "
+                             f"stable); got {mode}", parameter="--mode")
     sys.stdout.write(render_eigen(ea, fmt.value, mode=mode))
 
 
@@ -280,6 +286,57 @@ def _apply_summaries() -> None:
 _apply_summaries()
 
 
+def _is_no_args_help(exc: BaseException) -> bool:
+    """Whether ``exc`` is Click's "no arguments: show the help" signal (a group called without a sub-command)."""
+    try:
+        from typer._click.exceptions import NoArgsIsHelpError
+    except ImportError:  # pragma: no cover - another Typer layout
+        return type(exc).__name__ == "NoArgsIsHelpError"
+    return isinstance(exc, NoArgsIsHelpError)
+
+
+def _option_names(args: list[str]) -> dict[str, str]:
+    """The invoked command's options by the name of its Python parameter (``{"sample_rate": "--sample-rate"}``)."""
+    import typer.main
+
+    cmd = typer.main.get_command(app)
+    for a in args:
+        sub = getattr(cmd, "commands", {}).get(a)
+        if sub is None:
+            if not a.startswith("-"):
+                break
+            continue
+        cmd = sub
+    names = {}
+    for p in getattr(cmd, "params", []):
+        longs = [o for o in getattr(p, "opts", []) if o.startswith("--")]
+        if p.name and longs:
+            names[p.name] = longs[0]
+    return names
+
+
+def _with_option_names(exc: BrakesquealError, args: list[str]) -> str:
+    """The message of ``exc`` with the library's names of options (``'rtol'``) replaced by the command's
+    (``'--rtol'``): only for a :class:`~brakesqueal.errors.ParameterError` about an option
+    (its ``parameter``/``names``) that the invoked command has."""
+    from ..errors import ParameterError
+
+    msg = str(exc)
+    if not isinstance(exc, ParameterError) or not exc.names:
+        return msg
+    try:
+        options = _option_names(args)
+    except Exception:  # noqa: BLE001 - the message as it is rather than no message
+        return msg
+    if "option '" not in msg and "options '" not in msg:
+        return msg
+    for name in exc.names:
+        opt = options.get(name)
+        if opt:
+            msg = msg.replace(f"'{name}'", f"'{opt}'")
+    return msg
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point: run the CLI, turning user errors into one stderr line (exit 2) and interrupts into exit 130.
 
@@ -306,9 +363,12 @@ def main(argv: list[str] | None = None) -> int:
         with interrupt_guard(exit_after=EXIT_AFTER_S if program and args[:1] != ["sweep"] else None):
             rv = app(args=args, prog_name="brakesqueal", standalone_mode=False)
     except BrakesquealError as exc:
-        print(f"brakesqueal: error: {exc}", file=sys.stderr)
+        print(f"brakesqueal: error: {_with_option_names(exc, args)}", file=sys.stderr)
         return 2
     except TyperException as exc:
+        if _is_no_args_help(exc):  # a command group without its sub-command: its help, as the bare program
+            sys.stdout.write(exc.format_message().rstrip("\n") + "\n")
+            return 0
         msg = exc.format_message().replace("\n", " ")
         print(f"brakesqueal: error: {msg}", file=sys.stderr)
         return 2

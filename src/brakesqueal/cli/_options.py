@@ -12,8 +12,8 @@ from typing import Annotated, Any, Optional
 
 import typer
 
-__all__ = ["ModelOpt", "PresetOpt", "ParamsOpt", "SetOpt", "FormatOpt", "OutFormat", "NoCacheOpt", "ProgressOpt",
-           "space_from", "note"]
+__all__ = ["PLOT_SUFFIXES", "ContactLaw", "ModelOpt", "PresetOpt", "ParamsOpt", "SetOpt", "FormatOpt", "OutFormat",
+           "NoCacheOpt", "ProgressOpt", "space_from", "note", "refuse_set_of_axes"]
 
 
 class OutFormat(str, Enum):
@@ -21,6 +21,17 @@ class OutFormat(str, Enum):
 
     text = "text"
     json = "json"
+
+
+#: Formats of every command's ``--plot`` figure.
+PLOT_SUFFIXES = (".png", ".svg", ".pdf")
+
+
+class ContactLaw(str, Enum):
+    """``--contact``: the pads stay pressed (bilateral) or lift off and come back (unilateral)."""
+
+    bilateral = "bilateral"
+    unilateral = "unilateral"
 
 
 ModelOpt = Annotated[Optional[str], typer.Option(
@@ -85,3 +96,27 @@ def space_from(model: str | None, preset: str | None, params: str | None, sets: 
     for name in space.untied:
         note(f"--set {name}=... replaces the tie {name} = {space.preset.tied[name]} of preset '{space.label}'")
     return space
+
+
+def refuse_set_of_axes(sets: list[str] | None, axes: dict[str, str]) -> None:
+    """Refuse ``--set NAME=...`` of a name that an axis or path of the command varies (it would be ignored).
+
+    Parameters
+    ----------
+    sets : list of str or None
+        The ``--set`` arguments (``NAME=VALUE``).
+    axes : dict
+        The varied names and the option that varies each (e.g. ``{"mu": "--along"}``).
+
+    Raises
+    ------
+    ParameterError
+        If a ``--set`` names one of ``axes``.
+    """
+    from ..errors import ParameterError
+
+    for item in sets or []:
+        name = item.partition("=")[0].strip()
+        if name in axes:
+            raise ParameterError(f"--set {name} is also the {axes[name]} axis; leave it out of --set (the axis "
+                                 f"gives its values)", parameter=name)

@@ -8,7 +8,9 @@ from typing import Annotated, Optional
 
 import typer
 
-from ._options import FormatOpt, ModelOpt, OutFormat, ParamsOpt, PresetOpt, SetOpt, space_from
+from ..errors import ParameterError
+from ._options import (PLOT_SUFFIXES, FormatOpt, ModelOpt, OutFormat, ParamsOpt, PresetOpt, SetOpt, refuse_set_of_axes,
+                       space_from)
 
 __all__ = ["register"]
 
@@ -22,15 +24,19 @@ def modes(
     plot: Annotated[Optional[str], typer.Option("--plot", help="Draw the diagram (PNG, SVG or PDF).")] = None,
 ) -> None:
     """Frequencies and real parts of every mode along a path, tracked by continuity; coalescences and crossings."""
-    from ..analysis.maps import parse_axis
+    from ..analysis.maps import parse_axis, resolution_problem
     from ..analysis.modes import modes_along
     from ..outputs import atomic_write, check_output
 
     axis = parse_axis(along, with_num=False)
+    refuse_set_of_axes(set_, {axis.name: "--along"})
+    problem = resolution_problem(axis.start, axis.stop, num, axis.log)
+    if problem:
+        raise ParameterError(f"--along {axis.name} with --num {num}: {problem}", parameter=axis.name)
     if out:
         check_output(out, what="--out", suffixes=(".nc",))
     if plot:
-        check_output(plot, what="--plot", suffixes=(".png", ".svg", ".pdf"))
+        check_output(plot, what="--plot", suffixes=PLOT_SUFFIXES)
     space = space_from(model, preset, params, set_)
     tr = modes_along(space, axis.name, axis.start, axis.stop, num=num, log=axis.log)
     if out:

@@ -8,15 +8,24 @@ from __future__ import annotations
 import json
 import math
 import sys
+from enum import Enum
 from typing import Annotated, Any, Optional
 
 import typer
 
 from ..errors import ParameterError
-from ._options import (ModelOpt, PadDampingOpt, PadSlopeOpt, ParamsOpt, PresetOpt, SetOpt, StickSpeedOpt, pads_option,
-                       space_from)
+from ._options import (PLOT_SUFFIXES, ContactLaw, ModelOpt, OutFormat, PadDampingOpt, PadSlopeOpt, ParamsOpt,
+                       PresetOpt, SetOpt, StickSpeedOpt, pads_option, space_from)
 
 __all__ = ["register"]
+
+
+class _Events(str, Enum):
+    """``--events``: what a contact loss or sliding reversal does to the run."""
+
+    stop = "stop"
+    continue_ = "continue"
+    off = "off"
 
 
 def _floats(text: str, what: str) -> list[float]:
@@ -32,12 +41,6 @@ def _floats(text: str, what: str) -> list[float]:
 _NETCDF_SUFFIXES = (".nc", ".nc4", ".cdf", ".netcdf")
 
 
-def _plot_suffixes() -> tuple[str, ...]:
-    from matplotlib.backend_bases import FigureCanvasBase
-
-    return tuple(sorted("." + k for k in FigureCanvasBase.get_supported_filetypes()))
-
-
 def _check_outputs(out: str | None, plot: str | None, wav: str | None) -> None:
     """Every output path is checked before anything is computed (one line, exit status 2)."""
     from pathlib import Path
@@ -50,7 +53,7 @@ def _check_outputs(out: str | None, plot: str | None, wav: str | None) -> None:
     if wav:
         check_output(wav, what="--wav", suffixes=(".wav",))
     if plot:
-        check_output(plot, what="--plot", suffixes=_plot_suffixes())
+        check_output(plot, what="--plot", suffixes=PLOT_SUFFIXES)
     seen: dict[Path, str] = {}
     for opt, path in given.items():
         key = Path(path).resolve()
@@ -76,26 +79,23 @@ def _simulate_cmd(
     method: Annotated[str, typer.Option("--method", help="DOP853-jit (default) or a solve_ivp method.")] = "DOP853-jit",
     rtol: Annotated[float, typer.Option("--rtol", help="Relative tolerance, in [1e-13, 1e-2].")] = 1e-9,
     atol: Annotated[Optional[float], typer.Option("--atol", help="Absolute tolerance (default from rtol).")] = None,
-    events: Annotated[
-        str, typer.Option("--events", help="stop | continue | off (contact loss, sliding reversal).")
-    ] = "stop",
-    contact: Annotated[
-        str, typer.Option("--contact", help="bilateral (pads stay pressed) | unilateral (F_n = max(0, .): pads lift "
-                                            "off and come back; DOP853-jit only).")
-    ] = "bilateral",
+    events: Annotated[_Events, typer.Option(
+        "--events", help="At a contact loss or sliding reversal: stop, continue (record it) or off.")] = _Events.stop,
+    contact: Annotated[ContactLaw, typer.Option(
+        "--contact", help="bilateral (pads stay pressed) or unilateral (F_n = max(0, .): pads lift off and come "
+                          "back; DOP853-jit only).")] = ContactLaw.bilateral,
     pad_slope: PadSlopeOpt = None,
     stick_speed: StickSpeedOpt = None,
     pad_damping: PadDampingOpt = None,
     sample_rate: Annotated[float, typer.Option("--sample-rate", help="Output samples per second [Hz].")] = 44100.0,
     out: Annotated[Optional[str], typer.Option("--out", help="Write the trajectory to this NetCDF file.")] = None,
-    plot: Annotated[Optional[str], typer.Option("--plot", help="Write the plot (time history, phase, spectrum).")] = (
-        None
-    ),
+    plot: Annotated[Optional[str], typer.Option(
+        "--plot", help="Write the plot: time history, phase, spectrum (PNG, SVG or PDF).")] = None,
     wav: Annotated[
         Optional[str],
         typer.Option("--wav", help="Write the rim's normal velocity (a belt: the pad's) as 44.1 kHz audio."),
     ] = None,
-    fmt: Annotated[str, typer.Option("--format", help="Summary format: text | json.")] = "text",
+    fmt: Annotated[OutFormat, typer.Option("--format", help="Summary format.")] = OutFormat.text,
     progress: Annotated[bool, typer.Option(
         "--progress/--no-progress",
         help="Progress on stderr: a bar on a terminal, a line every 10 s otherwise.")] = True,
@@ -107,12 +107,8 @@ def _simulate_cmd(
     interrupted or failed write keeps an existing file).  Ctrl-C stops within
     about 0.1 s, during a first compilation within about 0.5 s (exit status 130).
     """
-    if fmt not in ("text", "json"):
-        raise ParameterError(f"The option '--format' must be text or json; got {fmt!r}")
     if not (math.isfinite(t_end) and t_end > 0):
         raise ParameterError(f"The option '--t-end' must be a positive number of seconds; got {t_end!r}")
-    if contact not in ("bilateral", "unilateral"):
-        raise ParameterError(f"The option '--contact' must be bilateral or unilateral; got {contact!r}")
     if q0 is not None and x0 is not None:
         raise ParameterError("give either --q0 (deviation from the silent motion) or --x0 (absolute state), not both")
     init: dict[str, Any] = {}
@@ -124,18 +120,19 @@ def _simulate_cmd(
     from ..interrupts import interrupt_guard
     p = pads_option(space_from(model, preset, params, set_), pad_slope, stick_speed, pad_damping).resolve({})
     with interrupt_guard():  # nested in the program's guard (brakesqueal.cli.main), which ends a stuck run
-        tr = _run(p, t_end, method, rtol, atol, events, sample_rate, progress, no_cache, {**init, "contact": contact})
+        tr = _run(p, t_end, method, rtol, atol, events.value, sample_rate, progress, no_cache,
+                  {**init, "contact": contact.value})
         if wav and tr.t.size < 2:
             raise ParameterError("the trajectory has fewer than two samples; nothing to write to --wav")
         _write(tr, out, plot, wav)
     summary = tr.summary
     data = {**summary.to_dict(), "model": tr.model, "message": tr.message, "start": tr.start,
-            "t_end_reached": float(tr.t[-1]) if tr.t.size else 0.0, "wall_s": tr.stats.get("wall_s")}  # fmt: skip
-    if contact == "unilateral":
-        data["contact"] = contact
+            "t_end_reached": tr.t_end_reached, "wall_s": tr.stats.get("wall_s")}  # fmt: skip
+    if contact == ContactLaw.unilateral:
+        data["contact"] = contact.value
         duty = tr.duty_cycle
         data["duty_cycle"] = None if duty is None else {str(k): float(v) for k, v in zip(tr.pads, duty)}
-    if fmt == "json":
+    if fmt == OutFormat.json:
         sys.stdout.write(json.dumps(data, indent=2) + "\n")
     else:
         for k, v in data.items():

@@ -10,6 +10,7 @@ anything is computed and written atomically (:mod:`brakesqueal.outputs`).
 from __future__ import annotations
 
 import json
+import math
 import sys
 from enum import Enum
 from typing import Annotated, Any, Optional
@@ -17,8 +18,9 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ..errors import ParameterError
-from ._options import (FormatOpt, ModelOpt, OutFormat, PadDampingOpt, PadSlopeOpt, ParamsOpt, PresetOpt,
-                       ProgressOpt, SetOpt, StickSpeedOpt, pads_option, space_from)
+from ._options import (PLOT_SUFFIXES, ContactLaw, FormatOpt, ModelOpt, OutFormat, PadDampingOpt, PadSlopeOpt,
+                       ParamsOpt, PresetOpt, ProgressOpt, SetOpt, StickSpeedOpt, pads_option, refuse_set_of_axes,
+                       space_from)
 
 __all__ = ["register"]
 
@@ -29,6 +31,12 @@ class _Color(str, Enum):
     frequency = "frequency"
 
 
+class _Pads(str, Enum):
+    auto = "auto"
+    exact = "exact"
+    quasi_static = "quasi-static"
+
+
 class _Fig(str, Enum):
     fig2 = "fig2"
     fig3 = "fig3"
@@ -36,7 +44,7 @@ class _Fig(str, Enum):
 
 
 _PlotOpt = Annotated[Optional[str], typer.Option("--plot", help="Also draw the result (PNG, SVG or PDF).")]
-_PLOT_SUFFIXES = (".png", ".svg", ".pdf")
+_PLOT_SUFFIXES = PLOT_SUFFIXES
 
 
 def _write_plot(fig: object, plot: str) -> None:
@@ -61,6 +69,7 @@ def crossings(
     from ..outputs import check_output
 
     axis = parse_axis(along, with_num=False)
+    refuse_set_of_axes(set_, {axis.name: "--along"})
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     space = space_from(model, preset, params, set_)
@@ -87,23 +96,47 @@ def _write_crossings(r: Any, space: Any, axis: Any, fmt: OutFormat, hopf: bool) 
 
 
 def critical_speed(
-    range_: Annotated[str, typer.Option("--range", help="Omega range LO:HI [rad/s].")] = "1:1e5",
+    range_: Annotated[str, typer.Option("--range", help="Omega range START:STOP [rad/s], 0 < START < STOP "
+                                        "(searched on a logarithmic path).")] = "1:1e5",
     model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
     fmt: FormatOpt = OutFormat.text, plot: _PlotOpt = None, hopf: _HopfOpt = False,
 ) -> None:
     """All onsets and re-stabilisations of squeal along the spin rate Omega, and Omega_crit."""
-    from ..analysis.crossings import critical_speeds
-    from ..analysis.maps import parse_axis
+    from ..analysis.crossings import critical_speeds, omega_name
+    from ..analysis.maps import Axis
     from ..outputs import check_output
 
-    axis = parse_axis(f"Omega={range_}:log", with_num=False)
+    lo, hi = _omega_range(range_)
+    refuse_set_of_axes(set_, {"Omega": "--range"})
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     space = space_from(model, preset, params, set_)
+    name = omega_name(space)
+    refuse_set_of_axes(set_, {name: "--range"})
+    axis = Axis(name, lo, hi, 2, True)
     r = critical_speeds(space, axis.start, axis.stop)
     if plot:
         _write_plot(r.plot(), plot)  # type: ignore[attr-defined]
     _write_crossings(r, space, axis, fmt, hopf)
+
+
+def _omega_range(text: str) -> tuple[float, float]:
+    """``--range START:STOP`` of ``critical-speed``: two numbers with ``0 < START < STOP`` [rad/s], resolved."""
+    from ..analysis.maps import resolution_problem
+    from ..model.expressions import evaluate
+
+    rule = "--range must be START:STOP in rad/s with 0 < START < STOP"
+    parts = [p.strip() for p in text.split(":")]
+    if len(parts) != 2 or not all(parts):
+        raise ParameterError(f"{rule} (two numbers; the path is always logarithmic); got {text!r}",
+                             parameter="--range")
+    lo, hi = (evaluate(p, {}, what=f"--range {w}") for p, w in zip(parts, ("START", "STOP")))
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
+        raise ParameterError(f"{rule} (both positive and finite); got {text!r}", parameter="--range")
+    problem = resolution_problem(lo, hi, 2, True)
+    if problem:
+        raise ParameterError(f"--range: {problem}", parameter="--range")
+    return lo, hi
 
 
 def map_(
@@ -126,6 +159,7 @@ def map_(
     from ._progress import progress as _progress
 
     ax_x, ax_y = parse_axis(x), parse_axis(y)
+    refuse_set_of_axes(set_, {ax_x.name: "--x", ax_y.name: "--y"})
     if color is not None and not plot:
         raise ParameterError("--color only changes the figure: give --plot FILE too")
     if color not in (None, _Color.verdict) and no_eigen:
@@ -142,7 +176,7 @@ def map_(
 
         _write_plot(plot_map_file(out, x=ax_x.name, color=(color or _Color.verdict).value), plot)
         msg += f" and {plot}"
-    sys.stdout.write(f"{msg} ({s.points} points, {100 * s.stable_fraction:.1f}% stable; {s.method})\n")
+    sys.stdout.write(f"{msg} ({s.text()}; {s.method})\n")
 
 
 def reproduce(
@@ -211,6 +245,7 @@ def hopf(
     from ..nonlinear.models import hopf_points
 
     axis = parse_axis(along, with_num=False)
+    refuse_set_of_axes(set_, {axis.name: "--along"})
     space = pads_option(space_from(model, preset, params, set_), None, None, pad_damping)
     r = _crossings(space, axis)
     pts = hopf_points(space, axis, result=r)
@@ -230,18 +265,19 @@ def cycles(
     out: Annotated[Optional[str], typer.Option("--out", help="NetCDF file of the branch (.nc).")] = None,
     max_points: Annotated[int, typer.Option("--max-points", min=2, max=2000,
                                             help="Largest number of branch points.")] = 60,
-    contact: Annotated[str, typer.Option("--contact", help="bilateral: the branch is valid up to the first contact "
-                                         "loss (located); unilateral: continued through lift-off and re-contact "
-                                         "(F_n = max(0, .), slower).")] = "bilateral",
+    contact_: Annotated[ContactLaw, typer.Option(
+        "--contact", help="bilateral: the branch is valid up to the first contact loss (located); unilateral: "
+                          "continued through lift-off and re-contact (F_n = max(0, .), slower).")
+    ] = ContactLaw.bilateral,
     pad_slope: PadSlopeOpt = None,
     stick_speed: StickSpeedOpt = None,
     pad_damping: PadDampingOpt = None,
-    pads: Annotated[str, typer.Option("--pads", help="auto: every pad's tangential rate kept, by shooting where "
-                                      "the simulated equations keep it, by harmonic balance where massless Coulomb "
-                                      "pads with a finite k_ip would be quasi-static (bilateral; with --contact "
-                                      "unilateral choose --pad-damping D or --pads quasi-static); exact: harmonic "
-                                      "balance; quasi-static: shooting with ldot := 0 for those pads (exact to "
-                                      "first order at the onset).")] = "auto",
+    pads_: Annotated[_Pads, typer.Option(
+        "--pads", help="auto: every pad's tangential rate kept, by shooting where the simulated equations keep it, "
+                       "by harmonic balance where massless Coulomb pads with a finite k_ip would be quasi-static "
+                       "(bilateral; with --contact unilateral choose --pad-damping D or --pads quasi-static); exact: "
+                       "harmonic balance; quasi-static: shooting with ldot := 0 for those pads (exact to first order "
+                       "at the onset).")] = _Pads.auto,
     exact_pads: Annotated[bool, typer.Option("--exact-pads", help="Same as --pads exact: harmonic balance on the "
                                              "implicit equations, the massless Coulomb pads exact (tangential rates "
                                              "kept, no regularisation); bilateral, to the located contact "
@@ -260,9 +296,9 @@ def cycles(
     from ..outputs import atomic_write, check_output
 
     axis = parse_axis(along, with_num=False)
-    if contact not in ("bilateral", "unilateral"):
-        raise ParameterError(f"The option '--contact' must be bilateral or unilateral; got {contact!r}")
-    if pads not in PAD_TREATMENTS:
+    refuse_set_of_axes(set_, {axis.name: "--along"})
+    contact, pads = contact_.value, pads_.value
+    if pads not in PAD_TREATMENTS:  # pragma: no cover - the choices of --pads are PAD_TREATMENTS
         raise ParameterError(f"The option '--pads' must be one of {', '.join(PAD_TREATMENTS)}; got {pads!r}")
     if exact_pads:
         if pads == "quasi-static":
@@ -366,13 +402,19 @@ def _cycles_exact_pads(axis: Any, space: Any, *, fmt: OutFormat, max_points: int
              f"{len(b.points)} branch points by harmonic balance ({b.status}: {b.message})",
              f"stability: {b.stability}"]
     lines += b.summary.text(rows=0).splitlines()
-    head = (f"{axis.name:>12} {'f [Hz]':>10} {'tilt [rad]':>11} " + " ".join(f"{'Fn min ' + p:>10}" for p in b.pads)
+    # the normal forces' range over the period: min (a pad lifts off where it reaches 0) and max (as the
+    # unilateral table of the summary)
+    head = (f"{axis.name:>12} {'f [Hz]':>10} {'tilt [rad]':>11} "
+            + " ".join(f"{'Fn min ' + p:>10} {'Fn max ' + p:>10}" for p in b.pads)
             + f" {'slide min':>10} {'H':>3} {'trunc':>8} {'resid':>8}  stable")
     lines.append(head)
     for pt in b.points:
         tilt = f"{pt.tilt_amplitude:11.4g}" if pt.tilt_amplitude is not None else f"{'-':>11}"
         st = "-" if pt.stable is None else ("yes" if pt.stable else "no")
-        lines.append(f"{pt.p:12.8g} {pt.frequency_hz:10.6g} {tilt} " + " ".join(f"{f:10.5g}" for f in pt.F_n_min)
+        fmax = [f"{v:10.5g}" for v in pt.F_n_max] if len(pt.F_n_max) == len(pt.F_n_min) else [f"{'-':>10}"] * len(
+            pt.F_n_min)
+        lines.append(f"{pt.p:12.8g} {pt.frequency_hz:10.6g} {tilt} "
+                     + " ".join(f"{lo:10.5g} {hi}" for lo, hi in zip(pt.F_n_min, fmax))
                      + f" {pt.sliding_margin_min:10.4g} {pt.harmonics:3d} {pt.truncation_error:8.1e} "
                        f"{pt.residual:8.1e}  {st}")
     sys.stdout.write("\n".join(lines) + "\n")

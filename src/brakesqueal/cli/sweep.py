@@ -10,7 +10,7 @@ import json
 import sys
 from enum import Enum
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated, Any, Optional
 
 import typer
 
@@ -41,6 +41,7 @@ def sweep(
     from ..errors import ParameterError
     from ..sweep import run_sweep, sweep_status
     from ..sweep.runner import check_scheduler_address, default_store
+    from ..status import verdict_counts_text
     from ..sweep.study import load_study
 
     st = load_study(study)
@@ -58,17 +59,35 @@ def sweep(
     with _progress("sweep", progress) as cb:
         run = run_sweep(st, store=store, workers=workers, scheduler=scheduler, overwrite=overwrite, progress=cb)
     ds = run.dataset
-    stable = float(ds["stable"].mean().compute())
+    counts = _verdict_counts(ds)
+    stable = counts["stable"] / st.n_points
     dims = " x ".join(f"{k}={v}" for k, v in zip(st.dims, st.shape))
     summary = {"store": str(store), "dims": dict(zip(st.dims, st.shape)), "points": st.n_points,
                "chunks": st.n_chunks, "computed_chunks": run.computed, "reused_chunks": run.reused,
-               "repaired": run.repaired, "stable_fraction": stable, "variables": list(ds.data_vars)}
+               "repaired": run.repaired, "stable_fraction": stable, "stable": counts["stable"],
+               "unstable": counts["unstable"], "status_counts": counts["status_counts"],
+               "variables": list(ds.data_vars)}
     if fmt == _Fmt.json:
         sys.stdout.write(json.dumps(summary, indent=2) + "\n")
     else:
         fixed = f"; repaired: {'; '.join(run.repaired)}" if run.repaired else ""
-        sys.stdout.write(f"wrote {store}: {dims} ({st.n_points} points, {st.n_chunks} chunks: "
-                         f"{run.computed} computed, {run.reused} reused{fixed}); {100 * stable:.1f}% stable\n")
+        verdicts = verdict_counts_text(st.n_points, counts["stable"], counts["unstable"], counts["status_counts"])
+        sys.stdout.write(f"wrote {store}: {dims} ({st.n_chunks} chunks: {run.computed} computed, {run.reused} "
+                         f"reused{fixed}); {verdicts}\n")
+
+
+def _verdict_counts(ds: Any) -> dict[str, Any]:
+    """Stable and unstable points (by status: only decided points have a verdict) and points per status."""
+    import dask
+
+    from ..status import DECIDED, PointStatus
+
+    status, stable = ds["status"], ds["stable"].astype(bool)
+    decided = status.isin([int(s) for s in DECIDED])
+    sums = [stable.sum(), (decided & ~stable).sum(), *[(status == int(s)).sum() for s in PointStatus]]
+    vals = [int(v) for v in dask.compute(*[x.data for x in sums])]
+    return {"stable": vals[0], "unstable": vals[1],
+            "status_counts": {s.meaning: v for s, v in zip(PointStatus, vals[2:]) if v}}
 
 
 def register(app: typer.Typer) -> None:

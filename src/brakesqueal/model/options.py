@@ -126,7 +126,8 @@ def _in_range(option: str, value: Any, high: float, unit: str) -> float:
     except (TypeError, ValueError):
         x = math.nan
     if not (0 < x <= high):
-        raise ParameterError(f"The option '{option}' must be in (0, {high:g}] {unit}; got {value!r}")
+        raise ParameterError(f"The option '{option}' must be in (0, {high:g}] {unit}; got {value!r}",
+                             parameter=option)
     return x
 
 
