@@ -88,3 +88,17 @@ def test_json_output_is_strict_json_at_extreme_values(capsys, setting):
         assert rc == 0
         d = json.loads(out, parse_constant=refuse)
         assert d["verdict"]["status"] in ("stable", "unstable", "undecided")
+
+
+def test_map_at_the_smallest_allowed_omega_gives_statuses_not_a_traceback(tmp_path, capsys):
+    """Omega = 1e-99 made numba's complex division in the quartic root kernel raise ZeroDivisionError."""
+    import xarray as xr
+
+    out = tmp_path / "z.nc"
+    rc = main(["map", "--x", "mu=0.1:1:4", "--y", "k_ip=1e5:1e9:3:log", "--out", str(out), "--set", "Omega=1e-99"])
+    capsys.readouterr()
+    assert rc == 0
+    with xr.open_dataset(out) as ds:
+        status = ds["status"].values
+        stable = ds["stable"].values
+    assert status.size == 12 and not stable[status > 1].any()

@@ -115,3 +115,13 @@ def test_closed_forms_contain_only_model_symbols(case):
     for m in (cf.M, cf.D, cf.K):
         assert m.free_symbols <= allowed
         assert not any(s.name.startswith("c_ip") for s in m.free_symbols)
+
+
+def test_unknown_case_is_a_parameter_error_with_a_suggestion():
+    import pytest
+
+    from brakesqueal import ParameterError, closed_form
+
+    with pytest.raises(ParameterError, match=r"did you mean 'symmetric'") as excinfo:
+        closed_form("symetric")
+    assert excinfo.value.parameter == "case" and isinstance(excinfo.value, ValueError)

@@ -387,7 +387,7 @@ def crossings(space: Any, axis: Axis) -> object:
     from ..results import CrossingResult
 
     space.check_axis(axis.name)
-    space.resolve({axis.name: axis.start})
+    _check_some_valid(space, axis)
     qn = quartic_numerators(space, (axis.name,))
     if qn is not None:
         start, found, undecided = exact_crossings(qn, axis.start, axis.stop, axis.log, _valid_fn(space, axis.name))
@@ -401,6 +401,24 @@ def crossings(space: Any, axis: Axis) -> object:
     return CrossingResult(parameter=axis.name, start=axis.start, stop=axis.stop, log=axis.log,
                           stable_at_start=start, crossings=tuple(found), method=method, space=space,
                           undecided_ranges=tuple(undecided), exhaustive=exhaustive, profile=prof)
+
+
+def _check_some_valid(space: Any, axis: Axis) -> None:
+    """Raise the start's ParameterError unless some point of the path resolves: a range may reach past the
+    allowed magnitudes (1e-100 to 1e100) at either end, those pieces are then reported undecided."""
+    try:
+        space.resolve({axis.name: axis.start})
+        return
+    except ParameterError as first:
+        error = first
+    for frac in (1.0, 0.5, 0.25, 0.75):
+        v = float(_split_point(Fraction(axis.start), Fraction(axis.stop), axis.log, frac)) if frac < 1 else axis.stop
+        try:
+            space.resolve({axis.name: v})
+            return
+        except ParameterError:
+            continue
+    raise error
 
 
 def omega_name(space: Any) -> str:
@@ -479,10 +497,11 @@ def critical_speeds(space: Any, lo: float = 1.0, hi: float = 1e5) -> object:
     axis = Axis(name, lo, hi, 2, True)
     if not (0 < lo):
         raise ParameterError(f"the Omega range needs 0 < START < STOP; got {lo!r}:{hi!r}")
-    space.resolve({name: lo})
-    # a range reaching past the allowed values of Omega (|Omega| <= 1e100) goes the way of `crossings`, which
-    # reports the part holding invalid parameter sets as undecided (the kernel would claim a verdict there)
-    if _omega_batchable(space, name) and _valid_fn(space, name)(hi):
+    _check_some_valid(space, axis)
+    # a range reaching past the allowed values of Omega (1e-100 <= |Omega| <= 1e100) goes the way of `crossings`,
+    # which reports the part holding invalid parameter sets as undecided (the kernel would claim a verdict there)
+    valid = _valid_fn(space, name)
+    if _omega_batchable(space, name) and valid(hi) and valid(lo):
         from .equilibrium import parameter_vector
 
         p = np.array([parameter_vector(space.resolve({}))])

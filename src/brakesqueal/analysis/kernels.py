@@ -1076,11 +1076,16 @@ def kernel_eigen(kern: GridKernel | MapKernel, C: np.ndarray, t: np.ndarray, lam
     ok = np.empty((rows, t.size), dtype=np.uint8)
     le = np.ascontiguousarray(lam_e, dtype=np.int64)
     with np.errstate(all="ignore"):
-        if rows * t.size >= PARALLEL_MIN and rows > CHARPOLY_BLOCK:
-            # blocks of rows in parallel, each warm-starting itself (results independent of the thread count)
-            quartic_top_grid_chunks(A, le, mr, fr, ok, CHARPOLY_BLOCK)
-        else:
-            quartic_top_grid(A, le, mr, fr, ok)
+        try:
+            if rows * t.size >= PARALLEL_MIN and rows > CHARPOLY_BLOCK:
+                # blocks of rows in parallel, each warm-starting itself (results independent of the thread count)
+                quartic_top_grid_chunks(A, le, mr, fr, ok, CHARPOLY_BLOCK)
+            else:
+                quartic_top_grid(A, le, mr, fr, ok)
+        except ZeroDivisionError:
+            # numba's complex division raises on a zero divisor (coefficients at the magnitude limits, e.g.
+            # Omega = 1e-99): no root is taken from this block, the caller recomputes every point
+            mr[:], fr[:], ok[:] = np.nan, np.nan, 0
     return mr, fr, ok
 
 

@@ -22,7 +22,16 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Any, Literal
 
+from ..errors import ParameterError
 from .backend import get_backend
+
+
+def _unknown_case(case: object) -> ParameterError:
+    """The error for an unknown closed-form case (a ``ValueError`` too)."""
+    from ..suggest import did_you_mean
+
+    return ParameterError(f"case must be one of {', '.join(CASES)}; got {case!r}{did_you_mean(str(case), CASES)}",
+                          parameter="case")
 
 __all__ = [
     "BLOCKS",
@@ -228,7 +237,7 @@ def case_substitutions(case: str, S: dict[str, Any]) -> dict[Any, Any]:
             S["c_ip1"]: 0, S["c_ip2"]: 0, S["k1"]: k, S["k2"]: k, S["d1"]: d, S["d2"]: d,
             S["h10"]: h / 2, S["h20"]: h / 2, S["mu1"]: mu, S["mu2"]: mu,
         }  # fmt: skip
-    raise ValueError(f"case must be one of {', '.join(CASES)}; got {case!r}")
+    raise _unknown_case(case)
 
 
 @lru_cache(maxsize=8)
@@ -251,7 +260,7 @@ def closed_form(case: Case = "general") -> ClosedForm:
     import sympy as sp
 
     if case not in CASES:
-        raise ValueError(f"case must be one of {', '.join(CASES)}; got {case!r}")
+        raise _unknown_case(case)
     from ..model.library import get_model
     from .assemble import build_equations
 
