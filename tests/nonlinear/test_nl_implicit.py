@@ -248,7 +248,7 @@ def test_pad_slope_option_equals_the_model_file_route(rising_friction_model, cap
     assert regularised_pads(ParameterSpace.from_preset("six-dof"), 1e-4).resolve({}).model.name == "six-dof"
     for bad in ("0", "-1e-4", "0.5", "nan"):
         assert main(["cycles", "--set", "k_ip=1e6", "--along", "Omega=60:120", "--pad-slope", bad]) == 2
-        assert "pad_slope" in capsys.readouterr().err
+        assert "--pad-slope" in capsys.readouterr().err
 
 
 def test_simulate_with_regularised_pads(capsys):
@@ -258,7 +258,7 @@ def test_simulate_with_regularised_pads(capsys):
     d = json.loads(capsys.readouterr().out)
     assert d["model"] == "paper+rising-pads" and d["t_end_reached"] == pytest.approx(0.005, abs=1 / 44100)
     assert main(["simulate", "--set", "k_ip=1e6", "--t-end", "0.005", "--pad-slope", "1"]) == 2
-    assert "pad_slope" in capsys.readouterr().err
+    assert "--pad-slope" in capsys.readouterr().err
 
 
 def test_predictions_stay_in_the_parameter_range():

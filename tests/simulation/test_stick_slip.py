@@ -59,7 +59,7 @@ def test_stick_speed_needs_pad_slope_on_the_command_line(capsys):
     assert "--stick-speed regularises the pads of --pad-slope" in capsys.readouterr().err
     assert main(["cycles", "--set", "k_ip=1e6", "--along", "Omega=60:120", "--pad-slope", "1e-4",
                  "--stick-speed", "2"]) == 2
-    assert "'stick_speed' must be in (0, 1] m/s" in capsys.readouterr().err
+    assert "'--stick-speed' must be in (0, 1] m/s" in capsys.readouterr().err
 
 
 def _run(vs, omega, t_end, perturbation):

@@ -121,8 +121,10 @@ class EigenAnalysis:
         :data:`~.robust.EXTENDED_VERDICT_MAX_SIZE` it is the componentwise
         bound of :func:`~.robust.extended_descriptor_verdict`.  ``max_real``
         is that of the listed eigenvalues (extended precision up to that
-        size); where they contradict the certified verdict the status is
-        ``"undecided"``.
+        size); where they contradict the certified verdict by more than that
+        bound the status is ``"undecided"`` (within it, at a point on the
+        boundary to rounding, the certified verdict and its ``max_real``
+        stand).
         """
         from .points import linear_verdict
         from .robust import EXTENDED_VERDICT_MAX_SIZE, STABLE, UNSTABLE, extended_descriptor_verdict
@@ -139,10 +141,14 @@ class EigenAnalysis:
             bound = safety * float(self.condition[i]) * _EPS * float(np.linalg.norm(lm.A, 2))
         status = "stable" if code == STABLE else "unstable" if code == UNSTABLE else "undecided"
         listed = float(self.eigenvalues[i].real)
+        exact = lm.pad_states or 2 * lm.n <= EXTENDED_MAX_SIZE  # listed in extended precision
         if (code == STABLE and not listed < 0) or (code == UNSTABLE and not listed > 0):
-            # the listed eigenvalues (extended precision) and the route disagree: neither is reported as certain
-            status = "undecided"
-        if lm.pad_states or 2 * lm.n <= EXTENDED_MAX_SIZE:
+            if not (exact and abs(listed) <= bound):
+                # the listed eigenvalues and the route disagree beyond the listed one's bound: neither is certain
+                status, mr = "undecided", listed
+            # else: a point on the boundary to rounding, the float matrices' eigenvalue within its bound of 0;
+            # the verdict (and its max Re) of the exact route on the parameters stands
+        elif exact:
             mr = listed  # the verdict line names the largest real part of the listed eigenvalues
         return Verdict(status, mr, bound, mr / abs(self.eigenvalues[i]))
 

@@ -172,6 +172,7 @@ class _AfterRest:
         self.doc, self.loop, self.delay, self.fn = doc, loop, delay_ms / 1000, fn
         self.due = 0.0
         self.pending = False
+        self.fired = False
 
     def poke(self) -> None:
         """(Re)start the rest."""
@@ -184,12 +185,24 @@ class _AfterRest:
         self.loop.call_later(wait + 0.001, self._tick)
 
     def _tick(self) -> None:
+        self.fired = False
         try:
             self.doc.add_next_tick_callback(self._fire)
         except Exception:  # the session is gone
             self.pending = False
+            return
+        # a next-tick callback added while the document is held can be lost when the hold is released (then the
+        # rest never ended: the link was not written after the last slider step); look again in a second
+        self.loop.call_later(1.0, self._retry)
+
+    def _retry(self) -> None:
+        if self.pending and not self.fired:
+            self._tick()
 
     def _fire(self) -> None:
+        if not self.pending or self.fired:
+            return  # a retried callback after the first one ran
+        self.fired = True
         wait = self.due - time.monotonic()
         if wait > 0.001:  # poked again since: wait for the rest
             self._arm(wait)
