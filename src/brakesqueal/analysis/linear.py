@@ -24,7 +24,6 @@ approximation of earlier versions; exact only in the first case).
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -134,22 +133,13 @@ def descriptor_eigenvalues(E: np.ndarray, A: np.ndarray, dps: int = 40) -> np.nd
         return pencil_eigenvalues(E, A)
     import mpmath
 
-    from .robust import balance_vector
+    from .robust import mp_balanced
 
     def at(digits: int) -> list[Any] | None:
         with mpmath.workdps(digits):
             try:
                 S = mpmath.inverse(mpmath.matrix(E.tolist())) * mpmath.matrix(A.tolist())
-                # balanced by an exact diagonal similarity (powers of 2): mpmath's QR iteration on a graded
-                # matrix (entries spanning 1e90) converged to wrong eigenvalues, the same at 40 and 80 digits
-                with np.errstate(all="ignore"), warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    Sd = np.array(S.tolist(), dtype=float)
-                    sc = balance_vector(Sd) if np.all(np.isfinite(Sd)) else np.ones(m)
-                if np.all(np.isfinite(sc)) and np.all(sc > 0):
-                    d = [mpmath.mpf(float(v)) for v in sc]
-                    S = mpmath.matrix([[S[i, j] * d[j] / d[i] for j in range(m)] for i in range(m)])
-                return list(mpmath.eig(S, left=False, right=False))
+                return list(mpmath.eig(mp_balanced(S)[0], left=False, right=False))
             except (ZeroDivisionError, mpmath.libmp.NoConvergence):  # a singular E, or no convergence
                 return None
 

@@ -70,7 +70,7 @@ __all__ = [
     "horner_bound", "isolate_real_roots", "isolate_real_roots_float", "quartic_interval", "eigen_verdicts",
     "charpoly_exact", "mp_roots_summary", "roots_summary", "trivial_verdicts", "matrix_verdicts", "reconcile",
     "exact_trivial_entries", "balance", "state_verdicts", "descriptor_verdicts", "extended_descriptor_verdict",
-    "EXTENDED_VERDICT_MAX_SIZE", "balance_vector",
+    "EXTENDED_VERDICT_MAX_SIZE", "mp_balanced",
 ]
 
 UNSTABLE, STABLE, UNDECIDED = 0, 1, 2
@@ -519,9 +519,26 @@ def descriptor_verdicts(E: np.ndarray, A: np.ndarray, *, rel_input: float = INPU
     return codes, mr, fr
 
 
-def balance_vector(S: np.ndarray) -> np.ndarray:
-    """Diagonal of the power-of-2 similarity that balances one matrix (:func:`balance_scaling`, run to the end)."""
-    return balance_scaling(np.asarray(S, dtype=float)[None], iterations=200)[1][0]
+def mp_balanced(S: Any) -> tuple[Any, list[Any]]:
+    """An mpmath matrix balanced by an exact diagonal similarity (powers of 2): ``(D^-1 S D, diag D)``.
+
+    mpmath's QR iteration converged to wrong eigenvalues of a graded matrix (entries spanning 1e90), the same
+    at 40 and 80 digits; balanced (:func:`balance_scaling`, run to the end) it does not.  ``D = I`` where the
+    matrix does not fit in double precision.
+    """
+    import warnings
+
+    import mpmath
+
+    N = S.rows
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        Sd = np.array(S.tolist(), dtype=float)
+        sc = balance_scaling(Sd[None], iterations=200)[1][0] if np.all(np.isfinite(Sd)) else np.ones(N)
+    if not (np.all(np.isfinite(sc)) and np.all(sc > 0)):
+        sc = np.ones(N)
+    d = [mpmath.mpf(float(v)) for v in sc]
+    return mpmath.matrix([[S[i, j] * d[j] / d[i] for j in range(N)] for i in range(N)]), d
 
 
 #: Largest descriptor size :func:`extended_descriptor_verdict` takes (about 30 ms at size 6).
@@ -604,20 +621,8 @@ def extended_descriptor_verdict(E: np.ndarray, A: np.ndarray, k: int, *, rel_inp
             aA = sub(aA, keep_r, keep_c) + sub(aA, keep_r, cols) * aX
         try:
             Einv = mpmath.inverse(mE)
-            S = Einv * mA
-            N = S.rows
-            # an exact diagonal similarity (powers of 2) first: mpmath's QR iteration converges to wrong
-            # eigenvalues of graded matrices (entries spanning 1e90)
-            import warnings
-
-            with np.errstate(all="ignore"), warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                Sd = np.array(S.tolist(), dtype=float)
-                sc = (balance_vector(Sd) if np.all(np.isfinite(Sd)) else np.ones(N))
-            if not (np.all(np.isfinite(sc)) and np.all(sc > 0)):
-                sc = np.ones(N)
-            dg = [mpmath.mpf(float(v)) for v in sc]
-            Sb = mpmath.matrix([[S[i, j] * dg[j] / dg[i] for j in range(N)] for i in range(N)])
+            Sb, dg = mp_balanced(Einv * mA)
+            N = Sb.rows
             lam, ELb, ERb = mpmath.eig(Sb, left=True, right=True)
         except (ZeroDivisionError, mpmath.libmp.NoConvergence):
             return none
