@@ -116,7 +116,7 @@ def _kernels() -> tuple[Any, Any, Any]:
         out[2] = -x[1]
         out[3] = x[0]
 
-    from brakesqueal.numeric.cache import guard_numba_caches
+    from brakesqueal.codegen.cache import guard_numba_caches
 
     guard_numba_caches([f, jac, dfdp])  # a damaged or unwritable numba cache file is recompiled, never an error
     return f, jac, dfdp

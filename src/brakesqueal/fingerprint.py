@@ -1,7 +1,7 @@
 """Content fingerprints of package sources and of the third-party code generators.
 
 One hash for both places that must notice a changed source: the code cache
-(:func:`brakesqueal.numeric.cache.source_fingerprint`) and the closed forms shipped
+(:func:`brakesqueal.codegen.cache.source_fingerprint`) and the closed forms shipped
 for ``derive`` (:func:`brakesqueal.cli.closed_forms.fingerprint`).  Standard library
 only, so a cold ``derive`` stays free of NumPy.
 """

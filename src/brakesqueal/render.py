@@ -83,19 +83,51 @@ def render_linear_model(lm: Any, fmt: str) -> str:
         f = abs(z.imag) / (2 * np.pi)
         zeta = -z.real / abs(z) if abs(z) > 0 else 0.0
         lines.append(f"  {z.real: .6e} {z.imag:+.6e}j  {_hz(f)}  {zeta: .3e}")
-    word = {"stable": "stable", "unstable": "UNSTABLE (squeal)", "undecided": "UNDECIDED"}[v.status]
-    lines.append(f"Silent motion is {word}: max Re(lambda) = {v.max_real:.6e} 1/s "
-                 f"({_bound_text(v.error_bound, ' 1/s')})")
+    lines += verdict_lines(v)
     return "\n".join(lines) + "\n"
+
+
+def verdict_lines(v: Any) -> list[str]:
+    """The verdict in words: what it is, what carries it, how it is certified (and, for a verdict carried by a
+    massless pad's own tangential rate, that pad's effective damping and the disk modes' verdict)."""
+    if v.pad_mode:
+        word = {"stable": "stable", "unstable": "UNSTABLE", "undecided": "UNDECIDED"}[v.status]
+    else:
+        word = {"stable": "stable", "unstable": "UNSTABLE (squeal)", "undecided": "UNDECIDED"}[v.status]
+    how = _how(v)
+    head = f"Silent motion is {word}: max Re(lambda) = {v.max_real:.6e} 1/s"
+    if v.carrier and not v.pad_mode:
+        f = "" if not math.isfinite(v.frequency) else f" at {v.frequency:.6g} Hz"
+        head += f", carried by a {v.carrier} mode{f}"
+    lines = [f"{head} ({how})"]
+    if v.pad_mode:
+        c = v.pad_damping
+        pad = v.carrier.removesuffix(" tangential rate")
+        lines.append(f"  carried by {pad}'s tangential rate: a non-oscillatory mode of the massless pad alone, not "
+                     "a disk vibration")
+        if c is not None and math.isfinite(c):
+            fix = (f"; a tangential damper d_ip above {abs(c):.2g} N s/m (or pad mass with damping) removes it"
+                   if c < 0 else "")
+            lines.append(f"  its effective tangential damping is {c:.3g} N s/m{fix}")
+        if v.disk is not None:
+            d = v.disk
+            lines.append(f"  disk modes alone: {d.status}, max Re(lambda) = {d.max_real:.6e} 1/s ({_how(d)})")
+    return lines
+
+
+def _how(v: Any) -> str:
+    """How a verdict is certified: its error bound (smaller than the margin) or the route that decided it."""
+    if v.status == "undecided":
+        b = float(v.error_bound)
+        return f"|max Re| within its error bound {b:.1e} 1/s" if math.isfinite(b) else "not certifiable"
+    if math.isfinite(float(v.error_bound)):
+        return f"error bound {float(v.error_bound):.1e} 1/s; route {v.method}"
+    return f"certified by route {v.method}"
 
 
 def _hz(f: float, width: int = 12) -> str:
     """A frequency in a column (scientific notation from 1e9 Hz: a 1e46 pad mode took 46 digits)."""
     return f"{f:{width}.4f}" if f < 1e9 else f"{f:{width}.4e}"
-
-
-def _bound_text(bound: float, unit: str = "") -> str:
-    return f"error bound {float(bound):.1e}{unit}" if math.isfinite(bound) else "no finite error bound"
 
 
 def _json_safe(obj: Any) -> Any:
@@ -112,7 +144,13 @@ def _json_safe(obj: Any) -> Any:
 def _verdict_dict(v: Any) -> dict[str, Any]:
     """The verdict as JSON (a non-finite error bound is ``null``: JSON has no Infinity)."""
     b = float(v.error_bound)
-    return {"status": v.status, "max_real": v.max_real, "error_bound": b if math.isfinite(b) else None}
+    out = {"status": v.status, "max_real": v.max_real, "error_bound": b if math.isfinite(b) else None,
+           "frequency": v.frequency, "carrier": v.carrier, "route": v.method}
+    if v.pad_mode:
+        out["pad_damping"] = v.pad_damping
+        if v.disk is not None:
+            out["disk_modes"] = _verdict_dict(v.disk)
+    return out
 
 
 def render_eigen(ea: Any, fmt: str, *, mode: int = 0) -> str:
@@ -134,7 +172,7 @@ def render_eigen(ea: Any, fmt: str, *, mode: int = 0) -> str:
             "attribution": {"mode": mode, "d_Re_lambda_d_ln_p": contrib},
         }), indent=2, allow_nan=False) + "\n"
     lines = [f"Model '{lm.model.name}': verdict {v.status}, max Re(lambda) = {v.max_real:.6e} 1/s "
-             f"({_bound_text(v.error_bound)})", "",
+             f"({_how(v)})", *verdict_lines(v)[1:], "",
              "mode  Re(lambda) [1/s]   frequency [Hz]  damping ratio  condition   shape (|x|, largest first)"]
     for i, (z, f, zt, c) in enumerate(zip(ea.eigenvalues, ea.frequencies, ea.damping_ratios, ea.condition)):
         x = ea.modes[:, i]

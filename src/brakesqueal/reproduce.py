@@ -33,8 +33,8 @@ def _noop(frac: float) -> None:
 def reproduce_fig2(out: str | Path, *, n_kip: int = 301, n_mu: int = 241, mu_line: float = FIG2_MU,
                    progress: Callable[[float], None] = _noop) -> dict[str, Any]:
     """Write ``fig2.png``, ``fig2.nc``, ``fig2.csv``, ``fig2.json`` to ``out``; returns the summary."""
-    from .analysis.crossings import crossings
-    from .analysis.maps import Axis, stability_map
+    from .analysis.maps import Axis
+    from .api import crossings, stability_map
     from .model.parameters import ParameterSpace
     from .plotting import save
 
@@ -103,7 +103,7 @@ def fig3_tips(space: Any, diff: np.ndarray, onset: np.ndarray, certain: np.ndarr
     list of (float, float)
         The tips, in increasing ``mu1 - mu2``.
     """
-    from .analysis.crossings import critical_speeds_many
+    from .api import critical_speeds_many
 
     has = np.isfinite(onset)
     out = []
@@ -131,7 +131,7 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
     """Write ``fig3.png``, ``fig3.nc``, ``fig3.csv``, ``fig3.json`` to ``out``; returns the summary."""
     import xarray as xr
 
-    from .analysis.crossings import critical_speeds_many
+    from .api import critical_speeds_many
     from .model.parameters import ParameterSpace
     from .plotting import plot_critical_curves, save
 

@@ -9,7 +9,14 @@ from __future__ import annotations
 
 from enum import Enum, IntEnum
 
-__all__ = ["PointStatus", "RunStatus", "STATUS_MEANINGS", "status_of_error", "DECIDED", "verdict_counts_text"]
+__all__ = ["PointStatus", "RunStatus", "STATUS_MEANINGS", "status_of_error", "DECIDED", "verdict_counts_text",
+           "TRIVIAL_NOISE_FLOOR"]
+
+#: The one rule of a trivial silent motion, for every command: a zero-state residual is zero "to rounding" when
+#: ``|F_i| <= TRIVIAL_NOISE_FLOOR eps S_i`` (``S_i`` the magnitude of the terms that cancel in it); at one point
+#: :func:`brakesqueal.analysis.equilibrium.is_trivial`, along a path or a map's axes its symbolic analogue
+#: (:func:`brakesqueal.symbolic.closed_form.quartic_numerators`, per monomial of the path's variables).
+TRIVIAL_NOISE_FLOOR = 64.0
 
 
 class PointStatus(IntEnum):

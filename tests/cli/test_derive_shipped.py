@@ -42,7 +42,7 @@ def test_generated_module_is_current():
 
 
 def test_sources_are_the_code_generating_modules_the_derivation_imports():
-    from brakesqueal.numeric import cache
+    from brakesqueal.codegen import cache
 
     sources = closed_forms.derivation_sources()
     assert sources == data.SOURCES, REGENERATE

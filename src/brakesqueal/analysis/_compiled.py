@@ -1477,7 +1477,7 @@ def quartic_top_grid_chunks(A, lam_e, mr, fr, ok, block):  # type: ignore[no-unt
 
 
 def _guard() -> None:
-    from ..numeric.cache import guard_numba_caches
+    from ..codegen.cache import guard_numba_caches
 
     guard_numba_caches(globals())  # a damaged numba cache file is recompiled, never an error
 

@@ -28,7 +28,6 @@ from typing import Any
 import numpy as np
 
 from ..status import PointStatus
-from .points import evaluate
 
 __all__ = ["Boundary", "stability_boundary"]
 
@@ -93,7 +92,7 @@ def _nearest(grid: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def stability_boundary(space: Any, outer: Any, inner: Any, stable: np.ndarray, status: np.ndarray, *,
                        iterations: int = 40, budget: float | None = None,
-                       evaluator: Callable[[dict[str, np.ndarray]], Any] | None = None) -> Boundary:
+                       evaluator: Callable[[dict[str, np.ndarray]], Any]) -> Boundary:
     """Stability boundary of a map, refined onto the boundary by bisection along grid edges.
 
     Parameters
@@ -113,10 +112,9 @@ def stability_boundary(space: Any, outer: Any, inner: Any, stable: np.ndarray, s
         bisection stops and every vertex keeps its current bracket (its
         ``width`` says how far it got).  The default, no budget, keeps the
         result independent of the machine's speed.
-    evaluator : callable, optional
-        ``evaluator({outer: values, inner: values}) -> Points`` for the bisection
-        points (default :func:`~.points.evaluate`; maps pass their route's own
-        certified evaluator).
+    evaluator : callable
+        ``evaluator({outer: values, inner: values}) -> Verdicts`` for the bisection
+        points (maps pass :func:`~.points.evaluate` with their engine: the dispatcher's certified verdicts).
 
     Returns
     -------
@@ -188,7 +186,7 @@ def stability_boundary(space: Any, outer: Any, inner: Any, stable: np.ndarray, s
             if sel.size == 0:
                 break
             vals = {names[0]: _v(vo[sel], outer.log), names[1]: _v(vi[sel], inner.log)}
-            r = evaluate(space, vals) if evaluator is None else evaluator(vals)
+            r = evaluator(vals)
             good = np.isin(r.status, _DECIDED)
             same = np.asarray(r.stable, bool) == sa[sel]
             upd = sel[good]

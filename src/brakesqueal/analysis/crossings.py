@@ -31,16 +31,20 @@ from __future__ import annotations
 
 import math
 from fractions import Fraction
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import ParameterError
 from ..model.expressions import names_in
 from ..status import PointStatus
-from .kernels import QuarticNumerators, omega_entries, omega_kernel_available, omega_subranges, quartic_numerators
+from .kernels import omega_entries, omega_subranges
 from .maps import Axis
 from .robust import isolate_real_roots
+
+if TYPE_CHECKING:
+    from ..codegen.engine import Engine
+    from ..model.parameters import ParameterSpace
 
 __all__ = ["crossings", "critical_speeds", "critical_speeds_many", "critical_speeds_batch", "exact_crossings",
            "exact_omega_crossings", "omega_name", "PROFILE_POINTS", "NUMERIC_GRID"]
@@ -50,42 +54,7 @@ PROFILE_POINTS = 200
 #: Grid points of the numeric route.
 NUMERIC_GRID = 801
 
-_DIGITS = 80
-
-
-def _mpf_fraction(v: Any) -> Fraction:
-    import mpmath
-
-    sign, man, exp, _ = mpmath.mpf(v)._mpf_
-    man = -int(man) if sign else int(man)
-    return Fraction(man * 2 ** exp) if exp >= 0 else Fraction(man, 2 ** (-exp))
-
-
-def _univariate(poly: Any, consts: tuple[Any, ...]) -> tuple[list[Fraction], bool]:
-    """Ascending Fraction coefficients in the first generator; ``exact`` False when constants were rounded."""
-    import mpmath
-    import sympy as sp
-
-    if not consts:
-        deg = max((m[0] for m in poly.monoms()), default=0)
-        out = [Fraction(0)] * (deg + 1)
-        for mon, c in poly.terms():
-            out[mon[0]] += Fraction(int(c.numerator), int(c.denominator))
-        return out, True
-    with mpmath.workdps(_DIGITS + 20):
-        cv = [mpmath.mpf(sp.N(c, _DIGITS + 30)) for c in consts]
-        acc: dict[int, Any] = {}
-        for mon, c in poly.terms():
-            v = mpmath.mpf(int(c.numerator)) / int(c.denominator)
-            for g, k in zip(cv, mon[1:]):
-                v *= g ** k
-            acc[mon[0]] = acc.get(mon[0], 0) + v
-        deg = max(acc, default=0)
-        out = [Fraction(0)] * (deg + 1)
-        for k, v in acc.items():
-            with mpmath.workdps(_DIGITS):
-                out[k] = _mpf_fraction(+v)
-    return out, False
+_DIGITS = 80  # significant digits of constants in inexact tables (symbolic.closed_form.UNIVARIATE_DIGITS)
 
 
 def _peval(c: list[Fraction], x: Fraction) -> tuple[Fraction, Fraction]:
@@ -132,14 +101,20 @@ def _split_point(a: Fraction, b: Fraction, log: bool, frac: float = 0.5) -> Frac
     return a + (b - a) * Fraction(frac).limit_denominator(64)
 
 
-def exact_crossings(qn: QuarticNumerators, lo: float, hi: float, log: bool = True,
+def _fractions(coeffs: list[str]) -> list[Fraction]:
+    return [Fraction(c) for c in coeffs]
+
+
+def exact_crossings(table: dict[str, Any], lo: float, hi: float, log: bool = True,
                     valid: Any = None) -> tuple[bool, list[tuple[float, str]], list[tuple[float, float]]]:
-    """All stability changes in ``(lo, hi)`` of a one-variable :class:`~.kernels.QuarticNumerators`.
+    """All stability changes in ``(lo, hi)`` from the exact univariate quartic of a path.
 
     Parameters
     ----------
-    qn : QuarticNumerators
-        Numerators in one axis variable.
+    table : dict
+        Exact ascending coefficients of ``N_0..N_4``, ``H3(N)`` and ``Den`` in the path variable
+        (:meth:`Engine.univariate <brakesqueal.codegen.engine.Engine.univariate>`; ``"p/q"`` strings) and
+        whether they are exact.
     lo, hi : float
         The range (taken exactly; any magnitudes).
     log : bool
@@ -161,12 +136,8 @@ def exact_crossings(qn: QuarticNumerators, lo: float, hi: float, log: bool = Tru
         Ranges where no verdict could be established (empty in all but
         pathological cases).
     """
-    exact = True
-    polys = []
-    for p in (*qn.N, qn.hurwitz(), qn.den):
-        c, ex = _univariate(p, qn.constants)
-        exact &= ex
-        polys.append(c)
+    exact = bool(table["exact"])
+    polys = [_fractions(c) for c in table["N"]] + [_fractions(table["H"]), _fractions(table["den"])]
     N = polys[:5]
     lo_q, hi_q = Fraction(lo), Fraction(hi)
     roots = isolate_real_roots([N[0], N[4], polys[5], polys[6]], lo_q, hi_q)
@@ -234,38 +205,67 @@ def _merge_ranges(r: list[tuple[float, float]]) -> list[tuple[float, float]]:
     return out
 
 
-def exact_omega_crossings(p: np.ndarray, lo: float, hi: float, spec: Any = None
+def _pmul(a: list[Fraction], b: list[Fraction]) -> list[Fraction]:
+    out = [Fraction(0)] * (len(a) + len(b) - 1)
+    for i, x in enumerate(a):
+        if x:
+            for j, y in enumerate(b):
+                out[i + j] += x * y
+    return out
+
+
+def _padd(*ps: tuple[int, list[Fraction]]) -> list[Fraction]:
+    out = [Fraction(0)] * max(len(p) for _, p in ps)
+    for sgn, p in ps:
+        for i, x in enumerate(p):
+            out[i] += sgn * x
+    return out
+
+
+def omega_quartic(engine: Engine, p: np.ndarray) -> dict[str, Any]:
+    """The exact quartic along Ω at one parameter vector (trivial silent motion), as an :func:`exact_crossings`
+    table: ``Ω² a_i(Ω)`` from the Laurent coefficients of the closed form's entries in exact rational
+    arithmetic (:meth:`Engine.exact_omega <brakesqueal.codegen.engine.Engine.exact_omega>`; no computer
+    algebra), so ``Den = Ω²``."""
+    mod = engine.exact_omega()
+    c = mod.omega_entries([Fraction(float(v)) for v in p])
+    e = [list(c[4 * k:4 * k + 4]) for k in range(12)]  # Ω · entry, ascending in Ω
+    m11, m12, m21, m22, d11, d12, d21, d22, k11, k12, k21, k22 = e
+    N = [_padd((1, _pmul(k11, k22)), (-1, _pmul(k12, k21))),
+         _padd((1, _pmul(d11, k22)), (1, _pmul(k11, d22)), (-1, _pmul(d12, k21)), (-1, _pmul(k12, d21))),
+         _padd((1, _pmul(m11, k22)), (1, _pmul(d11, d22)), (1, _pmul(k11, m22)), (-1, _pmul(m12, k21)),
+               (-1, _pmul(d12, d21)), (-1, _pmul(k12, m21))),
+         _padd((1, _pmul(m11, d22)), (1, _pmul(d11, m22)), (-1, _pmul(m12, d21)), (-1, _pmul(d12, m21))),
+         _padd((1, _pmul(m11, m22)), (-1, _pmul(m12, m21)))]
+    n0, n1, n2, n3, n4 = N
+    H = _padd((1, _pmul(n1, _padd((1, _pmul(n3, n2)), (-1, _pmul(n4, n1))))), (-1, _pmul(_pmul(n3, n3), n0)))
+
+    def txt(q: list[Fraction]) -> list[str]:
+        return [f"{v.numerator}/{v.denominator}" for v in q]
+
+    return {"N": [txt(q) for q in N], "H": txt(H), "den": ["0/1", "0/1", "1/1"], "exact": bool(mod.EXACT)}
+
+
+def exact_omega_crossings(engine: Engine, p: np.ndarray, lo: float, hi: float
                           ) -> tuple[bool, list[tuple[float, str]], list[tuple[float, float]]]:
     """Exact stability changes along Ω in ``(lo, hi)`` for one parameter vector (trivial silent motion).
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine; it needs the critical-speed kernel (a closed form with a named spin).
     p : ndarray
         Parameter vector in the model's packing order (compliances; Ω ignored).
     lo, hi : float
         The Ω range [rad/s].
-    spec : ModelSpec, optional
-        The model (default: the paper's); it needs a closed form with a named spin.
 
     Returns
     -------
     stable_at_start, crossings, undecided
-        See :func:`exact_crossings`.  The closed-form matrices are evaluated
-        with the (exact rational) parameter values and Ω symbolic.
+        See :func:`exact_crossings` (:func:`omega_quartic`: the parameter values taken as exact rationals, Ω
+        symbolic).
     """
-    import sympy as sp
-
-    from .kernels import _form, _paper, _quartic_field
-
-    form = _form(spec if spec is not None else _paper())
-    W = sp.Symbol("X0", positive=True)
-    sub = {s: (W if n == form.omega else sp.Rational(float(v))) for n, s, v in zip(form.names, form.symbols, p)}
-    entries = [e.xreplace(sub) for X in (form.M, form.D, form.K) for e in X]
-    res = _quartic_field(entries, [W])
-    if res is None:  # cannot happen for a Laurent closed form
-        return False, [], [(lo, hi)]
-    Nn, den, consts = res
-    return exact_crossings(QuarticNumerators(("Omega",), consts, Nn, den), lo, hi, True)
+    return exact_crossings(omega_quartic(engine, p), lo, hi, True)
 
 
 def _grid(axis: Axis, n: int) -> np.ndarray:
@@ -275,19 +275,20 @@ def _grid(axis: Axis, n: int) -> np.ndarray:
     return np.linspace(axis.start, axis.stop, n)
 
 
-def _profile(space: Any, axis: Axis, n: int = PROFILE_POINTS) -> tuple[np.ndarray, np.ndarray]:
+def _profile(engine: Engine, space: ParameterSpace, axis: Axis, n: int = PROFILE_POINTS
+             ) -> tuple[np.ndarray, np.ndarray]:
     """``(values, max_real)`` along a path from the per-point evaluator (NaN where undecidable)."""
     from .points import evaluate
 
     grid = _grid(axis, n)
-    r = evaluate(space, {axis.name: grid})
+    r = evaluate(engine, space, {axis.name: grid})
     return grid, np.where(np.isin(r.status, _DECIDED), r.max_real, np.nan)
 
 
 _DECIDED = (int(PointStatus.OK), int(PointStatus.OK_NONTRIVIAL))
 
 
-def _numeric(space: Any, axis: Axis, n: int = NUMERIC_GRID
+def _numeric(engine: Engine, space: ParameterSpace, axis: Axis, n: int = NUMERIC_GRID
              ) -> tuple[bool, list[tuple[float, str]], list[tuple[float, float]], tuple[np.ndarray, np.ndarray]]:
     """Certified per-point verdicts on a grid, sign changes bracketed, Brent on max Re λ."""
     from scipy.optimize import brentq
@@ -295,7 +296,7 @@ def _numeric(space: Any, axis: Axis, n: int = NUMERIC_GRID
     from .points import evaluate, evaluate_point
 
     grid = _grid(axis, n)
-    r = evaluate(space, {axis.name: grid})
+    r = evaluate(engine, space, {axis.name: grid})
     ok = np.isin(r.status, _DECIDED)
     st = r.stable & ok
     mr = r.max_real
@@ -305,7 +306,7 @@ def _numeric(space: Any, axis: Axis, n: int = NUMERIC_GRID
     out: list[tuple[float, str]] = []
 
     def f(v: float) -> float:
-        return evaluate_point(space, {axis.name: v}).max_real
+        return evaluate_point(engine, space, {axis.name: v}).max_real
 
     dec = np.flatnonzero(ok)
     for k0, k1 in zip(dec[:-1], dec[1:]):
@@ -336,7 +337,7 @@ def _valid_fn(space: Any, name: str) -> Any:
     return valid
 
 
-def crossings(space: Any, axis: Axis) -> object:
+def crossings(engine: Engine, space: ParameterSpace, axis: Axis) -> Any:
     """Every value of ``axis.name`` in ``(start, stop)`` where stability of the silent motion changes.
 
     Stability is that of the linearized equations (47) about the silent
@@ -345,6 +346,8 @@ def crossings(space: Any, axis: Axis) -> object:
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine.
     space : ParameterSpace
         The model, preset and overrides (any model); every other settable
         name keeps its value in ``space`` and tied names follow.
@@ -388,13 +391,13 @@ def crossings(space: Any, axis: Axis) -> object:
 
     space.check_axis(axis.name)
     _check_some_valid(space, axis)
-    qn = quartic_numerators(space, (axis.name,))
-    if qn is not None:
-        start, found, undecided = exact_crossings(qn, axis.start, axis.stop, axis.log, _valid_fn(space, axis.name))
+    table = engine.univariate(space, axis.name)
+    if table is not None:
+        start, found, undecided = exact_crossings(table, axis.start, axis.stop, axis.log, _valid_fn(space, axis.name))
         method, exhaustive = "exact (isolated real roots of the Hurwitz polynomials of the closed form)", True
-        prof = _profile(space, axis)
+        prof = _profile(engine, space, axis)
     else:
-        start, found, undecided, prof = _numeric(space, axis)
+        start, found, undecided, prof = _numeric(engine, space, axis)
         method = (f"numeric (certified per-point verdicts on a {NUMERIC_GRID}-point grid + Brent on max Re lambda; "
                   "grid search)")
         exhaustive = False
@@ -403,7 +406,7 @@ def crossings(space: Any, axis: Axis) -> object:
                           undecided_ranges=tuple(undecided), exhaustive=exhaustive, profile=prof)
 
 
-def _check_some_valid(space: Any, axis: Axis) -> None:
+def _check_some_valid(space: ParameterSpace, axis: Axis) -> None:
     """Raise the start's ParameterError unless some point of the path resolves: a range may reach past the
     allowed magnitudes (1e-100 to 1e100) at either end, those pieces are then reported undecided."""
     try:
@@ -421,7 +424,7 @@ def _check_some_valid(space: Any, axis: Axis) -> None:
     raise error
 
 
-def omega_name(space: Any) -> str:
+def omega_name(space: ParameterSpace) -> str:
     """The name of the disk's spin parameter of the space's model (a settable name of ``space``).
 
     Parameters
@@ -448,15 +451,15 @@ def omega_name(space: Any) -> str:
     return name
 
 
-def _omega_batchable(space: Any, name: str) -> bool:
-    if not omega_kernel_available(space.model):
+def _omega_batchable(engine: Engine, space: ParameterSpace, name: str) -> bool:
+    if not engine.caps.omega_kernel:
         return False
     if any(name in names_in(e) for e in space.tied.values()):
         return False
-    return quartic_numerators(space, ()) is not None
+    return engine.closed_route(space, ())
 
 
-def critical_speeds(space: Any, lo: float = 1.0, hi: float = 1e5) -> object:
+def critical_speeds(engine: Engine, space: ParameterSpace, lo: float = 1.0, hi: float = 1e5) -> Any:
     """All onsets and re-stabilisations of squeal along the spin rate Ω in ``(lo, hi)`` [rad/s].
 
     Uses the certified compiled Laurent-polynomial kernel when the model has
@@ -472,6 +475,8 @@ def critical_speeds(space: Any, lo: float = 1.0, hi: float = 1e5) -> object:
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine.
     space : ParameterSpace
         The model, preset and overrides (any model); the disk's spin
         (:func:`omega_name`) must be one of its settable names (not tied).
@@ -501,30 +506,31 @@ def critical_speeds(space: Any, lo: float = 1.0, hi: float = 1e5) -> object:
     # a range reaching past the allowed values of Omega (1e-100 <= |Omega| <= 1e100) goes the way of `crossings`,
     # which reports the part holding invalid parameter sets as undecided (the kernel would claim a verdict there)
     valid = _valid_fn(space, name)
-    if _omega_batchable(space, name) and valid(hi) and valid(lo):
+    if _omega_batchable(engine, space, name) and valid(hi) and valid(lo):
         from .equilibrium import parameter_vector
 
         p = np.array([parameter_vector(space.resolve({}))])
-        roots, dirs, counts, start, status = critical_speeds_batch(p, lo, hi, max_crossings=16, return_status=True,
-                                                                   spec=space.model)
+        roots, dirs, counts, start, status = critical_speeds_batch(engine, p, lo, hi, max_crossings=16,
+                                                                   return_status=True)
         found = tuple((float(roots[0, k]), "stabilizing" if dirs[0, k] > 0 else "destabilizing")
                       for k in range(min(int(counts[0]), 16)))
         undecided: tuple[tuple[float, float], ...] = ()
         if status[0] != 0:
-            _, _, und = exact_omega_crossings(p[0], lo, hi, space.model)
+            _, _, und = exact_omega_crossings(engine, p[0], lo, hi)
             undecided = tuple(und) or ((lo, hi),)
         return CriticalSpeedResult(parameter=name, start=lo, stop=hi, log=True, stable_at_start=bool(start[0]),
                                    crossings=found, method="exact (certified compiled Laurent-polynomial Hurwitz "
                                    "kernel, exact rational fallback)", space=space, undecided_ranges=undecided,
-                                   profile=_profile(space, axis))
-    r = crossings(space, axis)
+                                   profile=_profile(engine, space, axis))
+    r = crossings(engine, space, axis)
     return CriticalSpeedResult(parameter=name, start=lo, stop=hi, log=True, stable_at_start=r.stable_at_start,
                                crossings=r.crossings, method=r.method, space=space,
                                undecided_ranges=r.undecided_ranges, exhaustive=r.exhaustive, profile=r.profile)
 
 
-def critical_speeds_many(space: Any, changes: dict[str, np.ndarray], lo: float = 1.0, hi: float = 1e5,
-                         max_crossings: int = 8, *, return_status: bool = False) -> tuple[np.ndarray, ...]:
+def critical_speeds_many(engine: Engine, space: ParameterSpace, changes: dict[str, np.ndarray], lo: float = 1.0,
+                         hi: float = 1e5, max_crossings: int = 8, *, return_status: bool = False
+                         ) -> tuple[np.ndarray, ...]:
     """Critical speeds for many parameter sets (arrays of settable values), batched where possible.
 
     Each of the ``n`` points sets ``space``'s names to the values of
@@ -537,6 +543,8 @@ def critical_speeds_many(space: Any, changes: dict[str, np.ndarray], lo: float =
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine.
     space : ParameterSpace
         The model, preset and overrides (any model).
     changes : dict of str to array_like
@@ -572,7 +580,8 @@ def critical_speeds_many(space: Any, changes: dict[str, np.ndarray], lo: float =
         If a name is tied or not settable, Ω is not a settable parameter, the
         range is not ``0 < lo < hi``, or a point has invalid parameters.
     """
-    from .points import _is_trivial, _Model, valid_points
+    from .equilibrium import trivial_rows
+    from .points import valid_points
 
     name = omega_name(space)
     Axis(name, lo, hi, 2, True)
@@ -599,17 +608,17 @@ def critical_speeds_many(space: Any, changes: dict[str, np.ndarray], lo: float =
     start = np.zeros(n_pts, dtype=bool)
     status = np.zeros(n_pts, dtype=np.int8)
     fast = np.zeros(n_pts, dtype=bool)
-    if (omega_kernel_available(space.model) and not any(name in names_in(e) for e in space.tied.values())
+    if (engine.caps.omega_kernel and not any(name in names_in(e) for e in space.tied.values())
             and _valid_fn(space, name)(hi)):  # else per set by critical_speeds (invalid parts undecided)
-        fast = _is_trivial(_Model.of(space.model), P)
+        fast = trivial_rows(engine.compiled, P)[0]  # the one triviality decision
     ix = np.flatnonzero(fast)
     if ix.size:
-        r, d, c, s0, st = critical_speeds_batch(P[ix], lo, hi, max_crossings, return_status=True, spec=space.model)
+        r, d, c, s0, st = critical_speeds_batch(engine, P[ix], lo, hi, max_crossings, return_status=True)
         roots[ix], dirs[ix], counts[ix], start[ix] = r, d, c, s0
         status[ix] = np.where(st != 0, int(PointStatus.UNDECIDED), int(PointStatus.OK))
     for i in np.flatnonzero(~fast):
         sub = space.with_values({k: float(v[i]) for k, v in cols.items()})
-        res = critical_speeds(sub, lo, hi)
+        res = critical_speeds(engine, sub, lo, hi)
         found = list(res.crossings)  # type: ignore[attr-defined]
         for k, (v, dd) in enumerate(found[:max_crossings]):
             roots[i, k] = v
@@ -622,8 +631,8 @@ def critical_speeds_many(space: Any, changes: dict[str, np.ndarray], lo: float =
     return roots, dirs, counts, start
 
 
-def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossings: int = 8, *,
-                          return_status: bool = False, spec: Any = None) -> tuple[np.ndarray, ...]:
+def critical_speeds_batch(engine: Engine, params: np.ndarray, lo: float, hi: float, max_crossings: int = 8, *,
+                          return_status: bool = False) -> tuple[np.ndarray, ...]:
     """All stability changes along Ω in ``(lo, hi)`` for many parameter vectors (trivial silent motion).
 
     Each set is first handled by the certified compiled kernel
@@ -636,6 +645,9 @@ def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossing
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine; it needs the critical-speed kernel (:attr:`Capabilities.omega_kernel
+        <brakesqueal.codegen.engine.Capabilities.omega_kernel>`).
     params : ndarray, shape (n, n_parameters)
         Parameter vectors in the model's packing order (Ω ignored); the
         silent motion of every row must be trivial (for the paper's model
@@ -646,8 +658,6 @@ def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossing
         Columns of the outputs.
     return_status : bool
         Also return the per-set status (0 complete, 5 undecided somewhere in the range).
-    spec : ModelSpec, optional
-        The model (default: the paper's); it needs :func:`~.kernels.omega_kernel_available`.
 
     Returns
     -------
@@ -673,13 +683,13 @@ def critical_speeds_batch(params: np.ndarray, lo: float, hi: float, max_crossing
     start = np.zeros(n, dtype=np.bool_)
     flags = np.zeros(n, dtype=np.uint8)
     status = np.zeros(n, dtype=np.int8)
-    E, R = omega_entries(P, spec)
+    E, R = omega_entries(engine, P)
     if n >= PARALLEL_MIN:
         critical_batch_chunks(E, R, bounds, roots, dirs, counts, start, flags, max(1, n // (PARALLEL_MIN // 4)))
     else:
         critical_batch(E, R, bounds, roots, dirs, counts, start, flags)
     for i in np.flatnonzero(flags):
-        st, found, undecided = exact_omega_crossings(P[i], float(lo), float(hi), spec)
+        st, found, undecided = exact_omega_crossings(engine, P[i], float(lo), float(hi))
         roots[i] = np.nan
         dirs[i] = 0
         for k, (v, d) in enumerate(found[:max_crossings]):

@@ -31,32 +31,55 @@ _EPS = np.finfo(float).eps
 
 @dataclass(frozen=True)
 class Verdict:
-    """Stability verdict with its tolerance.
+    """Stability verdict with what carries it and how certain it is.
 
     Attributes
     ----------
     status : str
         ``"stable"``, ``"unstable"`` or ``"undecided"`` (not certifiable), the
-        certified verdict shared by every route.
+        certified verdict of the one dispatcher (:func:`~.verdict.decide_model`).
     max_real : float
-        Largest real part [1/s].
+        Largest real part [1/s] of the judged eigenvalues.
     error_bound : float
-        Estimated absolute error of that real part [1/s] (``safety · κ · ε · ‖A‖``).
+        Error bound of ``max_real`` [1/s] where it is smaller than ``|max_real|`` (the bound of the route that
+        certified the verdict through the eigenvalues, or the listed eigenvalue's own componentwise bound);
+        NaN where no such bound is at hand: the verdict is then certified otherwise (``method``, e.g. an exact
+        Routh-Hurwitz test), and no bound larger than the margin is ever reported.
     relative_margin : float
-        ``max_real / |λ|`` of the least-stable eigenvalue (about 1e-5 near the
-        boundaries of the paper's maps; verdicts are trustworthy down to
-        about ``error_bound / |λ|``, ~1e-13 for these models).
+        ``max_real / |λ|`` of the least-stable eigenvalue.
+    carrier : str or None
+        The mode carrying the verdict: ``"disk"``, ``"pad <name>"``, ``"caliper <name>"`` or
+        ``"pad <name> tangential rate"`` (a non-oscillatory mode of a massless pad alone).
+    method : str
+        The route that decided (:data:`~.verdict.ROUTES`).
+    frequency : float
+        Frequency of the least-stable judged eigenvalue [Hz].
+    pad_damping : float or None
+        For a verdict carried by a massless pad's tangential rate: that pad's effective tangential damping
+        ``G_dL`` [N s/m] (normalised to a positive stiffness; negative: the pad's own mode grows).
+    disk : Verdict or None
+        The verdict of the disk's modes alone when the verdict is carried by a pad's tangential rate.
     """
 
     status: str
     max_real: float
     error_bound: float
     relative_margin: float
+    carrier: str | None = None
+    method: str = "none"
+    frequency: float = math.nan
+    pad_damping: float | None = None
+    disk: Verdict | None = None
 
     @property
     def stable(self) -> bool:
         """True only for a decided ``"stable"``."""
         return self.status == "stable"
+
+    @property
+    def pad_mode(self) -> bool:
+        """Whether the verdict is carried by a massless pad's own tangential-rate mode."""
+        return bool(self.carrier and self.carrier.endswith("tangential rate"))
 
 
 @dataclass(frozen=True)
@@ -110,47 +133,85 @@ class EigenAnalysis:
         D, K = self.model.D, self.model.K
         return {"D_s": (D + D.T) / 2, "G": (D - D.T) / 2, "K_s": (K + K.T) / 2, "N": (K - K.T) / 2}
 
-    def verdict(self, safety: float = 100.0) -> Verdict:
-        """Stability verdict: the certified one of every route (:func:`~.points.linear_verdict`).
+    def verdict(self, safety: float = 100.0, modes: str = "all") -> Verdict:
+        """Stability verdict: the certified one of the one dispatcher (:func:`~.verdict.decide_model`).
 
-        ``status`` and ``max_real`` come from the certified verdict (interval
-        Routh for 2-DOF models, eigenvalues with condition bounds otherwise),
-        the same as maps, sweeps and the command line report; ``error_bound``
-        is the first-order estimate ``safety · κ · ε · ‖A‖`` of the least-stable
-        eigenvalue's error (for information); for state sizes up to
-        :data:`~.robust.EXTENDED_VERDICT_MAX_SIZE` it is the componentwise
-        bound of :func:`~.robust.extended_descriptor_verdict`.  ``max_real``
-        is that of the listed eigenvalues (extended precision up to that
-        size); where they contradict the certified verdict by more than that
-        bound the status is ``"undecided"`` (within it, at a point on the
-        boundary to rounding, the certified verdict and its ``max_real``
-        stand).
+        ``status``, ``carrier`` and ``method`` come from the dispatcher, the same as maps, sweeps and the command
+        line report.  ``max_real`` is that of the listed eigenvalues (extended precision up to
+        :data:`~.robust.EXTENDED_VERDICT_MAX_SIZE`); where they contradict the certified verdict by more than
+        the listed eigenvalue's bound the status is ``"undecided"`` (within it, at a point on the boundary to
+        rounding, the certified verdict and its ``max_real`` stand).  ``error_bound`` is reported only where
+        it is smaller than ``|max_real|`` (see :class:`Verdict`).  A verdict carried by a massless pad's
+        tangential rate also gives the pad's effective damping and the disk modes' own verdict.
+
+        Parameters
+        ----------
+        safety : float
+            Factor of the first-order estimate ``safety · κ · ε · ‖A‖`` used above the extended-precision size.
+        modes : {"all", "disk"}
+            Judge every eigenvalue, or only the disk's (a massless pad's own tangential-rate mode left out).
         """
-        from .points import linear_verdict
         from .robust import EXTENDED_VERDICT_MAX_SIZE, STABLE, UNSTABLE, extended_descriptor_verdict
+        from .verdict import decide_model
 
         lm = self.model
-        code, mr, _ = linear_verdict(lm)
+        v = decide_model(lm, modes=modes)
+        code, mr = int(v.code[0]), float(v.max_real[0])
+        route_bound, freq = float(v.bound[0]), float(v.frequency[0])
+        carrier, method = v.carrier_name(0), v.method_name(0)
         i = int(np.argmax(self.eigenvalues.real))
         E, A = lm.descriptor
         if E.shape[0] <= EXTENDED_VERDICT_MAX_SIZE:
             # componentwise bound of the extended-precision route: the norm-wise one below is dominated by the
             # largest modes (pads' own modes up to 1e25 at tilted silent motions) and says little of the slow ones
-            bound = extended_descriptor_verdict(E, A, len(lm.pad_states))[3]
+            listed_bound = extended_descriptor_verdict(E, A, len(lm.pad_states))[3]
         else:
-            bound = safety * float(self.condition[i]) * _EPS * float(np.linalg.norm(lm.A, 2))
+            listed_bound = safety * float(self.condition[i]) * _EPS * float(np.linalg.norm(lm.A, 2))
         status = "stable" if code == STABLE else "unstable" if code == UNSTABLE else "undecided"
         listed = float(self.eigenvalues[i].real)
         exact = lm.pad_states or 2 * lm.n <= EXTENDED_MAX_SIZE  # listed in extended precision
-        if (code == STABLE and not listed < 0) or (code == UNSTABLE and not listed > 0):
-            if not (exact and abs(listed) <= bound):
-                # the listed eigenvalues and the route disagree beyond the listed one's bound: neither is certain
-                status, mr = "undecided", listed
-            # else: a point on the boundary to rounding, the float matrices' eigenvalue within its bound of 0;
-            # the verdict (and its max Re) of the exact route on the parameters stands
-        elif exact:
-            mr = listed  # the verdict line names the largest real part of the listed eigenvalues
-        return Verdict(status, mr, bound, mr / abs(self.eigenvalues[i]))
+        bound = route_bound
+        if modes == "all":
+            if (code == STABLE and not listed < 0) or (code == UNSTABLE and not listed > 0):
+                if not (exact and abs(listed) <= listed_bound):
+                    # the listed eigenvalues and the route disagree beyond the listed one's bound: neither is certain
+                    status, mr, bound = "undecided", listed, listed_bound
+                # else: a point on the boundary to rounding, the float matrices' eigenvalue within its bound of
+                # 0; the verdict (and its max Re) of the exact route on the parameters stands
+            elif exact:
+                mr, freq = listed, float(abs(self.eigenvalues[i].imag) / (2 * math.pi))
+                bound = listed_bound  # the listed eigenvalue's own bound
+        if status != "undecided" and not (math.isfinite(bound) and bound < abs(mr)):
+            bound = math.nan  # certified otherwise (the route): no bound larger than the margin is reported
+        lam = self.eigenvalues[i] if modes == "all" else complex(mr, 2 * math.pi * freq)
+        margin = mr / abs(lam) if abs(lam) > 0 else math.nan
+        pad_damping = disk = None
+        if carrier is not None and carrier.endswith("tangential rate") and modes == "all":
+            pad_damping = self._pad_damping(carrier)
+            disk = self.verdict(safety, modes="disk")
+        return Verdict(status, mr, bound, margin, carrier, method, freq, pad_damping, disk)
+
+    def _pad_damping(self, carrier: str) -> float | None:
+        """The effective tangential damping ``G_dL`` [N s/m] of the pad named in a carrier label."""
+        lm = self.model
+        pad = carrier.removeprefix("pad ").removesuffix(" tangential rate")
+        names = [p.name for p in lm.model.pads]
+        if pad not in names or lm.G_dL is None or lm.G_L is None:
+            return None
+        from ..model.components import state_name
+
+        state = state_name("l", pad)
+        if state not in lm.pad_states:
+            return None
+        j = list(lm.pad_states).index(state)
+        spec_pad = lm.model.pads[names.index(pad)]
+        k_ip = lm.params[spec_pad.k_ip] if isinstance(spec_pad.k_ip, str) else float(spec_pad.k_ip)
+        g_l = float(lm.G_L[j, j])
+        if g_l == 0 or not math.isfinite(k_ip):
+            return None
+        # the pad's own balance G_L l + G_dL ldot + ... = 0 has the time constant G_dL / G_L; times the pad's
+        # tangential stiffness it is the damping of a spring-damper with that time constant [N s/m]
+        return float(lm.G_dL[j, j]) / g_l * float(k_ip)
 
     # -------------------------------------------------------------- sensitivities
     def entry_sensitivities(self) -> dict[str, np.ndarray]:
@@ -187,8 +248,8 @@ class EigenAnalysis:
                     continue
                 hp, hm = v * math.exp(rel_step), v * math.exp(-rel_step)
                 try:
-                    lp = linearize(p0.replace(**{name: hp}), pad_rates=rates)
-                    lm = linearize(p0.replace(**{name: hm}), pad_rates=rates)
+                    lp = linearize(self.model.engine, p0.replace(**{name: hp}), pad_rates=rates)
+                    lm = linearize(self.model.engine, p0.replace(**{name: hm}), pad_rates=rates)
                 except BrakesquealError:
                     out[name] = (z, z, z)
                     continue
@@ -219,8 +280,8 @@ class EigenAnalysis:
                 out[name] = np.zeros(lam0.size, dtype=complex)
                 continue
             try:
-                lp = linearize(p0.replace(**{name: v * math.exp(rel_step)})).eigenvalues
-                lm = linearize(p0.replace(**{name: v * math.exp(-rel_step)})).eigenvalues
+                lp = linearize(self.model.engine, p0.replace(**{name: v * math.exp(rel_step)})).eigenvalues
+                lm = linearize(self.model.engine, p0.replace(**{name: v * math.exp(-rel_step)})).eigenvalues
             except BrakesquealError:
                 out[name] = np.zeros(lam0.size, dtype=complex)
                 continue
@@ -293,7 +354,7 @@ def _eig_left_right(A: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return w, vl, vr
 
 
-def eigen_analysis(model: Any) -> EigenAnalysis:
+def eigen_analysis(model: Any, engine: Any = None) -> EigenAnalysis:
     """Eigen-analysis of a linear model (or of ``linearize(params)``), for any model.
 
     The eigenvalues are those of the first-order state matrix of eq. (47)
@@ -306,6 +367,8 @@ def eigen_analysis(model: Any) -> EigenAnalysis:
     model : LinearModel or Parameters
         A linear model (eq. 48), or a parameter set that is first linearized
         about its silent motion with :func:`~brakesqueal.analysis.linear.linearize`.
+    engine : Engine, optional
+        The model's engine (needed for a parameter set).
 
     Returns
     -------
@@ -321,7 +384,12 @@ def eigen_analysis(model: Any) -> EigenAnalysis:
     SilentMotionError
         If ``model`` is a parameter set without a usable silent motion.
     """
-    lm = model if isinstance(model, LinearModel) else linearize(model)
+    if isinstance(model, LinearModel):
+        lm = model
+    else:
+        if engine is None:
+            raise TypeError("eigen_analysis of a parameter set needs its model's engine")
+        lm = linearize(engine, model)
     A = lm.A
     w, vl, vr = _eig_left_right(A)
     order = np.lexsort((-w.imag, -w.real))

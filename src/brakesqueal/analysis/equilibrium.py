@@ -25,29 +25,64 @@ generalized) and ``G`` (eqs. 33-34) are ``n + m`` equations
   at the silent motion (:class:`~brakesqueal.errors.ContactLossError`,
   :class:`~brakesqueal.errors.NoSlidingError`).
 * **Many points** (:func:`silent_motions`): the Newton stage runs compiled
-  for all points in one loop (:mod:`~.silent_batch`, the same iteration and
-  tests); every point it does not accept cleanly goes through
-  :func:`silent_motion_vector`, so statuses are those of the per-point route.
+  for all points in one loop (the engine's batched kernel,
+  :mod:`brakesqueal.codegen.silent`: the same iteration and tests); every
+  point it does not accept cleanly goes through :func:`silent_motion_vector`,
+  so statuses are those of the per-point route.  It hands a point over when
+  Newton from the trivial state does not converge cleanly, leaves the
+  kinematics' range or meets a singular or non-finite Jacobian, when a pad's
+  normal force or sliding speed at the solution is near its limit
+  (``F_n <= 1e-7 max(|F_n(0)|, |F_n|)``, the same for ``|v_r|``), and never
+  runs at a trivial silent motion (decided to rounding as above).  **Why the
+  Newton stage starts from the trivial state, not from a neighbour's
+  solution:** the silent motion of a point is the one connected to the
+  trivial state; a warm start from a neighbouring grid point converges to the
+  root that continues the neighbour's, a property of the grid, not of the
+  point (measured: the paper's model with ``general`` values, ``mu1 = 1.68``,
+  soft ``k_t``: for ``k_t`` below about 1.1e4 the homotopy folds, while
+  Newton warm-started along ``k_t`` converges to admissible tilts all the way
+  down to ``k_t = 1``; ``tests/analysis/test_silent_batch.py``).
+
+Triviality is decided in one place for every command: :func:`is_trivial` on
+the zero-state residuals (one point: :func:`silent_motion_vector`; many:
+:func:`trivial_rows`).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import ContactLossError, NoSilentMotionError, NoSlidingError, SolverFailedError
+from ..status import TRIVIAL_NOISE_FLOOR
+
+if TYPE_CHECKING:
+    from ..codegen.compiled import CompiledModel
+    from ..codegen.engine import Engine
 
 __all__ = ["SilentMotion", "SilentMotions", "silent_motion", "silent_motion_vector", "silent_motions",
-           "parameter_vector", "as_parameters", "is_trivial", "MAX_TILT"]
+           "parameter_vector", "as_parameters", "is_trivial", "trivial_rows", "zero_state_status", "MAX_TILT",
+           "HANDOVER", "COMPILE_MIN"]
 
 _EPS = np.finfo(float).eps
 #: A residual row is zero to rounding when ``|F_i| <= NOISE_FLOOR eps S_i`` (``S_i``: its terms' magnitude).
-NOISE_FLOOR = 64.0
+NOISE_FLOOR = TRIVIAL_NOISE_FLOOR
 #: Largest tilt angle [rad] for which the kinematics (eq. 42: 1/(cos q1 cos q2)) is used.
 MAX_TILT = 1.2
+#: Reasons a point is handed to the per-point solver (codes of :attr:`SilentMotions.handover`).
+HANDOVER = {
+    0: "accepted by the compiled Newton stage",
+    1: "Newton from the trivial state did not converge cleanly (per-point globalised solver)",
+    2: "a pad's normal force or sliding speed near its limit (per-point solver decides)",
+    3: "non-finite residuals or Jacobian (per-point solver decides)",
+    4: "trivial silent motion (decided to rounding, no Newton)",
+}
+#: Fewest points for which the batched route compiles its kernel (numba, seconds on first use per model) when its
+#: machine code is not at hand; fewer points go through the per-point solver (~1 ms each).
+COMPILE_MIN = 2000
 
 
 def as_parameters(params: Any) -> Any:
@@ -184,7 +219,7 @@ def _newton(sysm: _System, y: np.ndarray, g: np.ndarray, max_iter: int = 30,
     converged result is then the root Newton's contraction region around the
     start leads to).
 
-    The compiled batch (:mod:`~.silent_batch`) runs the same iteration.
+    The compiled batch (:mod:`brakesqueal.codegen.silent`) runs the same iteration.
     """
     last = math.inf
     floor = False
@@ -300,18 +335,15 @@ def _continuation(sysm: _System, F0s: np.ndarray, tol: np.ndarray | None = None)
         h = min(h_max, h * 1.6)
 
 
-def silent_motion(params: Any, *, model: Any = None, use_cache: bool = True) -> SilentMotion:
+def silent_motion(engine: Engine, params: Any) -> SilentMotion:
     """Find the silent motion of eq. (46) and check that every pad touches and slides.
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine (:func:`brakesqueal.codegen.build`).
     params : Parameters
-        The model and its parameter values.
-    model : CompiledModel, optional
-        The compiled model (default: :func:`~brakesqueal.codegen.compile_model`
-        of ``params.model``).
-    use_cache : bool, optional
-        Use the on-disk code cache when compiling (default ``True``).
+        The model's parameter values.
 
     Returns
     -------
@@ -332,15 +364,11 @@ def silent_motion(params: Any, *, model: Any = None, use_cache: bool = True) -> 
     Assumes, as the paper does, that every pad slides in the direction of the
     disk's spin (``Omega > 0``) and stays in contact; both are checked.
     """
-    from ..codegen import CompiledModel, compile_model
-
     params = as_parameters(params)
-    model = getattr(model, "model", model)  # the transitional paper view wraps the compiled model
-    cm = model if isinstance(model, CompiledModel) else compile_model(params.model, use_cache=use_cache)
-    return silent_motion_vector(cm, list(map(float, params.vector())))
+    return silent_motion_vector(engine.compiled, list(map(float, params.vector())))
 
 
-def silent_motion_vector(model: Any, p: list[float]) -> SilentMotion:
+def silent_motion_vector(model: CompiledModel, p: list[float]) -> SilentMotion:
     """The per-point solver of :func:`silent_motion` on a packed parameter vector.
 
     Parameters
@@ -413,7 +441,7 @@ class SilentMotions:
     trivial : ndarray of bool, shape (N,)
         Trivial silent motion (``q0 = 0`` exactly).
     handover : ndarray of int8, shape (N,)
-        Why a point went to the per-point solver (:data:`~.silent_batch.HANDOVER`; 0: it did not).
+        Why a point went to the per-point solver (:data:`HANDOVER`; 0: it did not).
     iterations : ndarray of int, shape (N,)
         Newton iterations of the compiled stage.
     """
@@ -431,8 +459,22 @@ class SilentMotions:
         return np.concatenate([self.q0, self.l0], axis=1)
 
 
-def _trivial_rows(cm: Any, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rows whose zero-state residuals vanish to rounding (the criterion of ``silent_motion``), and ``S`` (N, n + m)."""
+def trivial_rows(cm: CompiledModel, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows whose zero-state residuals vanish to rounding (:func:`is_trivial`, the criterion of
+    :func:`silent_motion_vector`), and the residuals' term magnitudes ``S`` (N, n + m).
+
+    Parameters
+    ----------
+    cm : CompiledModel
+        The compiled model.
+    P : ndarray, shape (N, n_params)
+        Packed parameter vectors.
+
+    Returns
+    -------
+    trivial : ndarray of bool, shape (N,)
+    S : ndarray, shape (N, n + m)
+    """
     N = P.shape[0]
     cols = [np.ascontiguousarray(P[:, k]) for k in range(P.shape[1])]
     with np.errstate(all="ignore"):
@@ -442,13 +484,13 @@ def _trivial_rows(cm: Any, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(is_trivial(F, S), dtype=bool) & np.all(np.isfinite(F), axis=0), np.ascontiguousarray(S.T)
 
 
-def silent_motions(model: Any, P: Any, *, use_cache: bool = True, compiled: bool = True) -> SilentMotions:
+def silent_motions(engine: Engine, P: Any, *, use_cache: bool = True, compiled: bool = True) -> SilentMotions:
     """Silent motions of many points: compiled Newton stage, the per-point solver wherever it is not clean.
 
     Parameters
     ----------
-    model : ModelSpec or CompiledModel
-        The model.
+    engine : Engine
+        The model's engine.
     P : array_like, shape (N, n_params)
         Packed parameter vectors (:meth:`Parameters.vector
         <brakesqueal.model.parameters.Parameters.vector>`, one row per point;
@@ -456,7 +498,7 @@ def silent_motions(model: Any, P: Any, *, use_cache: bool = True, compiled: bool
         <brakesqueal.model.parameters.ParameterSpace.vectors>` stacked).
         Assumed valid.
     use_cache : bool, optional
-        Use the on-disk code cache (default ``True``).
+        Use the on-disk code cache for the compiled kernel (default ``True``).
     compiled : bool, optional
         ``False`` skips the compiled stage: every non-trivial point goes
         through :func:`silent_motion_vector` (the reference the tests
@@ -466,13 +508,11 @@ def silent_motions(model: Any, P: Any, *, use_cache: bool = True, compiled: bool
     -------
     SilentMotions
         Equal in status to :func:`silent_motion` at every point and in value
-        to rounding (see :mod:`~.silent_batch`).
+        to rounding.
     """
-    from ..codegen import CompiledModel, compile_model
     from ..status import PointStatus, status_of_error
-    from .silent_batch import load_kernel, mark_ready
 
-    cm = model if isinstance(model, CompiledModel) else compile_model(model, use_cache=use_cache)
+    cm = engine.compiled
     P = np.ascontiguousarray(np.atleast_2d(np.asarray(P, dtype=float)))
     N = P.shape[0]
     n, m, npad = cm.n, cm.m, len(cm.spec.pads)
@@ -481,12 +521,12 @@ def silent_motions(model: Any, P: Any, *, use_cache: bool = True, compiled: bool
     code = np.ones(N, dtype=np.int8)
     iters = np.zeros(N, dtype=np.int64)
     status = np.full(N, int(PointStatus.OK_NONTRIVIAL), dtype=np.int8)
-    triv, S = _trivial_rows(cm, P) if N else (np.zeros(0, dtype=bool), np.zeros((0, K)))
+    triv, S = trivial_rows(cm, P) if N else (np.zeros(0, dtype=bool), np.zeros((0, K)))
     code[triv] = 4
     Z[triv] = 0.0
     rest = np.flatnonzero(~triv)
     if compiled and rest.size:
-        kern = load_kernel(cm.spec, use_cache=use_cache)
+        kern = engine.silent_kernel(use_cache)
         sub = np.ascontiguousarray(P[rest])
         Zs = np.full((rest.size, K), np.nan)
         cs = np.ones(rest.size, dtype=np.int8)
@@ -496,12 +536,12 @@ def silent_motions(model: Any, P: Any, *, use_cache: bool = True, compiled: bool
         with np.errstate(all="ignore"):
             kern.newton_batch(sub, np.ascontiguousarray(np.abs(S[rest])), NOISE_FLOOR, MAX_TILT, 12, Zs, cs, its,
                               fn, sp)
-        mark_ready(cm.spec, use_cache)
+        engine.mark_silent_ready(use_cache)
         Z[rest], code[rest], iters[rest] = Zs, cs, its
     # the trivial points: contact and sliding at the zero state decide (vectorized, as silent_motion does)
     t = np.flatnonzero(triv)
     if t.size:
-        st = _zero_state_status(cm, P[t])
+        st = zero_state_status(cm, P[t])
         status[t] = st
         Z[t[st != int(PointStatus.OK)]] = np.nan
     for i in np.flatnonzero((code != 0) & (code != 4)):
@@ -519,8 +559,9 @@ def silent_motions(model: Any, P: Any, *, use_cache: bool = True, compiled: bool
                          handover=handover, iterations=iters)
 
 
-def _zero_state_status(cm: Any, P: np.ndarray) -> np.ndarray:
-    """``OK``, ``CONTACT_LOSS`` or ``NO_SLIDING`` of trivial silent motions (contact at the zero state)."""
+def zero_state_status(cm: CompiledModel, P: np.ndarray) -> np.ndarray:
+    """``OK``, ``CONTACT_LOSS`` or ``NO_SLIDING`` of trivial silent motions (contact at the zero state), per row
+    of the packed parameter matrix ``P`` (int8 :class:`~brakesqueal.status.PointStatus` codes)."""
     from ..codegen.compiled import CONTACT_FIELDS
     from ..status import PointStatus
 

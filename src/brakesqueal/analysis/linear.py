@@ -25,11 +25,15 @@ approximation of earlier versions; exact only in the first case).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .equilibrium import SilentMotion, as_parameters, parameter_vector, silent_motion
+
+if TYPE_CHECKING:
+    from ..codegen.compiled import CompiledModel
+    from ..codegen.engine import Engine
 
 __all__ = ["ModalMixin", "LinearModel", "linearize", "state_matrix", "jacobian_blocks_at", "pad_rate_eigenvalues",
            "PAD_RATES", "accurate_jacobian", "eliminate_algebraic", "descriptor_eigenvalues"]
@@ -277,6 +281,9 @@ class LinearModel(ModalMixin):
         Linearized tangential balance of the kept pads.
     pad_rates : str
         ``"kept"`` or ``"quasi-static"``.
+    engine : Engine or None
+        The engine it was computed with (``None`` for a model built by hand); sensitivities linearize again
+        with it.
     """
 
     params: Any
@@ -293,6 +300,7 @@ class LinearModel(ModalMixin):
     G_L: np.ndarray | None = None
     G_dL: np.ndarray | None = None
     pad_rates: str = "kept"
+    engine: Any = field(default=None, repr=False, compare=False)
     _eig: list[Any] = field(default_factory=list, repr=False, compare=False)
 
     # ---------------------------------------------------------------- structure
@@ -404,7 +412,7 @@ _MP_NAMESPACES: dict[str, dict[str, Any]] = {}
 JACOBIAN_AGREEMENT = 1e-15
 
 
-def accurate_jacobian(cm: Any, x: Any, p: Any) -> np.ndarray:
+def accurate_jacobian(cm: CompiledModel, x: Any, p: Any) -> np.ndarray:
     """``d(R, G)/dx`` at ``x`` with every entry correct to rounding, as an ``(n + m, 3n + 2m)`` array.
 
     At a tilted silent motion several entries are differences of terms that
@@ -447,7 +455,7 @@ def accurate_jacobian(cm: Any, x: Any, p: Any) -> np.ndarray:
     raise FloatingPointError("the Jacobian at the silent motion could not be evaluated accurately")
 
 
-def _blocks(cm: Any, x: list[float] | None, p: list[float]) -> dict[str, np.ndarray]:
+def _blocks(cm: CompiledModel, x: list[float] | None, p: list[float]) -> dict[str, np.ndarray]:
     """Jacobian blocks at ``x`` (``None``: the zero state, with its structural zeros exact; otherwise
     :func:`accurate_jacobian`)."""
     n, m = cm.n, cm.m
@@ -461,15 +469,12 @@ def _blocks(cm: Any, x: list[float] | None, p: list[float]) -> dict[str, np.ndar
     return out
 
 
-def jacobian_blocks_at(model: Any, x: list[float], p: list[float]) -> dict[str, np.ndarray]:
+def jacobian_blocks_at(cm: CompiledModel, x: list[float], p: list[float]) -> dict[str, np.ndarray]:
     """Exact Jacobian blocks at state ``x``: keys ``R_Q, R_dQ, R_ddQ, R_L, R_dL, G_Q, ..., G_dL``.
 
     For the paper's model the old keys ``psi_q, psi_dq, psi_ddq, psi_l, psi_dl, g_q, ...`` are
     also present (``psi`` = ``R``, ``g`` = ``G``).
     """
-    from ..codegen import CompiledModel, compile_model
-
-    cm = model if isinstance(model, CompiledModel) else compile_model("paper")
     b = _blocks(cm, x, p)
     for res, old in (("R", "psi"), ("G", "g")):
         for k, o in (("Q", "q"), ("dQ", "dq"), ("ddQ", "ddq"), ("L", "l"), ("dL", "dl")):
@@ -477,22 +482,20 @@ def jacobian_blocks_at(model: Any, x: list[float], p: list[float]) -> dict[str, 
     return b
 
 
-def linearize(params: Any, *, model: Any = None, pad_rates: str = "kept", use_cache: bool = True) -> LinearModel:
+def linearize(engine: Engine, params: Any, *, pad_rates: str = "kept") -> LinearModel:
     """Find the silent motion and linearize about it (eqs. 46-48), for any model.
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine (:func:`brakesqueal.codegen.build`).
     params : Parameters
-        The model and its parameter values.
-    model : CompiledModel, optional
-        Compiled model (default: :func:`~brakesqueal.codegen.compile_model`).
+        The model's parameter values.
     pad_rates : {"kept", "quasi-static"}
         How the massless pads' tangential rates enter (module docstring).
         ``"kept"`` (default) is exact for the model; ``"quasi-static"`` sets
         ``ldot := 0`` (exact only for rate-independent friction at the trivial
         silent motion).
-    use_cache : bool, optional
-        Use the on-disk code cache (default ``True``).
 
     Returns
     -------
@@ -510,21 +513,19 @@ def linearize(params: Any, *, model: Any = None, pad_rates: str = "kept", use_ca
     -----
     Assumes sliding contact at every pad at the silent motion (checked).
     """
-    from ..codegen import CompiledModel, compile_model
     from ..errors import ParameterError
 
     if pad_rates not in PAD_RATES:
         raise ParameterError(f"pad_rates must be one of {', '.join(PAD_RATES)}; got {pad_rates!r}")
     params = as_parameters(params)
-    model = getattr(model, "model", model)  # the transitional paper view wraps the compiled model
-    cm = model if isinstance(model, CompiledModel) else compile_model(params.model, use_cache=use_cache)
-    sm = silent_motion(params, model=cm)
+    cm = engine.compiled
+    sm = silent_motion(engine, params)
     p = parameter_vector(params)
     b = _blocks(cm, None if sm.trivial else sm.state(), p)
     m = cm.m
     M, D, K = b["R_ddQ"].copy(), b["R_dQ"].copy(), b["R_Q"].copy()
     if m == 0:
-        return LinearModel(params=params, silent=sm, M=M, D=D, K=K, pad_rates=pad_rates)
+        return LinearModel(params=params, silent=sm, engine=engine, M=M, D=D, K=K, pad_rates=pad_rates)
     if pad_rates == "quasi-static":
         dyn = np.zeros(m, dtype=bool)
     else:
@@ -546,30 +547,30 @@ def linearize(params: Any, *, model: Any = None, pad_rates: str = "kept", use_ca
             G_dQd = G_dQ[dyn] - Pd @ G_dQ[qs]
             G_ddQd = G_ddQ[dyn] - Pd @ G_ddQ[qs]
             G_Ld = G_L[np.ix_(dyn, dyn)] - Pd @ G_L[np.ix_(qs, dyn)]
-            return LinearModel(params=params, silent=sm, M=M, D=D, K=K,
+            return LinearModel(params=params, silent=sm, engine=engine, M=M, D=D, K=K,
                                pad_states=tuple(np.array(cm.algebraic)[dyn]), R_L=R_L, R_dL=R_dL[:, dyn],
                                G_Q=G_Qd, G_dQ=G_dQd, G_ddQ=G_ddQd, G_L=G_Ld, G_dL=G_dL[np.ix_(dyn, dyn)],
                                pad_rates=pad_rates)
-        return LinearModel(params=params, silent=sm, M=M, D=D, K=K, pad_rates=pad_rates)
-    return LinearModel(params=params, silent=sm, M=M, D=D, K=K, pad_states=tuple(cm.algebraic), R_L=R_L,
+        return LinearModel(params=params, silent=sm, engine=engine, M=M, D=D, K=K, pad_rates=pad_rates)
+    return LinearModel(params=params, silent=sm, engine=engine, M=M, D=D, K=K, pad_states=tuple(cm.algebraic), R_L=R_L,
                        R_dL=R_dL, G_Q=G_Q, G_dQ=G_dQ, G_ddQ=G_ddQ, G_L=G_L, G_dL=G_dL, pad_rates=pad_rates)
 
 
-def pad_rate_eigenvalues(params: Any, *, model: Any = None) -> np.ndarray:
+def pad_rate_eigenvalues(engine: Engine, params: Any) -> np.ndarray:
     """Finite eigenvalues with the pads' tangential rates kept (the default :func:`linearize`).
 
-    Kept for compatibility: equals ``linearize(params).eigenvalues``.
+    Kept for compatibility: equals ``linearize(engine, params).eigenvalues``.
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine.
     params : Parameters
-        The model and its parameter values.
-    model : CompiledModel, optional
-        Compiled model (default: compiled on demand).
+        The model's parameter values.
 
     Returns
     -------
     ndarray of complex
         The finite eigenvalues [1/s], sorted by decreasing real part.
     """
-    return linearize(params, model=model, pad_rates="kept").eigenvalues
+    return linearize(engine, params, pad_rates="kept").eigenvalues

@@ -1,21 +1,13 @@
 """Stability maps over two settable parameters of any model (chunked, bounded memory).
 
-The route is chosen by what the model allows (:mod:`.points`) and recorded in
-the map's ``method``:
-
-* **closed form** — models with two coordinates and rate-free pads whose
-  silent motion is identically trivial on the map (every zero-state residual
-  vanishes under the space's ties, e.g. ``mu1 h10 = mu2 h20`` for the paper's
-  model, eq. 49): the certified compiled Hurwitz kernel of :mod:`.kernels`
-  generated from the model's closed form (stable / unstable / uncertain per
-  point, rigorous floating-point error bounds); uncertain points, and
-  ``max_real`` / ``frequency``, come from the per-point closed-form route
-  :func:`~.robust.trivial_verdicts` (bounded entries → interval quartic →
-  certified Routh → exact rational evaluation), reconciled with the verdict;
-* **per point** — every other model or map: :func:`~.points.evaluate_arrays`
-  (trivial silent motions batched at the zero state with certified
-  eigenvalue verdicts, non-trivial ones linearized point by point with the
-  pads' states kept).
+Every block of the grid is decided by the one verdict dispatcher
+(:func:`~.verdict.decide`, the grid's points as a :class:`~.verdict.Grid`),
+so the grid routes apply where they can (the compiled Hurwitz kernel of a
+closed form, the exact characteristic polynomial of larger models) and every
+point they leave goes on to the per-point routes; the map's ``method`` lists
+the routes in the order they are tried, its ``route`` variable says which
+decided each point, and its ``carrier`` variable which mode carries each
+verdict.
 
 Points where the silent motion does not exist, a pad loses contact or does not
 slide, the parameters are invalid or the verdict cannot be decided are flagged
@@ -37,18 +29,17 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import ParameterError
 from ..status import PointStatus
-from .robust import STABLE, UNDECIDED, UNSTABLE
-from .kernels import (
-    CHARPOLY_ROUTE, CharpolyTable, charpoly_point_verdicts, charpoly_table, charpoly_verdicts, kernel_eigen,
-    kernel_scaling, kernel_segments, map_kernel,
-)
-from .points import ROUTES, Points, closed_form_route, evaluate_arrays, valid_points
+from .verdict import ROUTES, Points, Verdicts, decide
+
+if TYPE_CHECKING:
+    from ..codegen.engine import Engine
+    from ..model.parameters import ParameterSpace
 
 __all__ = ["Axis", "parse_axis", "resolution_problem", "stability_map", "write_map", "MapSummary", "classify_grid",
            "STATUS", "MAX_POINTS", "MAX_MAP_BYTES", "map_bytes"]
@@ -258,9 +249,9 @@ def map_bytes(points: int, eigen: bool) -> int:
     return 2 * per * points + 2**28
 
 
-def _check_axes(space: object, axes: list[Axis], force: bool, eigen: bool, in_memory: bool = True) -> None:
+def _check_axes(space: ParameterSpace, axes: list[Axis], force: bool, eigen: bool, in_memory: bool = True) -> None:
     for ax in axes:
-        space.check_axis(ax.name)  # type: ignore[attr-defined]
+        space.check_axis(ax.name)
     if len(axes) == 2 and axes[0].name == axes[1].name:
         raise ParameterError(f"both axes vary '{axes[0].name}'; choose two different parameters")
     n = math.prod(ax.num for ax in axes)
@@ -285,11 +276,13 @@ def _check_axes(space: object, axes: list[Axis], force: bool, eigen: bool, in_me
                              "points, write_map (the map command, bounded memory) or a sweep (brakesqueal sweep)")
 
 
-def classify_grid(space: object, x: Axis, y: Axis) -> tuple[np.ndarray, str, str]:
+def classify_grid(engine: Engine, space: ParameterSpace, x: Axis, y: Axis) -> tuple[np.ndarray, str, str]:
     """Only the certified kernel's codes on the full grid (benchmarks, large maps).
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine.
     space : ParameterSpace
         The parameter space.
     x, y : Axis
@@ -306,7 +299,7 @@ def classify_grid(space: object, x: Axis, y: Axis) -> tuple[np.ndarray, str, str
     ParameterError
         If no compiled kernel applies (the closed-form route does not).
     """
-    kern = map_kernel(space, x.name, y.name)  # type: ignore[arg-type]
+    kern = engine.map_kernel(space, x.name, y.name)
     if kern is None:
         raise ParameterError("no compiled kernel for this map (no closed form for the model, a non-trivial silent "
                              "motion or non-rational dependence)")
@@ -317,64 +310,34 @@ def classify_grid(space: object, x: Axis, y: Axis) -> tuple[np.ndarray, str, str
 
 @dataclass(frozen=True)
 class _Plan:
-    """How a map is computed: the kernel (if any), the axes in dimension order, the route's name."""
+    """How a map is computed: the engine, the axes in dimension order, the routes tried, the float type."""
 
-    kern: object
+    engine: Engine
     outer: Axis
     inner: Axis
-    scaled: int | None  # the kernel's inner-axis exponent (kernel_scaling), None: the kernel does not apply
-    closed: bool
     method: str
     ftype: type
-    charpoly: CharpolyTable | None = None
 
 
-def _plan(space: object, x: Axis, y: Axis, force: bool, eigen: bool, in_memory: bool = True) -> _Plan:
+def routes_text(closed: bool) -> str:
+    """The ``method`` of a map or study: the routes in the order the dispatcher tries them (ASCII, NetCDF3)."""
+    return "certified verdicts by the first route that decides (per point: variable 'route'): " + ", ".join(
+        r.name for r in ROUTES)
+
+
+def _plan(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, force: bool, eigen: bool,
+          in_memory: bool = True) -> _Plan:
     _check_axes(space, [x, y], force, eigen, in_memory)
-    space.resolve({})  # type: ignore[attr-defined]
-    closed = closed_form_route(space, (x.name, y.name))
-    kern = map_kernel(space, x.name, y.name) if closed else None  # type: ignore[arg-type]
+    space.resolve({})
+    closed = engine.closed_route(space, (x.name, y.name))
+    kern = engine.map_kernel(space, x.name, y.name) if closed else None
     ax = {x.name: x, y.name: y}
     outer, inner = (ax[kern.outer], ax[kern.inner]) if kern else (y, x)
-    scaled = _kernel_exponent(kern, inner.values_range, inner.num)
-    cp = None
-    if closed:
-        method = ("closed form: certified compiled Hurwitz kernel of the exact quartic + robust per-point route"
-                  if scaled is not None else ROUTES["closed"])
-    else:
-        # n-DOF models with a trivial silent motion on the whole map: roots of the exact characteristic polynomial
-        cp = charpoly_table(space, outer.name, inner.name)  # type: ignore[arg-type]
-        method = CHARPOLY_ROUTE if cp is not None else ROUTES["points"]
     ftype = np.float32 if outer.num * inner.num > _FLOAT32_ABOVE else np.float64
-    return _Plan(kern, outer, inner, scaled, closed, method, ftype, cp)
+    return _Plan(engine, outer, inner, routes_text(closed), ftype)
 
 
-def _kernel_exponent(kern: object, values: Callable[[int, int], np.ndarray], n: int, block: int = 1 << 20
-                     ) -> int | None:
-    """The exponent ``e`` of :func:`~.kernels.kernel_scaling` for an inner axis (``None``: the kernel does not apply).
-
-    ``values(i0, i1)`` gives the axis' values ``i0:i1`` of ``n``.  Same result
-    as ``kernel_scaling(kern, all values)[0]``, which depends only on whether
-    every value is finite and on the smallest nonzero and the largest
-    ``|value|``: these are found block by block and passed on, so a long axis
-    needs no array of its length (``t = values / 2^e`` is formed per block).
-    """
-    if kern is None:
-        return None
-    lo, hi, finite = math.inf, 0.0, True
-    for i in range(0, n, block):
-        a = np.abs(values(i, min(n, i + block)))
-        ok = np.isfinite(a)
-        finite = finite and bool(ok.all())
-        pos = a[ok & (a > 0)]
-        if pos.size:
-            lo, hi = min(lo, float(pos.min())), max(hi, float(pos.max()))
-    summary = np.array([lo, hi] if hi > 0 else [0.0]) if finite else np.array([np.nan])
-    scaled = kernel_scaling(kern, summary)  # type: ignore[arg-type]
-    return None if scaled is None else scaled[0]
-
-
-_Block = tuple[int, int, int, int, np.ndarray, np.ndarray, "np.ndarray | None", "np.ndarray | None"]
+_Block = tuple[int, int, int, int, Verdicts]
 
 
 def _blocks(n_o: int, n_i: int, points: int) -> Iterator[tuple[int, int, int, int]]:
@@ -391,103 +354,34 @@ def _blocks(n_o: int, n_i: int, points: int) -> Iterator[tuple[int, int, int, in
             yield r0, r0 + 1, c0, min(n_i, c0 + points)
 
 
-def _rows(space: object, plan: _Plan, eigen: bool, chunk_points: int) -> Iterator[_Block]:
-    """Yield ``(r0, r1, c0, c1, stable, status, max_real, frequency)`` for blocks of the grid (bounded memory).
+def _rows(space: ParameterSpace, plan: _Plan, eigen: bool, chunk_points: int, modes: str = "all"
+          ) -> Iterator[_Block]:
+    """Yield ``(r0, r1, c0, c1, verdicts)`` for blocks of the grid (bounded memory).
 
     A block is ``[r0:r1, c0:c1]`` of the ``(outer, inner)`` grid with at most
     ``chunk_points`` points: whole outer rows, or pieces of one row when a row
-    is longer.  With a kernel, the verdicts are its certified codes and, with ``eigen``,
-    ``max_real``/``frequency`` are the compiled roots of the same quartic
-    (:func:`~.kernels.kernel_eigen`); only points the kernel leaves uncertain,
-    whose roots were not found cleanly or whose ``max_real`` contradicts the
-    certified verdict go through :func:`~.points.evaluate_arrays` (robust
-    per-point route, exact arithmetic where needed).
+    is longer; each block is decided by :func:`~.verdict.decide` as a grid.
     """
-    kern, outer, inner = plan.kern, plan.outer, plan.inner
+    outer, inner = plan.outer, plan.inner
     n_o, n_i = outer.num, inner.num
-    # without a compiled kernel points may go one by one: smaller blocks, so progress is reported often
-    fast = kern is not None or plan.charpoly is not None
-    points = chunk_points if fast else min(chunk_points, 4096)
-    buf = np.empty((min(max(1, points // n_i), n_o), n_i), dtype=np.uint8) if n_i <= max(1, points) else None
-    iv_all = inner.values() if buf is not None else None  # whole rows: the inner values formed once
-    if plan.scaled is not None and iv_all is not None:  # and scaled and segmented once
-        t_all = np.ldexp(iv_all, -plan.scaled)
-        seg_all = kernel_segments(t_all)
-    for r0, r1, c0, c1 in _blocks(n_o, n_i, points):
+    iv_all = inner.values() if n_i <= max(1, chunk_points) else None  # whole rows: the inner values formed once
+    for r0, r1, c0, c1 in _blocks(n_o, n_i, chunk_points):
         # only this block's values: no array of an axis' length (a map may have very long axes)
         iv = iv_all if iv_all is not None else inner.values_range(c0, c1)
         ov = outer.values_range(r0, r1)
-        shape = (r1 - r0, c1 - c0)
-        arr = space.arrays({outer.name: ov[:, None], inner.name: iv[None, :]})  # type: ignore[attr-defined]
-        valid = np.broadcast_to(valid_points(space, arr), shape)
-        if plan.charpoly is not None:
-            yield (r0, r1, c0, c1, *_charpoly_rows(space, plan, ov, iv, valid, eigen))
-            continue
-        if kern is None or plan.scaled is None:
-            res = evaluate_arrays(space, arr, eigen=eigen, closed=plan.closed, valid=valid)
-            yield (r0, r1, c0, c1, res.stable, res.status, (res.max_real if eigen else None),
-                   (res.frequency if eigen else None))
-            continue
-        codes = buf[: r1 - r0] if buf is not None else np.empty(shape, dtype=np.uint8)
-        t = t_all if buf is not None else np.ldexp(iv, -plan.scaled)
-        seg, seg_T = seg_all if buf is not None else kernel_segments(t)
-        C, EC, lam_e = kern.row_tables(ov, plan.scaled)  # type: ignore[attr-defined]
-        kern.classify(C, EC, t, seg, seg_T, codes)  # type: ignore[attr-defined]
-        mr = fr = None
-        if eigen:
-            mr, fr, found = kernel_eigen(kern, C, t, lam_e)  # type: ignore[arg-type]
-            good = valid & found.view(bool) & (((codes == STABLE) & (mr < 0)) | ((codes == UNSTABLE) & (mr >= 0)))
-            mr[~valid] = np.nan
-            fr[~valid] = np.nan
-        else:
-            good = valid & (codes != UNDECIDED)
-        stable = good & (codes == STABLE)
-        status = np.where(valid, np.int8(PointStatus.OK), np.int8(PointStatus.INVALID))
-        redo = np.nonzero(valid & ~good)
-        if redo[0].size:
-            sub = space.arrays({outer.name: ov[redo[0]], inner.name: iv[redo[1]]})  # type: ignore[attr-defined]
-            res = evaluate_arrays(space, sub, eigen=eigen, codes=codes[redo], closed=True,
-                                  valid=np.ones(redo[0].size, dtype=bool))
-            stable[redo] = res.stable
-            status[redo] = res.status
-            if mr is not None and fr is not None:
-                mr[redo] = res.max_real
-                fr[redo] = res.frequency
-        yield r0, r1, c0, c1, stable, status, mr, fr
+        pts = Points.of(space, {outer.name: ov, inner.name: iv}, grid=True)
+        yield r0, r1, c0, c1, decide(plan.engine, space, pts, eigen=eigen, modes=modes)
 
 
-def _charpoly_rows(space: object, plan: _Plan, ov: np.ndarray, iv: np.ndarray, valid: np.ndarray, eigen: bool
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
-    """``(stable, status, max_real, frequency)`` of a block of rows by the characteristic-polynomial route.
-
-    Points whose inclusion disks do not decide (or, with ``eigen``, do not
-    give every root to :data:`~.kernels.CHARPOLY_ACCURACY`) go through
-    :func:`~.points.evaluate_arrays` (certified eigenvalue verdicts).
-    """
-    assert plan.charpoly is not None
-    codes, mr, fr = charpoly_verdicts(plan.charpoly, ov, iv, valid, eigen=eigen)
-    stable = valid & (codes == STABLE)
-    status = np.where(valid, np.int8(PointStatus.OK), np.int8(PointStatus.INVALID))
-    redo = np.nonzero(valid & (codes == UNDECIDED))
-    if redo[0].size:
-        sub = space.arrays({plan.outer.name: ov[redo[0]], plan.inner.name: iv[redo[1]]})  # type: ignore[attr-defined]
-        res = evaluate_arrays(space, sub, eigen=eigen, valid=np.ones(redo[0].size, dtype=bool))
-        stable[redo] = res.stable
-        status[redo] = res.status
-        mr[redo] = res.max_real
-        fr[redo] = res.frequency
-    if not eigen:
-        return stable, status, None, None
-    return stable, status, mr, fr
-
-
-def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen: bool = True,
-                  chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None,
-                  boundary: bool = True) -> object:
+def stability_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, *, force: bool = False,
+                  eigen: bool = True, chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None,
+                  boundary: bool = True, modes: str = "all") -> Any:
     """Compute a stability map over two settable parameters of ``space``.
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine.
     space : ParameterSpace
         The model, preset and overrides (:func:`brakesqueal.model.resolve_space`);
         tied names follow the axes.
@@ -510,6 +404,9 @@ def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen
         bisection (:func:`~.boundary.stability_boundary`; stored as
         ``boundary_<name>`` variables; only for maps of at most
         :data:`BOUNDARY_MAX_POINTS` points, to :data:`BOUNDARY_ITERATIONS` bisection steps).
+    modes : {"all", "disk"}
+        Judge every eigenvalue (default), or leave out the modes carried by a massless pad's own tangential
+        rate (:func:`~.verdict.decide`).
 
     Returns
     -------
@@ -518,7 +415,8 @@ def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen
         certified, ``status`` holds :class:`~brakesqueal.status.PointStatus`
         codes (``UNDECIDED`` marks points whose verdict could not be decided,
         e.g. exactly on a stability boundary); for ``OK``/``OK_NONTRIVIAL``
-        points ``stable`` ⇔ ``max_real < 0``.  ``method`` names the route.
+        points ``stable`` ⇔ ``max_real < 0``.  ``method`` names the routes,
+        ``route`` and ``carrier`` say per point which decided and which mode carries the verdict.
 
     Raises
     ------
@@ -528,57 +426,46 @@ def stability_map(space: object, x: Axis, y: Axis, *, force: bool = False, eigen
     """
     from ..results import StabilityMap
 
-    plan = _plan(space, x, y, force, eigen)
+    plan = _plan(engine, space, x, y, force, eigen)
     n_o, n_i = plan.outer.num, plan.inner.num
     stable = np.zeros((n_o, n_i), dtype=bool)
     status = np.zeros((n_o, n_i), dtype=np.int8)
+    carrier = np.full((n_o, n_i), -1, dtype=np.int8)
+    route = np.zeros((n_o, n_i), dtype=np.int8)
     max_real = np.full((n_o, n_i), np.nan, dtype=plan.ftype) if eigen else None
     freq = np.full((n_o, n_i), np.nan, dtype=plan.ftype) if eigen else None
-    for r0, r1, c0, c1, st, ss, mr, fr in _rows(space, plan, eigen, chunk_points):
-        stable[r0:r1, c0:c1] = st
-        status[r0:r1, c0:c1] = ss
+    labels: tuple[tuple[str, ...], tuple[str, ...]] = ((), ())
+    for r0, r1, c0, c1, v in _rows(space, plan, eigen, chunk_points, modes):
+        stable[r0:r1, c0:c1] = v.stable
+        status[r0:r1, c0:c1] = v.status
+        carrier[r0:r1, c0:c1] = v.carrier
+        route[r0:r1, c0:c1] = v.method
+        labels = (v.carriers, v.methods)
         if max_real is not None and freq is not None:
-            max_real[r0:r1, c0:c1] = mr
-            freq[r0:r1, c0:c1] = fr
+            max_real[r0:r1, c0:c1] = v.max_real
+            freq[r0:r1, c0:c1] = v.frequency
         if progress is not None:
             progress(((r1 - 1) * n_i + c1) / (n_o * n_i))
-    b = _boundary(space, plan, stable, status) if boundary else None
+    b = _boundary(space, plan, stable, status, modes) if boundary else None
     return StabilityMap.from_arrays(space, plan.outer, plan.inner, stable=stable, status=status, max_real=max_real,
-                                    frequency=freq, method=plan.method, boundary=b)
+                                    frequency=freq, method=plan.method, boundary=b, carrier=carrier,
+                                    carriers=labels[0], route=route, routes=labels[1])
 
 
-def _boundary(space: object, plan: _Plan, stable: np.ndarray, status: np.ndarray) -> Any:
+def _boundary(space: ParameterSpace, plan: _Plan, stable: np.ndarray, status: np.ndarray, modes: str = "all"
+              ) -> Any:
     """The refined stability boundary of a map (``None`` above :data:`BOUNDARY_MAX_POINTS` points)."""
     from .boundary import stability_boundary
+    from .points import evaluate
 
     if plan.outer.num * plan.inner.num > BOUNDARY_MAX_POINTS:
         return None
-    ev = None
-    if plan.charpoly is not None:
-        def ev(values: dict[str, np.ndarray]) -> Points:
-            return _charpoly_points(space, plan, values)
+
+    def ev(values: dict[str, np.ndarray]) -> Verdicts:
+        return evaluate(plan.engine, space, values, eigen=False, modes=modes)
+
     return stability_boundary(space, plan.outer, plan.inner, stable, status, iterations=BOUNDARY_ITERATIONS,
                               evaluator=ev)
-
-
-def _charpoly_points(space: object, plan: _Plan, values: dict[str, np.ndarray]) -> Points:
-    """Verdicts at scattered points of a map's axes by its characteristic-polynomial route (bisection points
-    of the boundary); undecided points go through :func:`~.points.evaluate_arrays` as on the grid."""
-    assert plan.charpoly is not None
-    xo = np.asarray(values[plan.outer.name], dtype=float)
-    yi = np.asarray(values[plan.inner.name], dtype=float)
-    arr = space.arrays({plan.outer.name: xo, plan.inner.name: yi})  # type: ignore[attr-defined]
-    valid = np.broadcast_to(valid_points(space, arr), xo.shape)
-    codes, mr, fr = charpoly_point_verdicts(plan.charpoly, xo, yi, eigen=False)
-    stable = valid & (codes == STABLE)
-    status = np.where(valid, np.int8(PointStatus.OK), np.int8(PointStatus.INVALID))
-    redo = np.flatnonzero(valid & (codes == UNDECIDED))
-    if redo.size:
-        sub = space.arrays({plan.outer.name: xo[redo], plan.inner.name: yi[redo]})  # type: ignore[attr-defined]
-        res = evaluate_arrays(space, sub, eigen=False, valid=np.ones(redo.size, dtype=bool))
-        stable[redo] = res.stable
-        status[redo] = res.status
-    return Points(status, stable, mr, fr)
 
 
 @dataclass(frozen=True)
@@ -628,9 +515,9 @@ class MapSummary:
         return verdict_counts_text(self.points, self.stable, self.unstable, self.status_counts)
 
 
-def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False, eigen: bool = True,
-              chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None,
-              boundary: bool = True) -> MapSummary:
+def write_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, path: str, *, force: bool = False,
+              eigen: bool = True, chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None,
+              boundary: bool = True, modes: str = "all") -> MapSummary:
     """Compute a stability map and write it to a NetCDF3 file block by block (memory bounded for any size).
 
     Same results and file content as ``stability_map(...).to_netcdf(path)``
@@ -646,13 +533,15 @@ def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine.
     space : ParameterSpace
         The parameter space.
     x, y : Axis
         The axes.
     path : str
         The NetCDF file to write (the caller makes it atomic).
-    force, eigen, chunk_points, progress, boundary
+    force, eigen, chunk_points, progress, boundary, modes
         As :func:`stability_map`.
 
     Returns
@@ -666,8 +555,9 @@ def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False
         than 4 GiB.
     """
     from ..results import MapFile
+    from .verdict import carrier_labels
 
-    plan = _plan(space, x, y, force, eigen, in_memory=False)
+    plan = _plan(engine, space, x, y, force, eigen, in_memory=False)
     n_o, n_i = plan.outer.num, plan.inner.num
     # the boundary needs the verdicts and status codes of the whole grid (2 bytes per point, at most
     # BOUNDARY_MAX_POINTS points); nothing else of the map is held: each block of rows goes to the file at once
@@ -675,12 +565,14 @@ def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False
     stable = np.zeros((n_o, n_i), dtype=bool) if keep else None
     status = np.zeros((n_o, n_i), dtype=np.int8) if keep else None
     f = MapFile(path, space, plan.outer, plan.inner, eigen=eigen, float_dtype=plan.ftype, method=plan.method,
-                boundary=keep)
+                boundary=keep, carriers=carrier_labels(engine)[0], routes=("none",) + tuple(r.name for r in ROUTES))
     n_stable = n_unstable = 0
     counts = np.zeros(len(PointStatus), dtype=np.int64)
     try:
-        for r0, r1, c0, c1, st, ss, mr, fr in _rows(space, plan, eigen, chunk_points):
-            f.write_rows(r0, r1, st, ss, mr, fr, c0=c0)
+        for r0, r1, c0, c1, v in _rows(space, plan, eigen, chunk_points, modes):
+            st, ss = v.stable, v.status
+            f.write_rows(r0, r1, st, ss, v.max_real if eigen else None, v.frequency if eigen else None, c0=c0,
+                         carrier=v.carrier.astype(np.int8), route=v.method.astype(np.int8))
             n_stable += int(np.count_nonzero(st))
             codes = np.asarray(ss, dtype=np.int64).ravel()
             counts += np.bincount(codes, minlength=counts.size)[:counts.size]
@@ -692,7 +584,7 @@ def write_map(space: object, x: Axis, y: Axis, path: str, *, force: bool = False
             if progress is not None:
                 progress(((r1 - 1) * n_i + c1) / (n_o * n_i))
         if stable is not None and status is not None:
-            b = _boundary(space, plan, stable, status)
+            b = _boundary(space, plan, stable, status, modes)
             if b is not None:
                 f.write_boundary(b)
     except BaseException:

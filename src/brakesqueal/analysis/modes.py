@@ -249,12 +249,14 @@ def track_modes(values: Sequence[float], linear: Callable[[float], Any], *, para
                       crossings=crossings, log=log, model=model, units=units)
 
 
-def modes_along(space: Any, name: str, start: float, stop: float, *, num: int = 200, log: bool = False,
-                pad_rates: str = "kept") -> ModeTracks:
+def modes_along(engine: Any, space: Any, name: str, start: float, stop: float, *, num: int = 200,
+                log: bool = False, pad_rates: str = "kept") -> ModeTracks:
     """Mode-coupling diagram of any model along one parameter of a parameter space.
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine.
     space : ParameterSpace
         The model, preset and overrides (:func:`brakesqueal.model.resolve_space`).
     name : str
@@ -295,5 +297,5 @@ def modes_along(space: Any, name: str, start: float, stop: float, *, num: int = 
     if problem:
         raise ParameterError(f"path '{name}': {problem}", parameter=name)
     values = np.geomspace(start, stop, num) if log else np.linspace(start, stop, num)
-    return track_modes(values, lambda v: linearize(space.resolve({name: v}), pad_rates=pad_rates),
+    return track_modes(values, lambda v: linearize(engine, space.resolve({name: v}), pad_rates=pad_rates),
                        parameter=name, log=log, model=space.model.name, units=space.preset.unit(name))

@@ -61,16 +61,20 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from fractions import Fraction
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ..codegen.engine import Engine
 
 __all__ = [
     "UNSTABLE", "STABLE", "UNDECIDED", "STATUS_UNDECIDED", "INPUT_REL", "routh_verdicts", "routh_exact",
     "horner_bound", "isolate_real_roots", "isolate_real_roots_float", "quartic_interval", "eigen_verdicts",
     "charpoly_exact", "mp_roots_summary", "roots_summary", "trivial_verdicts", "matrix_verdicts", "reconcile",
     "exact_trivial_entries", "balance", "state_verdicts", "descriptor_verdicts", "extended_descriptor_verdict",
-    "EXTENDED_VERDICT_MAX_SIZE", "mp_balanced",
+    "EXTENDED_VERDICT_MAX_SIZE", "mp_balanced", "extended_analysis", "state_analysis", "state_matrices",
+    "descriptor_states",
 ]
 
 UNSTABLE, STABLE, UNDECIDED = 0, 1, 2
@@ -385,48 +389,21 @@ def state_verdicts(S: np.ndarray, *, rel_input: float = INPUT_REL) -> tuple[np.n
         ``max_real < 0`` where the code is stable and ``max_real > 0`` where it
         is unstable.
     """
-    S = np.asarray(S, dtype=float)
-    N = S.shape[0]
-    codes = np.full(N, UNDECIDED, dtype=np.uint8)
-    mr = np.full(N, np.nan)
-    fr = np.full(N, np.nan)
-    if N == 0:
-        return codes, mr, fr
-    with np.errstate(all="ignore"):
-        good = np.all(np.isfinite(S), axis=(1, 2))
-        idx = np.flatnonzero(good)
-        if idx.size == 0:
-            return codes, mr, fr
-        B = balance(S[idx])
-        good2 = np.all(np.isfinite(B), axis=(1, 2))
-        B[~good2] = 0.0
-        lam, kappa = _eig_kappa(B)
-        good2 &= np.all(np.isfinite(lam), axis=1)
-        lam = np.where(np.isfinite(lam), lam, 0.0)
-        m = B.shape[-1]
-        eta = rel_input + 4.0 * m * 2.0 ** -53
-        b = 10.0 * kappa * eta * np.linalg.norm(B, axis=(1, 2))[:, None]
-        hi = np.max(lam.real + b, axis=1)
-        lo = np.max(lam.real - b, axis=1)
-        k = np.argmax(lam.real, axis=1)
-        top = lam[np.arange(idx.size), k]
-        c = np.where(hi < 0, STABLE, np.where(lo > 0, UNSTABLE, UNDECIDED)).astype(np.uint8)
-        c[~good2] = UNDECIDED
-        codes[idx] = c
-        mr[idx] = np.where(good2, top.real, np.nan)
-        fr[idx] = np.where(good2, np.abs(top.imag) / (2 * np.pi), np.nan)
+    codes, mr, fr, _, _ = state_analysis(S, rel_input=rel_input)
     return codes, mr, fr
 
 
-def _eig_kappa(B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Eigenvalues and their condition numbers ``‖x‖ ‖y‖ / |y^H x|`` (batched; per matrix where LAPACK fails)."""
+def _eig_kappa(B: np.ndarray, vectors: bool = False) -> Any:
+    """Eigenvalues and their condition numbers ``‖x‖ ‖y‖ / |y^H x|`` (batched; per matrix where LAPACK fails);
+    with ``vectors`` also the right eigenvectors (columns; NaN where LAPACK failed)."""
     try:
         lam, V = np.linalg.eig(B)
     except np.linalg.LinAlgError:
         if B.shape[0] == 1:
-            return np.full(B.shape[:2], np.nan + 0j), np.full(B.shape[:2], np.inf)
-        out = [_eig_kappa(B[i:i + 1]) for i in range(B.shape[0])]
-        return np.concatenate([o[0] for o in out]), np.concatenate([o[1] for o in out])
+            nan = (np.full(B.shape[:2], np.nan + 0j), np.full(B.shape[:2], np.inf))
+            return (*nan, np.full(B.shape, np.nan + 0j)) if vectors else nan
+        out = [_eig_kappa(B[i:i + 1], vectors) for i in range(B.shape[0])]
+        return tuple(np.concatenate([o[j] for o in out]) for j in range(3 if vectors else 2))
     try:
         W = np.linalg.inv(V)
         kappa = np.linalg.norm(V, axis=1) * np.linalg.norm(W, axis=2)
@@ -437,7 +414,137 @@ def _eig_kappa(B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             kappa = np.concatenate([_eig_kappa(B[i:i + 1])[1] for i in range(B.shape[0])])
     except ValueError:
         kappa = np.full(lam.shape, np.inf)
-    return lam, np.where(np.isfinite(kappa), kappa, np.inf)
+    kappa = np.where(np.isfinite(kappa), kappa, np.inf)
+    return (lam, kappa, V) if vectors else (lam, kappa)
+
+
+def state_analysis(S: np.ndarray, labels: np.ndarray | None = None, exclude: np.ndarray | None = None, *,
+                   rel_input: float = INPUT_REL) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`state_verdicts` with the error bound and the carrier of the least-stable eigenvalue.
+
+    Parameters
+    ----------
+    S : ndarray, shape (N, m, m)
+        State matrices.
+    labels : ndarray of int, shape (m,), optional
+        A label per state (e.g. the component it belongs to); an eigenvalue is carried by the label holding
+        the largest share of its balanced eigenvector.
+    exclude : ndarray of int, optional
+        Labels whose eigenvalues are left out of the verdict (reported, not judged).
+    rel_input : float
+        As :func:`state_verdicts`.
+
+    Returns
+    -------
+    codes, max_real, frequency : ndarray, shape (N,)
+        As :func:`state_verdicts` (over the eigenvalues not excluded).
+    bound : ndarray, shape (N,)
+        The error bound of the least-stable (judged) eigenvalue.
+    carrier : ndarray of int, shape (N,)
+        Its label (-1 without ``labels`` or a verdict).
+    """
+    S = np.asarray(S, dtype=float)
+    N, m = S.shape[0], S.shape[-1]
+    codes = np.full(N, UNDECIDED, dtype=np.uint8)
+    mr = np.full(N, np.nan)
+    fr = np.full(N, np.nan)
+    bd = np.full(N, np.nan)
+    car = np.full(N, -1, dtype=np.int64)
+    if N == 0:
+        return codes, mr, fr, bd, car
+    with np.errstate(all="ignore"):
+        good = np.all(np.isfinite(S), axis=(1, 2))
+        idx = np.flatnonzero(good)
+        if idx.size == 0:
+            return codes, mr, fr, bd, car
+        B = balance(S[idx])
+        good2 = np.all(np.isfinite(B), axis=(1, 2))
+        B[~good2] = 0.0
+        lam, kappa, V = _eig_kappa(B, vectors=True)
+        good2 &= np.all(np.isfinite(lam), axis=1)
+        lam = np.where(np.isfinite(lam), lam, 0.0)
+        eta = rel_input + 4.0 * m * 2.0 ** -53
+        b = 10.0 * kappa * eta * np.linalg.norm(B, axis=(1, 2))[:, None]
+        judged = np.ones(lam.shape, dtype=bool)
+        own = None
+        if labels is not None:
+            lab = np.asarray(labels, dtype=np.int64)
+            share = np.abs(V) ** 2  # (G, state, eigenvalue)
+            nl = int(lab.max()) + 1 if lab.size else 1
+            per = np.zeros((share.shape[0], nl, share.shape[2]))
+            for j in range(nl):
+                per[:, j, :] = share[:, lab == j, :].sum(axis=1)
+            own = np.argmax(per, axis=1)  # (G, eigenvalue)
+            if exclude is not None and len(exclude):
+                judged = ~np.isin(own, np.asarray(exclude, dtype=np.int64))
+        re = np.where(judged, lam.real, -np.inf)
+        hi = np.max(np.where(judged, lam.real + b, -np.inf), axis=1)
+        lo = np.max(np.where(judged, lam.real - b, -np.inf), axis=1)
+        k = np.argmax(re, axis=1)
+        rows = np.arange(idx.size)
+        top = lam[rows, k]
+        any_judged = np.any(judged, axis=1)
+        c = np.where(hi < 0, STABLE, np.where(lo > 0, UNSTABLE, UNDECIDED)).astype(np.uint8)
+        c[~good2] = UNDECIDED
+        c[~any_judged] = STABLE  # nothing judged: every mode excluded (only pad-rate modes)
+        codes[idx] = c
+        mr[idx] = np.where(good2 & any_judged, top.real, np.nan)
+        fr[idx] = np.where(good2 & any_judged, np.abs(top.imag) / (2 * np.pi), np.nan)
+        bd[idx] = np.where(good2 & any_judged, b[rows, k], np.nan)
+        if own is not None:
+            car[idx] = np.where(good2 & any_judged, own[rows, k], -1)
+    return codes, mr, fr, bd, car
+
+
+def state_matrices(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Balanced ``2n x 2n`` state matrices of eq. (47) for a batch, and which of them are usable.
+
+    Returns
+    -------
+    S : ndarray, shape (N, 2n, 2n)
+        ``[[0, w I], [-M^-1 K / w, -M^-1 D]]`` (``w`` a power of two; similar to eq. 47's state matrix);
+        zeros where unusable.
+    good : ndarray of bool, shape (N,)
+        Finite matrices with a nonsingular ``M``.
+    """
+    M, D, K = (np.asarray(X, dtype=float) for X in (M, D, K))
+    N, n = M.shape[0], M.shape[-1]
+    S = np.zeros((N, 2 * n, 2 * n))
+    with np.errstate(all="ignore"):
+        good = np.all(np.isfinite(M), axis=(1, 2)) & np.all(np.isfinite(D), axis=(1, 2)) & \
+            np.all(np.isfinite(K), axis=(1, 2))
+        detM = np.linalg.det(np.where(good[:, None, None], M, np.eye(n)))
+        good &= np.abs(detM) > 0
+        idx = np.flatnonzero(good)
+        if idx.size:
+            S[idx] = _state(M[idx], D[idx], K[idx])
+    return S, good
+
+
+def descriptor_states(E: np.ndarray, A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``E^-1 A`` of a batch of descriptor systems (LU with partial pivoting), and which of them are usable.
+
+    Returns
+    -------
+    S : ndarray, shape (N, m, m)
+        The state matrices (zeros where unusable).
+    good : ndarray of bool, shape (N,)
+        Finite systems with a nonsingular ``E`` (a singular one has an infinite eigenvalue).
+    """
+    E, A = np.asarray(E, dtype=float), np.asarray(A, dtype=float)
+    N, m = E.shape[0], E.shape[-1]
+    S = np.zeros((N, m, m))
+    with np.errstate(all="ignore"):
+        good = np.all(np.isfinite(E), axis=(1, 2)) & np.all(np.isfinite(A), axis=(1, 2))
+        good &= np.abs(np.linalg.det(np.where(good[:, None, None], E, np.eye(m)))) > 0
+        idx = np.flatnonzero(good)
+        if idx.size:
+            try:
+                S[idx] = np.linalg.solve(E[idx], A[idx])
+            except np.linalg.LinAlgError:
+                S[idx] = np.stack([_solve_or_nan(E[i], A[i]) for i in idx])
+        good &= np.all(np.isfinite(S), axis=(1, 2))
+    return S, good
 
 
 def eigen_verdicts(M: np.ndarray, D: np.ndarray, K: np.ndarray, *, rel_input: float = INPUT_REL
@@ -458,22 +565,14 @@ def eigen_verdicts(M: np.ndarray, D: np.ndarray, K: np.ndarray, *, rel_input: fl
         ``[[0, w I], [-M^-1 K / w, -M^-1 D]]``); singular or non-finite ``M``
         gives :data:`UNDECIDED`.
     """
-    M, D, K = (np.asarray(X, dtype=float) for X in (M, D, K))
-    N = M.shape[0]
+    S, good = state_matrices(M, D, K)
+    N = S.shape[0]
     codes = np.full(N, UNDECIDED, dtype=np.uint8)
     mr = np.full(N, np.nan)
     fr = np.full(N, np.nan)
-    if N == 0:
-        return codes, mr, fr
-    with np.errstate(all="ignore"):
-        good = np.all(np.isfinite(M), axis=(1, 2)) & np.all(np.isfinite(D), axis=(1, 2)) & \
-            np.all(np.isfinite(K), axis=(1, 2))
-        detM = np.linalg.det(np.where(good[:, None, None], M, np.eye(M.shape[-1])))
-        good &= np.abs(detM) > 0
-        idx = np.flatnonzero(good)
-        if idx.size == 0:
-            return codes, mr, fr
-        codes[idx], mr[idx], fr[idx] = state_verdicts(_state(M[idx], D[idx], K[idx]), rel_input=rel_input)
+    idx = np.flatnonzero(good)
+    if idx.size:
+        codes[idx], mr[idx], fr[idx] = state_verdicts(S[idx], rel_input=rel_input)
     return codes, mr, fr
 
 
@@ -497,25 +596,14 @@ def descriptor_verdicts(E: np.ndarray, A: np.ndarray, *, rel_input: float = INPU
         (e.g. ``lambda = -G_L/G_dL`` of a massless pad).  A singular ``E``
         (an infinite eigenvalue) gives :data:`UNDECIDED`.
     """
-    E, A = np.asarray(E, dtype=float), np.asarray(A, dtype=float)
-    N = E.shape[0]
+    S, good = descriptor_states(E, A)
+    N = S.shape[0]
     codes = np.full(N, UNDECIDED, dtype=np.uint8)
     mr = np.full(N, np.nan)
     fr = np.full(N, np.nan)
-    if N == 0:
-        return codes, mr, fr
-    with np.errstate(all="ignore"):
-        good = np.all(np.isfinite(E), axis=(1, 2)) & np.all(np.isfinite(A), axis=(1, 2))
-        eye = np.eye(E.shape[-1])
-        good &= np.abs(np.linalg.det(np.where(good[:, None, None], E, eye))) > 0
-        idx = np.flatnonzero(good)
-        if idx.size == 0:
-            return codes, mr, fr
-        try:
-            S = np.linalg.solve(E[idx], A[idx])
-        except np.linalg.LinAlgError:
-            S = np.stack([_solve_or_nan(E[i], A[i]) for i in idx])
-        codes[idx], mr[idx], fr[idx] = state_verdicts(S, rel_input=rel_input)
+    idx = np.flatnonzero(good)
+    if idx.size:
+        codes[idx], mr[idx], fr[idx] = state_verdicts(S[idx], rel_input=rel_input)
     return codes, mr, fr
 
 
@@ -585,14 +673,40 @@ def extended_descriptor_verdict(E: np.ndarray, A: np.ndarray, k: int, *, rel_inp
         frequency [Hz] and ``10 δ``; all finite eigenvalues (empty when
         undecided for want of them).
     """
+    return extended_analysis(E, A, k, rel_input=rel_input, dps=dps)[:5]  # type: ignore[return-value]
+
+
+def extended_analysis(E: np.ndarray, A: np.ndarray, k: int, labels: np.ndarray | None = None,
+                      exclude: np.ndarray | None = None, *, rel_input: float = INPUT_REL, dps: int = 40
+                      ) -> tuple[int, float, float, float, np.ndarray, int]:
+    """:func:`extended_descriptor_verdict` with the carrier of its least-stable eigenvalue, optionally leaving out
+    the eigenvalues of some carriers.
+
+    Parameters
+    ----------
+    E, A, k, rel_input, dps
+        As :func:`extended_descriptor_verdict`.
+    labels : ndarray of int, shape (m,), optional
+        A label per state; an eigenvalue is carried by the label of the state with the largest component of its
+        balanced eigenvector.
+    exclude : ndarray of int, optional
+        Labels whose eigenvalues are left out of the verdict.
+
+    Returns
+    -------
+    code, max_real, frequency, bound, eigenvalues, carrier
+        As :func:`extended_descriptor_verdict` (over the judged eigenvalues), and the carrier label of the
+        least-stable judged one (-1 without ``labels``).
+    """
     import mpmath
 
     E, A = np.asarray(E, dtype=float), np.asarray(A, dtype=float)
     m = E.shape[0]
-    none = (UNDECIDED, math.nan, math.nan, math.inf, np.empty(0, dtype=complex))
+    none = (UNDECIDED, math.nan, math.nan, math.inf, np.empty(0, dtype=complex), -1)
     if m > EXTENDED_VERDICT_MAX_SIZE or not (np.all(np.isfinite(E)) and np.all(np.isfinite(A))):
         return none
     rows = np.flatnonzero(np.all(E == 0.0, axis=1))
+    keep_c = list(range(m))
     with mpmath.workdps(dps):
         mE, mA = mpmath.matrix(E.tolist()), mpmath.matrix(A.tolist())
         aE, aA = mpmath.matrix(np.abs(E).tolist()), mpmath.matrix(np.abs(A).tolist())
@@ -628,7 +742,9 @@ def extended_descriptor_verdict(E: np.ndarray, A: np.ndarray, k: int, *, rel_inp
             return none
         out = np.empty(N, dtype=complex)
         bounds = np.empty(N)
+        owner = np.zeros(N, dtype=np.int64)
         for i in range(N):
+            owner[i] = int(np.argmax([abs(complex(ERb[r, i])) for r in range(N)]))
             x = mpmath.matrix([ERb[r, i] * dg[r] for r in range(N)])
             w = mpmath.matrix([[ELb[i, c] / dg[c] for c in range(N)]])
             y = w * Einv  # y A' = λ y E'
@@ -640,14 +756,25 @@ def extended_descriptor_verdict(E: np.ndarray, A: np.ndarray, k: int, *, rel_inp
             out[i] = complex(lam[i])
     tiny = np.abs(out.imag) <= 1e-30 * np.abs(out)
     out[tiny] = out[tiny].real
-    j = int(np.argmax(out.real))
-    if np.all(out.real + bounds < 0):
+    carriers = np.full(N, -1, dtype=np.int64)
+    judged = np.ones(N, dtype=bool)
+    if labels is not None:
+        lab = np.asarray(labels, dtype=np.int64)
+        carriers = lab[np.asarray(keep_c, dtype=np.int64)[owner]]
+        if exclude is not None and len(exclude):
+            judged = ~np.isin(carriers, np.asarray(exclude, dtype=np.int64))
+    if not judged.any():  # every mode excluded
+        return STABLE, math.nan, math.nan, math.nan, out, -1
+    re = np.where(judged, out.real, -np.inf)
+    j = int(np.argmax(re))
+    if np.all((out.real + bounds < 0) | ~judged):
         code = STABLE
-    elif np.any(out.real - bounds > 0):
+    elif np.any((out.real - bounds > 0) & judged):
         code = UNSTABLE
     else:
         code = UNDECIDED
-    return code, float(out[j].real), float(abs(out[j].imag) / (2 * math.pi)), float(bounds[j]), out
+    return (code, float(out[j].real), float(abs(out[j].imag) / (2 * math.pi)), float(bounds[j]), out,
+            int(carriers[j]))
 
 
 def _solve_or_nan(E: np.ndarray, A: np.ndarray) -> np.ndarray:
@@ -747,54 +874,24 @@ def reconcile(codes: np.ndarray, max_real: np.ndarray, recompute: Callable[[int]
 
 
 # ---------------------------------------------------------------- 2-DOF closed form, exact
-def _exact_entries_fn(spec: Any) -> Callable[[Sequence[Fraction]], list[Fraction]]:
-    """Python function evaluating the 12 closed-form entries of a model with Fraction arithmetic (generated)."""
-    from .kernels import _form, _memo, _terms
-
-    form = _form(spec)
-
-    def build() -> Callable[[Sequence[Fraction]], list[Fraction]]:
-        args = list(form.symbols)
-        lines = ["def f(x):", "    F = Fraction", "    out = []"]
-        for X in (form.M, form.D, form.K):
-            for i in range(2):
-                for j in range(2):
-                    terms = []
-                    for c, powers in _terms(X[i, j], args):
-                        cq = _to_fraction(c)
-                        fac = [f"F({cq.numerator}, {cq.denominator})"]
-                        fac += [f"x[{k}] ** {p}" if p != 1 else f"x[{k}]" for k, p in sorted(powers.items())]
-                        terms.append(" * ".join(fac))
-                    lines.append(f"    out.append({' + '.join(terms) if terms else 'F(0)'})")
-        lines.append("    return out")
-        ns: dict[str, Any] = {"Fraction": Fraction}
-        exec("\n".join(lines), ns)
-        return ns["f"]  # type: ignore[no-any-return]
-
-    return _memo(("exact-entries", form.key), build)  # type: ignore[no-any-return]
-
-
-def exact_trivial_entries(p: Sequence[float], spec: Any = None) -> list[Fraction]:
+def exact_trivial_entries(engine: Engine, p: Sequence[float]) -> list[Fraction]:
     """The 12 closed-form entries of ``M, D, K`` (trivial silent motion) evaluated exactly at parameter vector ``p``.
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine; it needs a closed form.
     p : sequence of float
         Parameter vector in the model's packing order (compliances for
         tangential stiffnesses); each float is taken as the exact rational it
         represents.
-    spec : ModelSpec, optional
-        The model (default: the paper's); it needs a closed form
-        (:func:`~.kernels.model_form`).
 
     Returns
     -------
     list of Fraction
-        ``M, D, K`` row-major.
+        ``M, D, K`` row-major (:meth:`Engine.exact_entries <brakesqueal.codegen.engine.Engine.exact_entries>`).
     """
-    from .kernels import _paper
-
-    return _exact_entries_fn(spec if spec is not None else _paper())([Fraction(float(v)) for v in p])
+    return list(engine.exact_entries().entries([Fraction(float(v)) for v in p]))
 
 
 def _quartic_exact(e: Sequence[Fraction]) -> list[Fraction]:
@@ -806,9 +903,9 @@ def _quartic_exact(e: Sequence[Fraction]) -> list[Fraction]:
             m11 * m22 - m12 * m21]
 
 
-def _exact_point(p: Sequence[float], eigen: bool, spec: Any = None) -> tuple[int, float, float]:
+def _exact_point(engine: Engine, p: Sequence[float], eigen: bool) -> tuple[int, float, float]:
     try:
-        q = _quartic_exact(exact_trivial_entries(p, spec))
+        q = _quartic_exact(exact_trivial_entries(engine, p))
     except (ZeroDivisionError, OverflowError, ValueError):  # singular closed form (invalid parameters)
         return UNDECIDED, math.nan, math.nan
     code = routh_exact(q)
@@ -818,12 +915,15 @@ def _exact_point(p: Sequence[float], eigen: bool, spec: Any = None) -> tuple[int
     return code, mr, fr
 
 
-def trivial_verdicts(P: np.ndarray, *, eigen: bool = True, codes: np.ndarray | None = None, spec: Any = None
+def trivial_verdicts(engine: Engine, P: np.ndarray, *, eigen: bool = True, codes: np.ndarray | None = None
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per-point robust route for 2-DOF parameter vectors at the trivial silent motion.
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine; it needs a closed form (:attr:`Capabilities.closed_form
+        <brakesqueal.codegen.engine.Capabilities.closed_form>`).
     P : ndarray, shape (n, n_parameters)
         Parameter vectors (the model's packing order, compliances), valid and
         with a trivial silent motion (for the paper's model ``mu1 h10 = mu2 h20``).
@@ -833,9 +933,6 @@ def trivial_verdicts(P: np.ndarray, *, eigen: bool = True, codes: np.ndarray | N
     codes : ndarray of uint8, optional
         Verdicts already certified elsewhere (e.g. by a compiled map kernel);
         only entries equal to :data:`UNDECIDED` are recomputed.
-    spec : ModelSpec, optional
-        The model (default: the paper's); it needs a closed form
-        (:func:`~.kernels.model_form`).
 
     Returns
     -------
@@ -865,17 +962,17 @@ def trivial_verdicts(P: np.ndarray, *, eigen: bool = True, codes: np.ndarray | N
     out = np.full(n, UNDECIDED, dtype=np.uint8) if codes is None else codes.astype(np.uint8).copy()
     A = RA = None
     if todo.any() or eigen:
-        E, R = trivial_entries(P, spec)
+        E, R = trivial_entries(engine, P)
         A, RA = quartic_interval(E, R)
     if todo.any():
         ix = np.flatnonzero(todo)
         out[ix] = routh_verdicts(A[ix], RA[ix])
         for i in ix[out[ix] == UNDECIDED]:
             if np.all(np.isfinite(P[i])):
-                out[i] = _exact_point(P[i], False, spec)[0]
+                out[i] = _exact_point(engine, P[i], False)[0]
     if eigen and A is not None:
         mr, fr = roots_summary(A)
-        reconcile(out, mr, lambda i: _exact_point(P[i], True, spec), fr)
+        reconcile(out, mr, lambda i: _exact_point(engine, P[i], True), fr)
     return out, mr, fr
 
 

@@ -93,7 +93,7 @@ def derive(
 
     text = None if no_cache else shipped_text(case.value, fmt.value)
     if text is None:
-        from ..numeric import cache
+        from ..codegen import cache
         from ..render import render_closed_form
 
         text = cache.cached_text("closed-forms", f"{case.value}.{fmt.value}",
@@ -111,10 +111,11 @@ def linearize(
 ) -> None:
     """Find the silent motion, linearize (eqs. 46-48) and print M, D, K, the eigenvalues and the verdict."""
     from ..analysis.linear import linearize as _linearize
+    from ..codegen import build
     from ..render import render_linear_model
 
     p = space_from(model, preset, params, set_).resolve({})
-    lm = _linearize(p, pad_rates=pad_rates.value, use_cache=not no_cache)
+    lm = _linearize(build(p.model, use_cache=not no_cache), p, pad_rates=pad_rates.value)
     sys.stdout.write(render_linear_model(lm, fmt.value))
 
 
@@ -126,7 +127,7 @@ def eigen(
                                       "(0 = least stable).", min=0)] = 0,
 ) -> None:
     """Eigen-analysis at one point: frequencies, damping ratios, mode shapes, sensitivities, attribution of Re λ."""
-    from ..analysis.eigen import eigen_analysis
+    from ..api import eigen_analysis
     from ..render import render_eigen
 
     ea = eigen_analysis(space_from(model, preset, params, set_).resolve({}))
@@ -159,9 +160,9 @@ def list_(what: Annotated[ListWhat, typer.Argument(help="models or presets")],
         rows = []
         for name in MODELS:
             spec = get_model(name)
-            from ..codegen import compile_model
+            from ..codegen import build
 
-            rows.append({"name": name, "coordinates": list(compile_model(spec).coords),
+            rows.append({"name": name, "coordinates": list(build(spec).caps.coords),
                          "presets": spec.preset_names(), "description": spec.description})
         if fmt == OutFormat.json:
             sys.stdout.write(json.dumps(rows, indent=2) + "\n")

@@ -16,7 +16,7 @@ cache_app = typer.Typer(help="Inspect or clear the code cache ($BRAKESQUEAL_CACH
 @cache_app.command("info")
 def _info_cmd() -> None:
     """Print the cache root and the files and bytes per package version (* = in use)."""
-    from ..numeric.cache import cache_info
+    from ..codegen.cache import cache_info
 
     info = cache_info()
     sys.stdout.write(f"root {info['root']}\n")
@@ -32,7 +32,7 @@ def _clear_cmd(
     stale: Annotated[bool, typer.Option("--stale", help="Only remove directories of other versions.")] = False,
 ) -> None:
     """Delete cached code (regenerated on the next run)."""
-    from ..numeric.cache import clear_cache
+    from ..codegen.cache import clear_cache
 
     for d in clear_cache(stale_only=stale):
         sys.stdout.write(f"removed {d}\n")

@@ -11,7 +11,7 @@ When anything the derivation reads has changed, :func:`shipped_text` returns
 
 ``tests/cli/test_derive_shipped.py`` checks every shipped text against the live
 derivation, that the fingerprint is current and that it covers every code-generating
-module (:data:`brakesqueal.numeric.cache.GENERATOR_MODULES`) the derivation imports.
+module (:data:`brakesqueal.codegen.cache.GENERATOR_MODULES`) the derivation imports.
 Check, and regenerate after editing the derivation (or upgrading SymPy/symengine)::
 
     python -m brakesqueal.cli.closed_forms          # exit 1 when stale
@@ -86,7 +86,7 @@ texts = {{f"{{c}}|{{f}}": render_closed_form(c, f) for c in {cases!r} for f in {
 from pathlib import Path
 files = {{str(Path(m.__file__).resolve()) for n, m in list(sys.modules.items())
          if n.split(".")[0] == "brakesqueal" and getattr(m, "__file__", None)}}
-from brakesqueal.numeric import cache
+from brakesqueal.codegen import cache
 gen = {{str(p.resolve()) for p in cache.generator_files()}}
 print(json.dumps({{"texts": texts, "files": sorted(f for f in files if f in gen)}}))
 """
@@ -111,7 +111,7 @@ def derivation_sources() -> tuple[str, ...]:
     -------
     tuple of str
         Paths relative to the package directory, sorted: the modules of
-        :data:`brakesqueal.numeric.cache.GENERATOR_MODULES` that the live derivation imports.
+        :data:`brakesqueal.codegen.cache.GENERATOR_MODULES` that the live derivation imports.
     """
     files = _probe()["files"]
     assert isinstance(files, list)

@@ -25,7 +25,7 @@ def modes(
 ) -> None:
     """Frequencies and real parts of every mode along a path, tracked by continuity; coalescences and crossings."""
     from ..analysis.maps import parse_axis, resolution_problem
-    from ..analysis.modes import modes_along
+    from ..api import modes_along
     from ..outputs import atomic_write, check_output
 
     axis = parse_axis(along, with_num=False)

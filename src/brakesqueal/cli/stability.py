@@ -64,8 +64,8 @@ def crossings(
     fmt: FormatOpt = OutFormat.text, plot: _PlotOpt = None, hopf: _HopfOpt = False,
 ) -> None:
     """Every parameter value on a path where the stability of the silent motion changes (exact where possible)."""
-    from ..analysis.crossings import crossings as _crossings
     from ..analysis.maps import parse_axis
+    from ..api import crossings as _crossings
     from ..outputs import check_output
 
     axis = parse_axis(along, with_num=False)
@@ -102,8 +102,9 @@ def critical_speed(
     fmt: FormatOpt = OutFormat.text, plot: _PlotOpt = None, hopf: _HopfOpt = False,
 ) -> None:
     """All onsets and re-stabilisations of squeal along the spin rate Omega, and Omega_crit."""
-    from ..analysis.crossings import critical_speeds, omega_name
+    from ..analysis.crossings import omega_name
     from ..analysis.maps import Axis
+    from ..api import critical_speeds
     from ..outputs import check_output
 
     lo, hi = _omega_range(range_)
@@ -154,7 +155,8 @@ def map_(
         "--color", help="What the plot's colours show: the verdict, or max Re λ or the frequency.")] = None,
 ) -> None:
     """Stability map over two parameters of any model: NetCDF (stable, status, max_real, frequency); optional plot."""
-    from ..analysis.maps import parse_axis, write_map
+    from ..analysis.maps import parse_axis
+    from ..api import write_map
     from ..outputs import atomic_write, check_output
     from ._progress import progress as _progress
 
@@ -240,8 +242,8 @@ def hopf(
     fmt: FormatOpt = OutFormat.text, pad_damping: PadDampingOpt = None,
 ) -> None:
     """Hopf criticality at every stability crossing on a path: l1, sub/supercritical, predicted cycle amplitude."""
-    from ..analysis.crossings import crossings as _crossings
     from ..analysis.maps import parse_axis
+    from ..api import crossings as _crossings
     from ..nonlinear.models import hopf_points
 
     axis = parse_axis(along, with_num=False)

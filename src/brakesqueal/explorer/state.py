@@ -266,7 +266,7 @@ def stability_names(space: Any, names: list[str]) -> list[str]:
     of every name's :func:`slider_range` with the others at their current
     values.  Empty when the current point itself is not decided.
     """
-    from ..analysis.points import evaluate
+    from ..api import evaluate
     from ..errors import BrakesquealError
 
     k = len(names)
@@ -335,8 +335,7 @@ def locus_view(space: Any, along: str, rng: SliderRange, num: int = LOCUS_POINTS
     ParameterError, SilentMotionError
         At the current point (errors along the path are reported in ``message``).
     """
-    from ..analysis.linear import linearize
-    from ..analysis.modes import modes_along
+    from ..api import linearize, modes_along
     from ..errors import BrakesquealError
 
     lm = linearize(space.resolve({}))
@@ -428,7 +427,8 @@ def map_view(space: Any, x: str, y: str, rx: SliderRange, ry: SliderRange, nx: i
     ParameterError
         Equal or tied axes, too many points (:data:`MAX_MAP_POINTS`).
     """
-    from ..analysis.maps import Axis, stability_map
+    from ..analysis.maps import Axis
+    from ..api import stability_map
 
     check_map_size(nx, ny)
     if x == y:
@@ -450,7 +450,8 @@ def map_view(space: Any, x: str, y: str, rx: SliderRange, ry: SliderRange, nx: i
 # ---------------------------------------------------------------------------------------------- speeds, Hopf
 def critical_speed_text(space: Any) -> str:
     """One line: the critical speeds of the current point (:func:`~brakesqueal.analysis.crossings.critical_speeds`)."""
-    from ..analysis.crossings import critical_speeds, omega_name
+    from ..analysis.crossings import omega_name
+    from ..api import critical_speeds
     from ..errors import BrakesquealError
 
     try:

@@ -573,8 +573,10 @@ def _check_trivial(params: Any) -> None:
             "silent motion")
     hint = ("(use 'brakesqueal linearize " + ("" if params.model.name == "paper" else f"--model {params.model.name} ")
             + "--format json' for the numeric matrices at this silent motion)")
+    from ..codegen import build
+
     try:
-        sm = silent_motion(params)
+        sm = silent_motion(build(params.model), params)  # export is an entry point: the model is built here
     except SilentMotionError as exc:
         raise ParameterError(f"{what}; these parameters have none: {exc}") from None
     if sm.trivial:

@@ -412,6 +412,22 @@ class Pad:
         """Whether the pad is massless tangentially with a finite stiffness: its deformation ``l`` is in ``L``."""
         return "tangential" not in self.dofs and not self.rigid
 
+    @property
+    def treatment(self) -> str | None:
+        """How the pad's tangential deformation ``l`` enters the linearization and the simulation.
+
+        The one place this is decided: ``None`` for a pad without a deformation in ``L`` (a tangential DOF or
+        a rigid support); ``"dynamic"`` (``l`` keeps a first-order rate state) when its friction law depends on
+        the sliding speed (:attr:`LawDef.rate_dependent <brakesqueal.model.friction.LawDef.rate_dependent>`)
+        or it has a tangential damper; ``"quasi-static"`` otherwise (``l`` follows the disk through its
+        balance; the paper's pads).  Decided from the model, never from parameter values or a law's name.
+        """
+        if not self.quasi_static:
+            return None
+        from .friction import LAWS
+
+        return "dynamic" if LAWS[self.friction.law].rate_dependent or self.tangentially_damped else "quasi-static"
+
     # physics hooks (docs/extending.md): ctx is a brakesqueal.symbolic.assemble.Assembly
     def coordinates(self) -> list[str]:
         """``w_<pad>`` and ``u_<pad>`` of its normal and tangential DOFs."""

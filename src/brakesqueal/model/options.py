@@ -190,15 +190,14 @@ def regularised_pads(space: Any, slope: float, stick_speed: float | None = None)
     from dataclasses import replace
 
     from .components import FrictionLaw
+    from .friction import LAWS
 
     value = _in_range("pad_slope", slope, MAX_PAD_SLOPE, "s/m")
     v_reg = None if stick_speed is None else _in_range("stick_speed", stick_speed, MAX_STICK_SPEED, "m/s")
     spec = space.resolve({}).model
     pads, changed = [], False
     for pad in spec.pads:
-        massless = "tangential" not in pad.dofs
-        finite = not (isinstance(pad.k_ip, (int, float)) and math.isinf(pad.k_ip))
-        if massless and finite and pad.friction.law == "coulomb":
+        if pad.quasi_static and not LAWS[pad.friction.law].rate_dependent:
             law = (FrictionLaw("linear", pad.friction.mu, slope=-value) if v_reg is None
                    else FrictionLaw("stick", pad.friction.mu, v_reg=v_reg, slope=-value))
             pad = replace(pad, friction=law)

@@ -183,7 +183,7 @@ def dop853(f, jac, dfdp, y0, p, th, T, rtol, atol, sens, t_samples, samples, h0,
 
 
 def _guard() -> None:
-    from ..numeric.cache import guard_numba_caches
+    from ..codegen.cache import guard_numba_caches
 
     guard_numba_caches(globals())  # a damaged or unwritable numba cache file is recompiled, never an error
 

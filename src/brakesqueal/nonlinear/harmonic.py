@@ -539,9 +539,10 @@ class _Continuation:
 
 def _first_hopf(space: Any, axis: Any, use_cache: bool) -> Any:
     from ..analysis.crossings import crossings
+    from ..simulation import simulation_model
     from .implicit import exact_lyapunov
 
-    r = crossings(space, axis)
+    r = crossings(simulation_model(space.resolve({}).model, use_cache=use_cache).engine, space, axis)
     errors = []
     for value, _direction in r.crossings:  # type: ignore[attr-defined]
         try:
@@ -884,7 +885,7 @@ def _make_point(bal: _Balance, sim: Any, C: np.ndarray, omega: float, p: float, 
     # the silent motion at p
     from ..analysis.equilibrium import silent_motion
 
-    sm = silent_motion(bal.space.resolve({bal.name: p}), model=cm)
+    sm = silent_motion(sim.engine, bal.space.resolve({bal.name: p}))
     x0 = np.asarray(sm.state(), dtype=float)
     vr0 = cm.contact_table(x0, pv)[:, 1:4]
     slide = np.einsum("pkt,pk->pt", ct[:, 1:4, :], vr0 / np.linalg.norm(vr0, axis=1)[:, None])

@@ -107,10 +107,10 @@ class _Point:
         cm = sim.compiled
         self.cm, self.n, self.m = cm, cm.n, cm.m
         self.pvec = [float(v) for v in sim.parameter_vector(self.params)]
-        self.sm = silent_motion(self.params, model=cm)
+        self.sm = silent_motion(sim.engine, self.params)
         self.x0 = np.asarray(self.sm.state(), dtype=float)
         self.J = cm.zero_jacobian_matrix(self.pvec) if self.sm.trivial else cm.jacobian_matrix(self.x0, self.pvec)
-        self.lm = linearize(self.params, model=cm)
+        self.lm = linearize(sim.engine, self.params)
         self.kept = [cm.algebraic.index(s) for s in self.lm.pad_states]
 
     def eigenvalues(self) -> np.ndarray:

@@ -494,9 +494,9 @@ def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = 
     from ..simulation.trajectory import soft_quasi_static_pads as soft_at
     from .implicit import exact_lyapunov
 
-    r = crossings(space, axis) if result is None else result
     system = model_system(space, axis.name, use_cache=use_cache)
     sim = system.simulation_model  # type: ignore[attr-defined]
+    r = crossings(sim.engine, space, axis) if result is None else result
     treatment = dict(zip(sim.pad_unknowns, sim.pad_kinds))
     out = []
     for value, direction in r.crossings:  # type: ignore[attr-defined]

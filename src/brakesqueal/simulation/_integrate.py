@@ -77,17 +77,21 @@ class SimulationModel:
         numba functions ``rhs``, ``solve_pads``, ``event_values``, ``contact``,
         ``energy``, ``post_process`` and the integrator ``dop853``
         (:mod:`brakesqueal.simulation._kernels`).
-    compiled : CompiledModel
-        The model's compiled residuals (:func:`~brakesqueal.codegen.compile_model`),
-        for the silent motion and the linearization.
+    engine : Engine
+        The model's engine (:func:`brakesqueal.codegen.build`), for the silent motion and the linearization.
     use_cache : bool
         Whether the on-disk code cache is used.
     """
 
     spec: Any
     kernels: ModuleType
-    compiled: Any
+    engine: Any
     use_cache: bool = True
+
+    @property
+    def compiled(self) -> Any:
+        """The model's compiled residuals (:attr:`Engine.compiled <brakesqueal.codegen.engine.Engine.compiled>`)."""
+        return self.engine.compiled
 
     # ---------------------------------------------------------------- structure
     @property
@@ -188,7 +192,7 @@ class SimulationModel:
 
         params = self.parameters(params)
         cm = self.compiled
-        sm = silent_motion(params, model=cm)
+        sm = silent_motion(self.engine, params)
         p = self.parameter_vector(params)
         n, m = cm.n, cm.m
         dyn = [j for j, k in enumerate(self.pad_kinds) if k == "dynamic"]
@@ -242,7 +246,7 @@ class SimulationModel:
 
         params = self.parameters(params)
         dyn = self.dynamic
-        lm = linearize(params, model=self.compiled, pad_rates="kept" if dyn else "quasi-static")
+        lm = linearize(self.engine, params, pad_rates="kept" if dyn else "quasi-static")
         if tuple(lm.pad_states) == dyn:
             return np.asarray(lm.A, dtype=float), lm
         return _own_linear_matrix(self, params, lm.silent), None
@@ -488,7 +492,7 @@ def simulation_model(model: Any = "paper", *, use_cache: bool = True) -> Simulat
         paper's model).
     use_cache : bool, optional
         Keep the generated kernel source in the package cache (see
-        :mod:`brakesqueal.numeric.cache`), where numba also caches its
+        :mod:`brakesqueal.codegen.cache`), where numba also caches its
         machine code (default ``True``); ``False`` generates and compiles in
         memory and writes no file.
 
@@ -497,7 +501,7 @@ def simulation_model(model: Any = "paper", *, use_cache: bool = True) -> Simulat
     SimulationModel
         Memoized per process by the model's equations.
     """
-    from ..codegen import compile_model
+    from ..codegen import build
     from ..codegen.compiled import model_key
     from ..model.parameters import as_model_spec as _model
     from ._kernels import load_kernels
@@ -506,12 +510,11 @@ def simulation_model(model: Any = "paper", *, use_cache: bool = True) -> Simulat
     key = (model_key(spec), use_cache)
     sim = _MODELS.get(key)
     if sim is None:
-        sim = SimulationModel(spec=spec, kernels=load_kernels(spec, use_cache), compiled=compile_model(
-            spec, use_cache=use_cache), use_cache=use_cache)
+        sim = SimulationModel(spec=spec, kernels=load_kernels(spec, use_cache), engine=build(spec, use_cache=use_cache),
+                              use_cache=use_cache)
         _MODELS[key] = sim
     elif sim.spec is not spec:
-        sim = SimulationModel(spec=spec, kernels=sim.kernels, compiled=compile_model(spec, use_cache=use_cache),
-                              use_cache=use_cache)
+        sim = SimulationModel(spec=spec, kernels=sim.kernels, engine=sim.engine.with_spec(spec), use_cache=use_cache)
     return sim
 
 

@@ -46,7 +46,7 @@ No compiled function returns an array: boxing an array calls back into the
 interpreter (numba's ``_numba_unpickle``), where a pending ``KeyboardInterrupt``
 would surface inside compiled code (issue 11).
 
-The module is cached per model (:func:`brakesqueal.numeric.cache.load_module`,
+The module is cached per model (:func:`brakesqueal.codegen.cache.load_module`,
 entry ``model-<hash>/simulate.py``) and numba caches its machine code beside it.
 """
 
@@ -56,7 +56,7 @@ import math
 import types
 from typing import Any
 
-from ..numeric import cache
+from ..codegen import cache
 
 __all__ = ["KERNEL_NAME", "PAD_KINDS", "pad_treatment", "kernel_source", "load_kernels"]
 
@@ -84,13 +84,7 @@ def pad_treatment(spec: Any) -> tuple[str, ...]:
         ``stick``) or a tangential damper ``d_ip`` (a parameter name or a
         nonzero number).  Decided from the model, never from parameter values.
     """
-    out = []
-    for pad in spec.pads:
-        rigid = not isinstance(pad.k_ip, str) and math.isinf(pad.k_ip)
-        if "tangential" in pad.dofs or rigid:
-            continue
-        out.append("quasi-static" if pad.friction.law == "coulomb" and not pad.tangentially_damped else "dynamic")
-    return tuple(out)
+    return tuple(t for t in (pad.treatment for pad in spec.pads) if t is not None)
 
 
 def _value(se: Any, eq: Any, v: Any) -> Any:

@@ -1,23 +1,13 @@
 """Per-chunk computation of a study (runs in the client or on Dask workers).
 
-Everything here reuses the stability routes of :mod:`brakesqueal.analysis`,
-for any model (the route is chosen by what the model allows, as for maps):
-
-* **Closed-form route** (two coordinates, rate-free pads, silent motion
-  identically trivial on the study's axes): the generated certified Hurwitz
-  classifier of :mod:`~brakesqueal.analysis.kernels`
-  (:func:`~brakesqueal.analysis.kernels.grid_kernel`, same source and numba
-  cache as ``stability_map``): the model's closed form is specialised once
-  with *all* grid axes symbolic, the exact numerators of the quartic's
-  coefficients are polynomials in one *inner* axis whose coefficients depend
-  on the other axes; rows are evaluated in exponent-scaled floating point
-  with error bounds, and every point is classified stable / unstable /
-  uncertain.  With two axes this is the map kernel.
-* **Every point** the kernel leaves uncertain, samples, grids without a
-  kernel and every other model: the one per-point evaluator
-  :func:`~brakesqueal.analysis.points.evaluate_arrays` (closed-form robust
-  route, batched certified eigenvalue verdicts at trivial silent motions,
-  numeric linearization with the pads' states kept elsewhere).
+A chunk is a grid (or a set of samples) of the study's parameter space,
+decided by the one verdict dispatcher (:func:`brakesqueal.analysis.verdict.decide`)
+exactly as a map's block is: the grid routes where they apply (the compiled
+Hurwitz kernel of a closed form, specialised once with *all* grid axes
+symbolic; same source and numba cache as ``stability_map``), every point
+they leave by the per-point routes.  The worker builds the model's engine
+once per process (:func:`engine_of`: a chunk is an entry point, like a
+command).
 * ``margin``, ``max_real``, ``frequency`` — the least-stable eigenvalue,
   reconciled with the verdict (a stable point has ``max_real < 0``, an
   unstable one ``max_real >= 0``).
@@ -40,12 +30,11 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.kernels import grid_kernel, kernel_scaling, kernel_segments
-from ..analysis.points import closed_form_route, compact, evaluate_arrays, valid_points
+from ..analysis.verdict import Grid, Points, compact, decide
 from ..model.parameters import ParameterSpace, Value
 from ..status import PointStatus
 
-__all__ = ["ChunkSpec", "build_space", "compute_chunk", "grid_kernel", "FLOAT_QUANTITIES"]
+__all__ = ["ChunkSpec", "build_space", "compute_chunk", "engine_of", "FLOAT_QUANTITIES"]
 
 #: Float quantities and their attributes.
 FLOAT_QUANTITIES = {
@@ -175,24 +164,11 @@ def _summary(mr: np.ndarray, fr: np.ndarray) -> dict[str, np.ndarray]:
     return {"max_real": mr, "frequency": fr, "margin": margin}
 
 
-def _kernel_codes(spec: ChunkSpec, space: ParameterSpace, coords: dict[str, np.ndarray],
-                  shape: tuple[int, ...]) -> np.ndarray | None:
-    """Certified kernel codes on the chunk's grid (0/1/2, study dimension order), or None without a kernel."""
-    kern = grid_kernel(space, tuple(spec.names))
-    if kern is None:
-        return None
-    i = kern.inner
-    iv = np.asarray(coords[spec.names[i]], dtype=float)
-    scaled = kernel_scaling(kern, iv)
-    if scaled is None:
-        return None
-    others = [k for k in range(len(shape)) if k != i]
-    mesh = np.meshgrid(*[np.asarray(coords[spec.names[k]], dtype=float) for k in others], indexing="ij")
-    C, EC = kern.row_coefficients([m.ravel() for m in mesh], scaled[0])
-    seg, T = kernel_segments(scaled[1])
-    res = np.empty((C.shape[0], shape[i]), dtype=np.uint8)
-    kern.classify(C, EC, scaled[1], seg, T, res)
-    return np.moveaxis(res.reshape([shape[k] for k in others] + [shape[i]]), -1, i)
+def engine_of(space: ParameterSpace) -> Any:
+    """The engine of a study's model in this worker process (built once per model; a chunk is an entry point)."""
+    from ..codegen import build
+
+    return build(space.model)
 
 
 def compute_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -216,26 +192,27 @@ def compute_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, n
     from ..analysis.crossings import critical_speeds_many
 
     space = build_space(spec.preset, spec.values, spec.tied, spec.model)
+    engine = engine_of(space)
+    floats = [q for q in FLOAT_QUANTITIES if q in spec.quantities]
+    eig = bool(set(floats) - {"critical_speed"})
     if spec.kind == "grid":
         shape = tuple(int(np.size(coords[n])) for n in spec.names)
         nd = len(shape)
         axes = {n: np.asarray(coords[n], dtype=float).reshape([-1 if i == k else 1 for i in range(nd)])
                 for k, n in enumerate(spec.names)}
+        arr = {k: compact(v) for k, v in space.arrays(axes).items()}
+        grid = Grid(tuple(spec.names), tuple(np.asarray(coords[n], dtype=float).ravel() for n in spec.names))
+        pts = Points(space, arr, tuple(spec.names), grid=grid)
     else:
         shape = (int(np.size(coords[spec.names[0]])),)
         axes = {n: np.asarray(coords[n], dtype=float) for n in spec.names}
-    arr = {k: compact(v) for k, v in space.arrays(axes).items()}
-    closed = closed_form_route(space, tuple(spec.names))
-    floats = [q for q in FLOAT_QUANTITIES if q in spec.quantities]
-    eig = bool(set(floats) - {"critical_speed"})
-    codes = _kernel_codes(spec, space, coords, shape) if (spec.kind == "grid" and closed) else None
-    full = {k: np.broadcast_to(v, shape) for k, v in arr.items()}
-    res = evaluate_arrays(space, full, eigen=eig, codes=codes, closed=closed, valid=valid_points(space, arr))
-    stable = np.asarray(res.stable, dtype=bool)
-    status = np.asarray(res.status, dtype=np.int8)
+        pts = Points(space, space.arrays(axes), tuple(spec.names))
+    res = decide(engine, space, pts, eigen=eig)
+    stable = np.asarray(res.stable, dtype=bool).reshape(shape)
+    status = np.asarray(res.status, dtype=np.int8).reshape(shape)
     out: dict[str, np.ndarray] = {q: np.full(shape, np.nan) for q in floats}
     if eig:
-        s = _summary(res.max_real, res.frequency)
+        s = _summary(res.max_real.reshape(shape), res.frequency.reshape(shape))
         for q in floats:
             if q in s:
                 out[q][...] = s[q]
@@ -243,8 +220,8 @@ def compute_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, n
         dec = np.flatnonzero(np.isin(status, _DECIDED))
         if dec.size:
             ix = np.unravel_index(dec, shape)
-            pts = {n: np.broadcast_to(axes[n], shape)[ix] for n in spec.names}
-            roots, dirs, counts, _, cst = critical_speeds_many(space, pts, *spec.critical_speed_range,
+            at = {n: np.broadcast_to(axes[n], shape)[ix] for n in spec.names}
+            roots, dirs, counts, _, cst = critical_speeds_many(engine, space, at, *spec.critical_speed_range,
                                                                return_status=True)
             k = np.arange(roots.shape[1])
             onset = (dirs == -1) & (k[None, :] < counts[:, None])

@@ -612,11 +612,12 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
         if not 0 < crit[0] < crit[1]:
             raise ctx.err("compute.critical_speed_range", f"needs 0 < LO < HI; got {cr!r}")
     if "critical_speed" in quant:
-        from ..analysis.kernels import omega_kernel_available
+        from ..codegen import build
         from ..model.expressions import names_in
 
         spin = space.model.disk.Omega
-        if not isinstance(spin, str) or not omega_kernel_available(space.model):
+        # a study file is an entry point: its model's engine is built where the file is read
+        if not isinstance(spin, str) or not build(space.model).caps.omega_kernel:
             raise ctx.err("compute.quantities", f"'critical_speed' in sweeps needs the certified critical-speed "
                                                 f"kernel (models with two coordinates, rate-free pads and the spin "
                                                 f"as a parameter); model '{space.model.name}' has none: use "

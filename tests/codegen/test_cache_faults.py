@@ -26,7 +26,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from brakesqueal.numeric import cache
+from brakesqueal.codegen import cache
 
 PKG = Path(cache.__file__).resolve().parent.parent
 

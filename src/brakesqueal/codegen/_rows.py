@@ -105,7 +105,7 @@ def normalise_rows(C, EC, degrees, lam_e):  # type: ignore[no-untyped-def]
 
 
 def _guard() -> None:
-    from ..numeric.cache import guard_numba_caches
+    from .cache import guard_numba_caches
 
     guard_numba_caches(globals())  # a damaged or unwritable numba cache file is recompiled, never an error
 

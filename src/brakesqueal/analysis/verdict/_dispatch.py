@@ -1,0 +1,224 @@
+r"""The one verdict dispatcher: which route decides which point.
+
+:func:`decide` (parameter points) and :func:`decide_model` (one linear model)
+build a :class:`~._base.Context` and hand it to :func:`_choose`, the only
+function that chooses among the routes.  The rule is one ordered list,
+:data:`ROUTES`, cheapest first:
+
+1. ``closed-grid`` — the compiled Hurwitz kernel of a grid (closed form);
+2. ``charpoly-grid`` — certified roots of the exact characteristic
+   polynomial on a 2-D grid (any model size);
+3. ``closed-interval`` — bounded closed-form entries, interval quartic,
+   certified Routh–Hurwitz;
+4. ``closed-exact`` — the closed form in exact rational arithmetic;
+5. ``quartic-interval`` — interval quartic of numerically linearized 2x2
+   matrices;
+6. ``eigen-bounds`` — eigenvalues of the linearization with condition-number
+   bounds (any size, pads kept as states);
+7. ``extended`` — 40-digit eigenvalues with componentwise bounds (small
+   systems).
+
+Each route says whether it applies to the call (model, space, axes, input
+kind) and which pending points it can take; it returns *certified* codes.  A
+point is settled by the first route that certifies it — with ``max_real``
+wanted, only if the route's ``max_real`` has the verdict's sign (stable ⇔
+``max_real < 0``) — and the route is recorded in ``method``; every other
+point goes on to the next route, and a point no route settles is
+``UNDECIDED``.  Before the routes, the operating points are decided once
+(:mod:`._linear`: validity, triviality of the silent motion, the silent
+motions and contact), and after them the carrier of every verdict.
+
+Adding a route is one module with a :class:`~._base.Route` subclass and one
+:func:`register` call (``docs/architecture.md``).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ...status import PointStatus
+from ._base import DECIDED, STABLE, UNDECIDED, UNSTABLE, Context, Points, Route, Verdicts
+from ._linear import group_of_model, linear_groups, operating_points
+from .charpoly_grid import CharpolyGrid
+from .closed_exact import ClosedExact
+from .closed_grid import ClosedGrid
+from .closed_interval import ClosedInterval
+from .eigen_bounds import EigenBounds, excluded, state_labels
+from .extended import Extended
+from .quartic_interval import QuarticInterval
+
+if TYPE_CHECKING:
+    from ...codegen.engine import Engine
+    from ...model.parameters import ParameterSpace
+
+__all__ = ["decide", "decide_model", "ROUTES", "register", "MODES"]
+
+#: The routes, in the order the dispatcher tries them.
+ROUTES: list[Route] = [ClosedGrid(), CharpolyGrid(), ClosedInterval(), ClosedExact(), QuarticInterval(), EigenBounds(),
+                       Extended()]
+#: What a verdict judges: every eigenvalue, or the disk's modes (a massless pad's own tangential-rate mode left out).
+MODES = ("all", "disk")
+
+
+def register(route: Route, *, before: str | None = None) -> None:
+    """Add a route to :data:`ROUTES` (at the end, or before the route named ``before``).
+
+    Parameters
+    ----------
+    route : Route
+        The route (its :attr:`~._base.Route.name` must be new).
+    before : str, optional
+        The name of the route it goes before.
+
+    Raises
+    ------
+    ValueError
+        A route of that name exists, or ``before`` names none.
+    """
+    if any(r.name == route.name for r in ROUTES):
+        raise ValueError(f"a route named {route.name!r} is registered already")
+    if before is None:
+        ROUTES.append(route)
+        return
+    names = [r.name for r in ROUTES]
+    if before not in names:
+        raise ValueError(f"no route named {before!r}; routes: {', '.join(names)}")
+    ROUTES.insert(names.index(before), route)
+
+
+def _check_modes(modes: str) -> None:
+    if modes not in MODES:
+        from ...errors import ParameterError
+
+        raise ParameterError(f"modes must be one of {', '.join(MODES)}; got {modes!r}", parameter="modes")
+
+
+def decide(engine: Engine, space: ParameterSpace, points: Points, *, eigen: bool = True,
+           modes: str = "all") -> Verdicts:
+    """Statuses and certified verdicts of parameter points, each decided by the first route that can.
+
+    Parameters
+    ----------
+    engine : Engine
+        The model's engine.
+    space : ParameterSpace
+        The parameter space of the points.
+    points : Points
+        The points (broadcast arrays or a grid).
+    eigen : bool
+        Also compute ``max_real`` and the frequency where a cheaper certified verdict exists.
+    modes : {"all", "disk"}
+        Judge every eigenvalue (default), or leave out the modes carried by a massless pad's own tangential
+        rate (reported as carriers, not judged).
+
+    Returns
+    -------
+    Verdicts
+        Arrays of ``points.shape``.
+    """
+    _check_modes(modes)
+    ctx = Context(engine, space, points, points.size, eigen=eigen, modes=modes)
+    ctx.closed = bool(engine.closed_route(space, points.names)) if engine.caps.closed_form else False
+    operating_points(ctx)
+    return _choose(ctx).reshape(points.shape)
+
+
+def decide_model(lm: Any, *, eigen: bool = True, modes: str = "all") -> Verdicts:
+    """The certified verdict of one linear model (:class:`~..linear.LinearModel`).
+
+    A model from :func:`~..linear.linearize` (it carries its engine and parameters) is decided as the
+    parameter point it is, so that its verdict is the one maps, sweeps and crossings give there; a model built
+    by hand is decided from its matrices alone.
+
+    Returns
+    -------
+    Verdicts
+        Of shape ``()``.
+    """
+    _check_modes(modes)
+    engine = getattr(lm, "engine", None)
+    points = space = None
+    if engine is not None:
+        from ...model.parameters import ParameterSpace
+
+        space = ParameterSpace.from_parameters(lm.params)
+        points = Points(space, space.arrays({}))
+    ctx = Context(engine, space, points, 1, eigen=eigen, modes=modes)
+    trivial = bool(getattr(getattr(lm, "silent", None), "trivial", False))
+    ctx.status[0] = int(PointStatus.OK if trivial or engine is None else PointStatus.OK_NONTRIVIAL)
+    ctx.trivial[0] = trivial and engine is not None
+    ctx.models[0] = lm
+    g = group_of_model(lm, np.array([0]))
+    ctx.linear_cache[0] = (g, 0)
+    return _choose(ctx)
+
+
+def _consistent(code: np.ndarray, mr: np.ndarray, eigen: bool) -> np.ndarray:
+    """Codes a route certified and, with ``max_real`` wanted, whose ``max_real`` has the verdict's sign."""
+    ok = (code == STABLE) | (code == UNSTABLE)
+    if eigen:
+        with np.errstate(invalid="ignore"):
+            ok &= ((code == STABLE) & (mr < 0)) | ((code == UNSTABLE) & (mr >= 0))
+    return ok
+
+
+def _choose(ctx: Context) -> Verdicts:
+    """The one place that chooses routes: each pending point goes through :data:`ROUTES` until one settles it."""
+    pending = np.flatnonzero(np.isin(ctx.status, DECIDED))
+    methods = ("none",) + tuple(r.name for r in ROUTES)
+    for k, route in enumerate(ROUTES, start=1):
+        if pending.size == 0:
+            break
+        if not route.applies(ctx):
+            continue
+        idx = route.take(ctx, pending)
+        if idx.size == 0:
+            continue
+        res = route.run(ctx, idx)
+        alive = np.isin(ctx.status[idx], DECIDED)  # a per-point linearization may have found no silent motion
+        ok = _consistent(res.code, res.max_real, ctx.eigen) & alive
+        done = idx[ok]
+        ctx.code[done] = res.code[ok]
+        ctx.max_real[done] = res.max_real[ok]
+        ctx.frequency[done] = res.frequency[ok]
+        if res.bound is not None:
+            ctx.bound[done] = res.bound[ok]
+        if res.carrier is not None:
+            ctx.carrier[done] = res.carrier[ok]
+        ctx.method[done] = k
+        # what an undecided point's routes computed is kept for information (the first value found)
+        info = idx[~ok & alive]
+        fill = np.isnan(ctx.max_real[info])
+        ctx.max_real[info[fill]] = res.max_real[~ok & alive][fill]
+        ctx.frequency[info[fill]] = res.frequency[~ok & alive][fill]
+        pending = np.setdiff1d(pending, done, assume_unique=True)
+        pending = pending[np.isin(ctx.status[pending], DECIDED)]
+    ctx.status[pending] = int(PointStatus.UNDECIDED)
+    ctx.code[pending] = UNDECIDED
+    _carriers(ctx)
+    return Verdicts(ctx.status, ctx.code, ctx.max_real, ctx.frequency, ctx.bound, ctx.carrier.astype(np.int16),
+                    ctx.method, ctx.carriers, methods)
+
+
+def _carriers(ctx: Context) -> None:
+    """The carrier of every verdict a route left without one (the leading eigenvalue's component)."""
+    todo = np.flatnonzero(np.isin(ctx.status, DECIDED) & (ctx.carrier < 0))
+    if todo.size == 0:
+        return
+    if ctx.disk_only:
+        ctx.carrier[todo] = 0
+        return
+    from ..robust import descriptor_states, state_analysis, state_matrices
+
+    for g in linear_groups(ctx, todo):
+        if g.E is None:
+            assert g.M is not None and g.D is not None and g.K is not None
+            S, good = state_matrices(g.M, g.D, g.K)
+        else:
+            S, good = descriptor_states(g.E, g.A)  # type: ignore[arg-type]
+        sel = np.flatnonzero(good)
+        if sel.size:
+            car = state_analysis(S[sel], state_labels(ctx, g), excluded(ctx))[4]
+            ctx.carrier[g.idx[sel]] = car

@@ -1,0 +1,214 @@
+r"""The public API of the analysis: one entry point per question, for every model.
+
+Each function here is an *entry point*: it builds the model's
+:class:`~brakesqueal.codegen.engine.Engine` once (:func:`~brakesqueal.codegen.build`,
+memoized per process by the model's equations) and hands it down to the
+layer that does the work; nothing below compiles or derives anything itself.
+The same functions are re-exported by :mod:`brakesqueal` (``brakesqueal.linearize``,
+``brakesqueal.stability_map``, ...).
+
+Every verdict comes from the one verdict dispatcher
+(:func:`brakesqueal.analysis.verdict.decide`) and names the route that
+decided it and the mode that carries it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from .analysis.eigen import EigenAnalysis
+    from .analysis.equilibrium import SilentMotion
+    from .analysis.linear import LinearModel
+    from .analysis.maps import Axis, MapSummary
+    from .analysis.modes import ModeTracks
+    from .analysis.points import PointVerdict, Verdicts
+    from .codegen.engine import Engine
+    from .model.parameters import Parameters, ParameterSpace
+
+__all__ = ["engine", "silent_motion", "linearize", "pad_rate_eigenvalues", "eigen_analysis", "evaluate",
+           "evaluate_point", "stability_map", "write_map", "crossings", "critical_speeds", "critical_speeds_many",
+           "modes_along"]
+
+
+def engine(model: Any) -> Engine:
+    """The engine of a model (a :class:`~brakesqueal.model.components.ModelSpec`, a built-in model's name, a
+    model file, or anything with a ``model`` attribute: parameters, a parameter space).
+
+    Parameters
+    ----------
+    model : ModelSpec, str, Parameters or ParameterSpace
+        The model.
+
+    Returns
+    -------
+    Engine
+        Memoized per process by the model's equations.
+    """
+    from .codegen import build
+
+    return build(getattr(model, "model", model))
+
+
+def silent_motion(params: Parameters) -> SilentMotion:
+    """The silent motion (eq. 46) of a parameter set (:func:`brakesqueal.analysis.equilibrium.silent_motion`).
+
+    Parameters
+    ----------
+    params : Parameters
+        The model and its parameter values.
+
+    Returns
+    -------
+    SilentMotion
+    """
+    from .analysis.equilibrium import as_parameters
+    from .analysis.equilibrium import silent_motion as _silent_motion
+
+    params = as_parameters(params)
+    return _silent_motion(engine(params), params)
+
+
+def linearize(params: Parameters, *, pad_rates: str = "kept") -> LinearModel:
+    """Silent motion and linear model (eqs. 46-48) of a parameter set of any model.
+
+    Parameters
+    ----------
+    params : Parameters
+        The model and its parameter values.
+    pad_rates : {"kept", "quasi-static"}
+        How the massless pads' tangential rates enter (:func:`brakesqueal.analysis.linear.linearize`).
+
+    Returns
+    -------
+    LinearModel
+    """
+    from .analysis.equilibrium import as_parameters
+    from .analysis.linear import linearize as _linearize
+
+    params = as_parameters(params)
+    return _linearize(engine(params), params, pad_rates=pad_rates)
+
+
+def pad_rate_eigenvalues(params: Parameters) -> np.ndarray:
+    """Finite eigenvalues with the pads' tangential rates kept (``linearize(params).eigenvalues``)."""
+    return linearize(params).eigenvalues
+
+
+def eigen_analysis(model: Any) -> EigenAnalysis:
+    """Eigenvalues, modes, splits, sensitivities and verdict of a linear model or a parameter set.
+
+    Parameters
+    ----------
+    model : LinearModel or Parameters
+        A linear model, or a parameter set (linearized first).
+
+    Returns
+    -------
+    EigenAnalysis
+    """
+    from .analysis.eigen import eigen_analysis as _eigen
+    from .analysis.linear import LinearModel
+
+    if isinstance(model, LinearModel):
+        return _eigen(model)
+    return _eigen(linearize(model))
+
+
+def evaluate(space: ParameterSpace, values: Mapping[str, Any], *, eigen: bool = True, modes: str = "all") -> Verdicts:
+    """Statuses and certified verdicts at points of a parameter space (:func:`brakesqueal.analysis.points.evaluate`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space (any model); tied names follow the values.
+    values : Mapping[str, array_like]
+        Settable names → values (broadcastable arrays; SI units).
+    eigen : bool
+        Also compute ``max_real`` and the frequency where a cheaper certified verdict exists.
+    modes : {"all", "disk"}
+        Judge every eigenvalue, or leave out the modes of a massless pad's own tangential rate.
+
+    Returns
+    -------
+    Verdicts
+    """
+    from .analysis.points import evaluate as _evaluate
+
+    return _evaluate(engine(space), space, values, eigen=eigen, modes=modes)
+
+
+def evaluate_point(space: ParameterSpace, values: Mapping[str, float] | None = None, *,
+                   modes: str = "all") -> PointVerdict:
+    """Status and certified verdict of one point of a parameter space (default: its current point)."""
+    from .analysis.points import evaluate_point as _evaluate_point
+
+    return _evaluate_point(engine(space), space, values, modes=modes)
+
+
+def stability_map(space: ParameterSpace, x: Axis, y: Axis, *, force: bool = False, eigen: bool = True,
+                  chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None,
+                  boundary: bool = True, modes: str = "all") -> Any:
+    """A stability map over two settable parameters (:func:`brakesqueal.analysis.maps.stability_map`).
+
+    Returns
+    -------
+    StabilityMap
+    """
+    from .analysis.maps import stability_map as _map
+
+    return _map(engine(space), space, x, y, force=force, eigen=eigen, chunk_points=chunk_points, progress=progress,
+                boundary=boundary, modes=modes)
+
+
+def write_map(space: ParameterSpace, x: Axis, y: Axis, path: str, *, force: bool = False, eigen: bool = True,
+              chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None, boundary: bool = True,
+              modes: str = "all") -> MapSummary:
+    """A stability map written to NetCDF block by block (:func:`brakesqueal.analysis.maps.write_map`)."""
+    from .analysis.maps import write_map as _write
+
+    return _write(engine(space), space, x, y, path, force=force, eigen=eigen, chunk_points=chunk_points,
+                  progress=progress, boundary=boundary, modes=modes)
+
+
+def crossings(space: ParameterSpace, axis: Axis) -> Any:
+    """Every stability change along one settable parameter (:func:`brakesqueal.analysis.crossings.crossings`).
+
+    Returns
+    -------
+    CrossingResult
+    """
+    from .analysis.crossings import crossings as _crossings
+
+    return _crossings(engine(space), space, axis)
+
+
+def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5) -> Any:
+    """All onsets and re-stabilisations along Ω (:func:`brakesqueal.analysis.crossings.critical_speeds`).
+
+    Returns
+    -------
+    CriticalSpeedResult
+    """
+    from .analysis.crossings import critical_speeds as _critical
+
+    return _critical(engine(space), space, lo, hi)
+
+
+def critical_speeds_many(space: ParameterSpace, changes: dict[str, Any], lo: float = 1.0, hi: float = 1e5,
+                         max_crossings: int = 8, *, return_status: bool = False) -> tuple[Any, ...]:
+    """Critical speeds of many parameter sets, batched (:func:`brakesqueal.analysis.crossings.critical_speeds_many`)."""
+    from .analysis.crossings import critical_speeds_many as _many
+
+    return _many(engine(space), space, changes, lo, hi, max_crossings, return_status=return_status)
+
+
+def modes_along(space: ParameterSpace, name: str, start: float, stop: float, *, num: int = 200, log: bool = False,
+                pad_rates: str = "kept") -> ModeTracks:
+    """Mode-coupling diagram along one settable parameter (:func:`brakesqueal.analysis.modes.modes_along`)."""
+    from .analysis.modes import modes_along as _modes
+
+    return _modes(engine(space), space, name, start, stop, num=num, log=log, pad_rates=pad_rates)
