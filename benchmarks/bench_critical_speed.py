@@ -15,13 +15,14 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import BenchResult, best_time, emit  # noqa: E402
+from brakesqueal.codegen import build
 
 
 def run(n: int = 100000) -> list[BenchResult]:
     from scipy.optimize import brentq
 
     from brakesqueal.analysis.crossings import critical_speeds_batch
-    from brakesqueal.analysis.linear import linearize
+    from brakesqueal import linearize
     from brakesqueal.model import ParameterSpace
 
     rng = np.random.default_rng(1)
@@ -32,14 +33,14 @@ def run(n: int = 100000) -> list[BenchResult]:
     P = np.ascontiguousarray(np.stack([np.broadcast_to(v, (n,)) for v in space.vectors(arr)], axis=1))
     import numba
 
-    critical_speeds_batch(P[:10], 1.0, 1e5, spec=space.model)
-    critical_speeds_batch(P[:5000], 1.0, 1e5, spec=space.model)  # the parallel driver (chunks of sets)
-    t = best_time(lambda: critical_speeds_batch(P, 1.0, 1e5, spec=space.model), repeat=3)
+    critical_speeds_batch(build(space.model), P[:10], 1.0, 1e5)
+    critical_speeds_batch(build(space.model), P[:5000], 1.0, 1e5)  # the parallel driver (chunks of sets)
+    t = best_time(lambda: critical_speeds_batch(build(space.model), P, 1.0, 1e5), repeat=3)
     rate = n / t
     threads = numba.get_num_threads()
     numba.set_num_threads(1)
     try:
-        t1 = best_time(lambda: critical_speeds_batch(P, 1.0, 1e5, spec=space.model), repeat=3)
+        t1 = best_time(lambda: critical_speeds_batch(build(space.model), P, 1.0, 1e5), repeat=3)
     finally:
         numba.set_num_threads(threads)
     m = 5  # baseline: log-grid scan of max Re(lambda) (numeric linearization) + brentq, a few sets

@@ -12,7 +12,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import BenchResult, best_time, emit  # noqa: E402
 
-from brakesqueal.analysis.modes import modes_along  # noqa: E402
+from brakesqueal import modes_along  # noqa: E402
 from brakesqueal.model import expressions, resolve_space  # noqa: E402
 
 

@@ -17,6 +17,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import BenchResult, best_time, emit  # noqa: E402
+from brakesqueal.codegen import build
 
 
 def naive_rate(space, kip: np.ndarray, mu: np.ndarray, n: int) -> float:  # type: ignore[no-untyped-def]
@@ -37,14 +38,14 @@ def naive_rate(space, kip: np.ndarray, mu: np.ndarray, n: int) -> float:  # type
 
 
 def run(size: int = 4000, large: bool = False) -> list[BenchResult]:
-    from brakesqueal.analysis.kernels import classify_numpy, inner_exponent, kernel_segments, map_kernel
-    from brakesqueal.analysis.maps import Axis, stability_map
+    from brakesqueal.analysis.kernels import classify_numpy, inner_exponent, kernel_segments
+    from brakesqueal import Axis, stability_map
     from brakesqueal.model import ParameterSpace
 
     space = ParameterSpace.from_preset("paper-fig2")
     x, y = Axis("k_ip", 1e5, 1e10, size, True), Axis("mu", 0.05, 1.0, size)
     t0 = time.perf_counter()
-    kern = map_kernel(space, x.name, y.name)
+    kern = build(space.model).map_kernel(space, x.name, y.name)
     build = time.perf_counter() - t0
     assert kern is not None
     ax = {x.name: x, y.name: y}

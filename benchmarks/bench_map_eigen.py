@@ -20,17 +20,18 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import BenchResult, best_time, emit  # noqa: E402
+from brakesqueal.codegen import build
 
 
 def run(size: int = 2000) -> list[BenchResult]:
-    from brakesqueal.analysis.kernels import kernel_eigen, kernel_scaling, map_kernel
-    from brakesqueal.analysis.maps import Axis, stability_map
+    from brakesqueal.analysis.kernels import kernel_eigen, kernel_scaling
+    from brakesqueal import Axis, stability_map
     from brakesqueal.analysis.robust import roots_summary
     from brakesqueal.model import ParameterSpace
 
     space = ParameterSpace.from_preset("paper-fig2")
     x, y = Axis("k_ip", 1e5, 1e10, size, True), Axis("mu", 0.05, 1.0, size)
-    kern = map_kernel(space, x.name, y.name)
+    kern = build(space.model).map_kernel(space, x.name, y.name)
     assert kern is not None
     ax = {x.name: x, y.name: y}
     ov, iv = ax[kern.outer].values(), ax[kern.inner].values()

@@ -28,11 +28,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import BenchResult, best_time, emit  # noqa: E402
+from brakesqueal.codegen import build
 
 
 def run(model: str = "eight-dof", size: int = 1000) -> list[BenchResult]:
-    from brakesqueal.analysis.kernels import charpoly_table, charpoly_verdicts
-    from brakesqueal.analysis.maps import Axis, stability_map
+    from brakesqueal.analysis.kernels import charpoly_verdicts
+    from brakesqueal import Axis, stability_map
     from brakesqueal.analysis.points import evaluate_arrays
     from brakesqueal.codegen import compile_model
     from brakesqueal.model import resolve_space
@@ -48,7 +49,7 @@ def run(model: str = "eight-dof", size: int = 1000) -> list[BenchResult]:
     x, y = axes(size)
     pts = size * size
     stability_map(space, *axes(8))  # compile and warm up
-    tab = charpoly_table(space, y.name, x.name)
+    tab = build(space.model).charpoly_table(space, y.name, x.name)
     if tab is None:
         raise SystemExit(f"the characteristic-polynomial route does not apply to {model} over {names}")
     ov, iv = y.values(), x.values()
@@ -70,7 +71,7 @@ def run(model: str = "eight-dof", size: int = 1000) -> list[BenchResult]:
     sel_o, sel_i = ov[rng.integers(0, ov.size, nb)], iv[rng.integers(0, iv.size, nb)]
     arr = space.arrays({y.name: sel_o, x.name: sel_i})
     t0 = time.perf_counter()
-    evaluate_arrays(space, arr, eigen=True)
+    evaluate_arrays(build(space.model), space, arr, eigen=True)
     base = nb / (time.perf_counter() - t0)
     n2 = 2 * compile_model(spec).n
     A = rng.normal(size=(nb, n2, n2))

@@ -331,7 +331,7 @@ def bench_paper_model(*, points: int = 200, old_points: int = 20, brute_points: 
     """
     import math as _m
 
-    from brakesqueal.analysis.maps import Axis
+    from brakesqueal import Axis
     from brakesqueal.model import ParameterSpace
     from brakesqueal.nonlinear import ScipyFlow, continue_cycles, first_lyapunov
     from brakesqueal.nonlinear.compiled import model_flow
@@ -430,7 +430,7 @@ def bench_exact_pads_branch(*, points: int = 200) -> list[BenchResult]:
     -------
     list of BenchResult
     """
-    from brakesqueal.analysis.maps import Axis
+    from brakesqueal import Axis
     from brakesqueal.model import ParameterSpace
     from brakesqueal.nonlinear.harmonic import harmonic_branch
     from brakesqueal.nonlinear.models import squeal_branch

@@ -24,6 +24,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import BenchResult, best_time, emit  # noqa: E402
+from brakesqueal.codegen import build
 
 
 def run(size: int = 100, baseline_points: int = 300) -> list[BenchResult]:
@@ -37,9 +38,9 @@ def run(size: int = 100, baseline_points: int = 300) -> list[BenchResult]:
     mu = np.linspace(0.2, 0.8, size)
     arr = space.arrays({"mu1": mu[None, :], "mu2": mu[:, None]})
     P = np.stack([np.broadcast_to(v, (size, size)).ravel() for v in space.vectors(arr)], axis=1)
-    silent_motions(cm, P[:8])  # load / compile the kernel
-    t_batch = best_time(lambda: silent_motions(cm, P), repeat=3)
-    res = silent_motions(cm, P)
+    silent_motions(build(cm.spec), P[:8])  # load / compile the kernel
+    t_batch = best_time(lambda: silent_motions(build(cm.spec), P), repeat=3)
+    res = silent_motions(build(cm.spec), P)
     sub = P[np.random.default_rng(0).choice(P.shape[0], min(baseline_points, P.shape[0]), replace=False)]
     t0 = time.perf_counter()
     for p in sub:

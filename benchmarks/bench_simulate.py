@@ -76,7 +76,8 @@ def builder_rhs(params: Any) -> tuple[Callable[[float, np.ndarray], np.ndarray],
     to :mod:`math`), the quasi-static pads' ``L`` by Newton's method in NumPy,
     ``M = dR/dQddot`` from the Jacobian, ``Qddot = -M^{-1} R(Qddot = 0)``.
     """
-    from brakesqueal.analysis.equilibrium import as_parameters, silent_motion
+    from brakesqueal import silent_motion
+    from brakesqueal.analysis.equilibrium import as_parameters
     from brakesqueal.codegen import compile_model
 
     params = as_parameters(params)

@@ -14,9 +14,15 @@ import math
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.equilibrium import parameter_vector, silent_motion
-from brakesqueal.analysis.linear import linearize
-from brakesqueal.numeric.compiled import compiled_model
+from brakesqueal import silent_motion
+from brakesqueal.analysis.equilibrium import parameter_vector
+from brakesqueal import linearize
+from brakesqueal.codegen import build
+
+
+def compiled_model():
+    """The paper's compiled equations (its engine's)."""
+    return build("paper").compiled
 from brakesqueal.model import Parameters, get_model
 from brakesqueal.symbolic.model import PARAMETER_SYMBOLS, STATE_SYMBOLS
 

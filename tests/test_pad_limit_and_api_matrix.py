@@ -25,12 +25,12 @@ import pytest
 import scipy.linalg as sla
 from matplotlib.figure import Figure
 
-from brakesqueal.analysis.eigen import eigen_analysis
-from brakesqueal.analysis.linear import linearize
-from brakesqueal.analysis.maps import Axis
-from brakesqueal.analysis.modes import modes_along
-from brakesqueal.analysis.points import evaluate_point
-from brakesqueal.analysis.stability import critical_speeds, crossings, stability_map
+from brakesqueal import eigen_analysis
+from brakesqueal import linearize
+from brakesqueal import Axis
+from brakesqueal import modes_along
+from brakesqueal import evaluate_point
+from brakesqueal import critical_speeds, crossings, stability_map
 from brakesqueal.export import TARGETS, export_code
 from brakesqueal.model import MODELS, Disk, FrictionLaw, ModelSpec, Pad, ParameterSpace
 from brakesqueal.model.library import paper_parameters_full

@@ -17,9 +17,9 @@ import pytest
 import scipy.linalg
 
 from brakesqueal.analysis.boundary import stability_boundary
-from brakesqueal.analysis.crossings import crossings
-from brakesqueal.analysis.linear import linearize
-from brakesqueal.analysis.maps import Axis, stability_map, write_map
+from brakesqueal import crossings
+from brakesqueal import linearize
+from brakesqueal import Axis, stability_map, write_map
 from brakesqueal.errors import ParameterError
 from brakesqueal.model import ParameterSpace, get_model
 from brakesqueal.results import open_map, plot_map_file
@@ -151,7 +151,7 @@ def test_boundary_bad_options():
 def test_fig3_tips_close_the_squeal_region():
     """At a located tip the onset and the re-stabilisation meet: just inside both exist and are close to the
     tip's speed, just outside the silent motion is stable on the whole range (exact critical speeds)."""
-    from brakesqueal.analysis.crossings import critical_speeds_many
+    from brakesqueal import critical_speeds_many
     from brakesqueal.reproduce import fig3_tips
 
     space = ParameterSpace.from_preset("paper-fig3", {"k_ip": math.inf})
@@ -177,8 +177,8 @@ def test_fig3_tips_close_the_squeal_region():
 def test_points_on_the_boundary_get_one_verdict_everywhere(kip):
     """At the float nearest an exact crossing (and its neighbours) linearize, eigen-analysis, the per-point
     evaluator and a map report the same verdict."""
-    from brakesqueal.analysis.eigen import eigen_analysis
-    from brakesqueal.analysis.points import evaluate_point
+    from brakesqueal import eigen_analysis
+    from brakesqueal import evaluate_point
 
     space = ParameterSpace.from_preset("paper-fig2", {"k_ip": kip})
     r = crossings(space, Axis("mu", 0.05, 1.0))

@@ -16,9 +16,9 @@ import sys
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.crossings import critical_speeds, crossings
-from brakesqueal.analysis.linear import linearize
-from brakesqueal.analysis.maps import Axis, stability_map
+from brakesqueal import critical_speeds, crossings
+from brakesqueal import linearize
+from brakesqueal import Axis, stability_map
 from brakesqueal.model import ParameterSpace, get_model, model_to_toml, resolve_space
 
 

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.eigen import eigen_analysis
-from brakesqueal.analysis.linear import LinearModel, linearize, state_matrix
+from brakesqueal import eigen_analysis
+from brakesqueal import linearize
+from brakesqueal.analysis.linear import LinearModel, state_matrix
 from brakesqueal.model import get_preset
 
 

@@ -15,7 +15,7 @@ import math
 import pytest
 import sympy as sp
 
-from brakesqueal.analysis.crossings import critical_speeds
+from brakesqueal import critical_speeds
 from brakesqueal.model.parameters import ParameterSpace
 
 BASE = {"mu1": "0.6", "mu2": "0.4", "k_ip": "1e8", "h": "0.02", "r": "0.13", "k_t": "1.88e7", "d_t": "0.1",
@@ -91,8 +91,8 @@ def test_a_range_past_omegas_bound_is_undecided_there_and_agrees_with_crossings(
     # critical-speed routes and `crossings` must list that piece as undecided and agree on everything else.
     import numpy as np
 
-    from brakesqueal.analysis.crossings import critical_speeds_many, crossings
-    from brakesqueal.analysis.maps import Axis
+    from brakesqueal import critical_speeds_many, crossings
+    from brakesqueal import Axis
     from brakesqueal.status import PointStatus
 
     space = ParameterSpace.from_preset(preset)
@@ -122,7 +122,7 @@ def test_verdict_line_and_listed_eigenvalues_agree_at_extreme_values():
     import numpy as np
 
     from brakesqueal import linearize, resolve_space
-    from brakesqueal.analysis.eigen import eigen_analysis
+    from brakesqueal import eigen_analysis
     from brakesqueal.analysis.robust import charpoly_exact
 
     rng = np.random.default_rng(27)

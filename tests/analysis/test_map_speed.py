@@ -16,9 +16,10 @@ import sys
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.maps import Axis, stability_map, write_map
+from brakesqueal import Axis, stability_map, write_map
 from brakesqueal.model.parameters import ParameterSpace
 from brakesqueal.status import PointStatus
+from brakesqueal.codegen import build
 
 SRC = os.path.join(os.path.dirname(__file__), os.pardir, os.pardir, "src")
 
@@ -29,7 +30,7 @@ def _state_eigenvalues(space, names, a, b):
 
     arr = space.arrays({names[0]: a, names[1]: b})
     P = np.stack([np.broadcast_to(v, a.shape) for v in space.vectors(arr)], axis=1)
-    E, _ = trivial_entries(P, space.model)
+    E, _ = trivial_entries(build(space.model), P)
     M, D, K = E[:, 0:4].reshape(-1, 2, 2), E[:, 4:8].reshape(-1, 2, 2), E[:, 8:12].reshape(-1, 2, 2)
     S = np.zeros((a.size, 4, 4))
     S[:, 0:2, 2:4] = np.eye(2)
@@ -89,12 +90,12 @@ def test_map_max_real_and_frequency_against_lapack(seed):
 @pytest.mark.parametrize("seed", range(4))
 def test_kernel_eigen_fast_route_against_lapack(seed):
     """The compiled route itself (before any fallback) finds almost every point and agrees with LAPACK."""
-    from brakesqueal.analysis.kernels import kernel_eigen, kernel_scaling, map_kernel
+    from brakesqueal.analysis.kernels import kernel_eigen, kernel_scaling
 
     rng = np.random.default_rng(9200 + seed)
     space = ParameterSpace.from_preset("paper-fig2")
     x, y = _random_axes(rng)
-    kern = map_kernel(space, x.name, y.name)
+    kern = build(space.model).map_kernel(space, x.name, y.name)
     assert kern is not None
     ax = {x.name: x, y.name: y}
     ov, iv = ax[kern.outer].values(), ax[kern.inner].values()

@@ -8,7 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.modes import modes_along, track_modes
+from brakesqueal import modes_along
+from brakesqueal.analysis.modes import track_modes
 from brakesqueal.cli import main
 from brakesqueal.model import resolve_space
 
@@ -41,8 +42,8 @@ def test_tracks_are_continuous_through_a_crossing_of_frequencies():
 
 
 def test_paper_crossings_agree_with_the_exact_route():
-    from brakesqueal.analysis.crossings import crossings
-    from brakesqueal.analysis.maps import Axis
+    from brakesqueal import crossings
+    from brakesqueal import Axis
     from brakesqueal.model import ParameterSpace
 
     tr = modes_along(resolve_space(preset="paper-fig2", sets=["mu=0.5"]), "k_ip", 1e5, 1e10, num=120, log=True)
@@ -72,7 +73,7 @@ def test_a_path_on_which_the_pads_states_come_and_go():
     motion keeps no pad state, elsewhere both pads' rates are kept (2n + 2 first-order states).  The tracking
     compared vectors of different lengths and raised a NumPy ValueError (found through the explorer's root
     locus); it now compares their shared mechanical part, and every path point's eigenvalues are on a track."""
-    from brakesqueal.analysis.linear import linearize
+    from brakesqueal import linearize
 
     space = resolve_space(None, "paper-fig3", None, ["h10=0.012"])
     values = np.linspace(0.0, 1.2, 60)

@@ -16,12 +16,11 @@ import numpy as np
 
 from brakesqueal.analysis import _compiled
 from brakesqueal.analysis.crossings import critical_speeds_batch, exact_omega_crossings
-from brakesqueal.analysis.kernels import (
-    CHARPOLY_ACCURACY, charpoly_table, charpoly_verdicts, omega_entries, omega_subranges,
-)
-from brakesqueal.analysis.maps import Axis
+from brakesqueal.analysis.kernels import CHARPOLY_ACCURACY, charpoly_verdicts, omega_entries, omega_subranges
+from brakesqueal import Axis
 from brakesqueal.analysis.robust import UNDECIDED
 from brakesqueal.model import ParameterSpace, resolve_space
+from brakesqueal.codegen import build
 
 
 def test_critical_speeds_parallel_equals_serial_and_exact():
@@ -32,8 +31,8 @@ def test_critical_speeds_parallel_equals_serial_and_exact():
     space = ParameterSpace.from_preset("paper-fig3")
     arr = space.arrays({"mu1": mu1, "mu2": 1 - mu1, "k_ip": kip})
     P = np.ascontiguousarray(np.stack([np.broadcast_to(v, (n,)) for v in space.vectors(arr)], axis=1))
-    roots, dirs, counts, start = critical_speeds_batch(P, 1.0, 1e5, spec=space.model)
-    E, R = omega_entries(P, space.model)
+    roots, dirs, counts, start = critical_speeds_batch(build(space.model), P, 1.0, 1e5)
+    E, R = omega_entries(build(space.model), P)
     r2 = np.full((n, 8), np.nan)
     d2 = np.zeros((n, 8), dtype=np.int8)
     c2 = np.zeros(n, dtype=np.int64)
@@ -47,7 +46,7 @@ def test_critical_speeds_parallel_equals_serial_and_exact():
     np.testing.assert_array_equal(start, s2)
     assert (counts == 2).sum() > n // 2
     for i in rng.choice(n, 4, replace=False):
-        st, found, undecided = exact_omega_crossings(P[i], 1.0, 1e5, space.model)
+        st, found, undecided = exact_omega_crossings(build(space.model), P[i], 1.0, 1e5)
         assert not undecided and bool(st) == bool(start[i]) and len(found) == counts[i]
         for k, (v, d) in enumerate(found):
             assert abs(roots[i, k] / v - 1) <= 1e-10
@@ -56,7 +55,7 @@ def test_critical_speeds_parallel_equals_serial_and_exact():
 
 def test_charpoly_blocks_equal_serial_sweep_for_any_thread_count():
     space = resolve_space("eight-dof")
-    tab = charpoly_table(space, "k_cn", "k_c")
+    tab = build(space.model).charpoly_table(space, "k_cn", "k_c")
     assert tab is not None
     ov = Axis("k_cn", 5e6, 5e8, 150, log=True).values()
     iv = Axis("k_c", 1e8, 1e10, 40, log=True).values()
@@ -84,11 +83,11 @@ def test_charpoly_blocks_equal_serial_sweep_for_any_thread_count():
 
 
 def test_quartic_roots_blocks_equal_serial_for_any_thread_count():
-    from brakesqueal.analysis.kernels import kernel_eigen, kernel_scaling, map_kernel
+    from brakesqueal.analysis.kernels import kernel_eigen, kernel_scaling
 
     space = ParameterSpace.from_preset("paper-fig2")
     x, y = Axis("k_ip", 1e5, 1e10, 90, True), Axis("mu", 0.05, 1.0, 300)
-    kern = map_kernel(space, x.name, y.name)
+    kern = build(space.model).map_kernel(space, x.name, y.name)
     assert kern is not None
     ax = {x.name: x, y.name: y}
     ov, iv = ax[kern.outer].values(), ax[kern.inner].values()

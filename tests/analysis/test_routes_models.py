@@ -20,9 +20,9 @@ import mpmath
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.crossings import critical_speeds, crossings
-from brakesqueal.analysis.linear import linearize
-from brakesqueal.analysis.maps import Axis, stability_map
+from brakesqueal import critical_speeds, crossings
+from brakesqueal import linearize
+from brakesqueal import Axis, stability_map
 from brakesqueal.errors import BrakesquealError
 from brakesqueal.model import MODELS, ParameterSpace, resolve_space
 
@@ -262,7 +262,7 @@ def test_grouped_validity_equals_the_roles_table(model):
 
 def test_critical_speeds_many_batches_trivial_sets_and_routes_the_others_point_by_point():
     """Sets with a trivial silent motion go through the compiled kernel, the others through critical_speeds."""
-    from brakesqueal.analysis.crossings import critical_speeds_many
+    from brakesqueal import critical_speeds_many
     from brakesqueal.status import PointStatus
 
     space = resolve_space("paper", sets={"k_ip1": "inf", "k_ip2": "inf"})

@@ -18,12 +18,12 @@ import numpy as np
 import pytest
 
 from brakesqueal.analysis import points as pts
-from brakesqueal.analysis.equilibrium import (
-    _continuation, _newton, _System, silent_motion, silent_motion_vector, silent_motions,
-)
+from brakesqueal import silent_motion
+from brakesqueal.analysis.equilibrium import _continuation, _newton, _System, silent_motion_vector, silent_motions
 from brakesqueal.codegen import compile_model
 from brakesqueal.model import Parameters, get_model, resolve_space
 from brakesqueal.status import PointStatus
+from brakesqueal.codegen import build
 
 ref = pytest.importorskip("tests.reference.newton_euler")
 
@@ -62,8 +62,8 @@ def test_paper_model_random_grids_cross_failures_and_hand_over():
                  N0=10 ** rng.uniform(1, 4), k_ip1=10 ** rng.uniform(5, 9), k_ip2=10 ** rng.uniform(5, 9))
         rows.append([float(v) for v in Parameters(spec, d).vector()])
     P = np.array(rows)
-    a = silent_motions(cm, P)
-    b = silent_motions(cm, P, compiled=False)
+    a = silent_motions(build(cm.spec), P)
+    b = silent_motions(build(cm.spec), P, compiled=False)
     assert _same(a, b) <= 1e-10
     st = set(np.unique(a.status).tolist())
     assert int(PointStatus.OK_NONTRIVIAL) in st and int(PointStatus.NO_SILENT_MOTION) in st  # crosses folds
@@ -75,8 +75,8 @@ def test_paper_fig3_map_grid_untied():
     space = resolve_space(preset="paper-fig3", sets={"h10": 0.012})
     mu = np.linspace(0.05, 1.0, 23)
     P = _rows(space, {"mu1": np.repeat(mu, 23), "mu2": np.tile(mu, 23)})
-    a = silent_motions(space.model, P)
-    b = silent_motions(space.model, P, compiled=False)
+    a = silent_motions(build(space.model), P)
+    b = silent_motions(build(space.model), P, compiled=False)
     assert _same(a, b) <= 1e-10
     # the tie mu1 h10 = mu2 h20 holds at some grid points' neighbourhood only: the trivial ones are decided exactly
     assert np.all(a.q0[a.trivial] == 0.0)
@@ -91,8 +91,8 @@ def test_built_models_with_nontrivial_silent_motions(model, n):
     if "mu1" not in space.settable():
         vals = {"mu": rng.uniform(0.05, 1.5, n), "h10": rng.uniform(0.001, 0.06, n), "k_t": 10 ** rng.uniform(2, 7, n)}
     P = _rows(space, vals)
-    a = silent_motions(space.model, P)
-    b = silent_motions(space.model, P, compiled=False)
+    a = silent_motions(build(space.model), P)
+    b = silent_motions(build(space.model), P, compiled=False)
     assert _same(a, b) <= 1e-10
     assert np.count_nonzero((a.status == int(PointStatus.OK_NONTRIVIAL)) & (a.handover == 0)) > n // 4
 
@@ -103,7 +103,7 @@ def test_accepted_points_satisfy_the_independent_equations():
     rng = np.random.default_rng(7)
     ps = [Parameters(spec, dict(SOFT, mu1=rng.uniform(0.1, 1.0), h10=rng.uniform(0.002, 0.05))) for _ in range(6)]
     P = np.array([[float(v) for v in p.vector()] for p in ps])
-    a = silent_motions(spec, P)
+    a = silent_motions(build(spec), P)
     assert np.all(a.handover == 0)
     from brakesqueal.symbolic.model import PARAMETER_SYMBOLS, STATE_SYMBOLS
 
@@ -154,7 +154,7 @@ def test_evaluate_arrays_batched_equals_per_point(model, preset, sets, axes, mon
     xv = np.sort(rng.uniform(x0, x1, nx))
     yv = np.sort(rng.uniform(y0, y1, ny))
     arr = space.arrays({xn: xv[None, :], yn: yv[:, None]})
-    silent_motions(space.model, _rows(space, {xn: xv[:2]}))  # the kernel compiled: small grids take the batch too
+    silent_motions(build(space.model), _rows(space, {xn: xv[:2]}))  # the kernel compiled: small grids take the batch too
     calls = []
     per_point = pts._nontrivial_point
     monkeypatch.setattr(pts, "_nontrivial_point", lambda *a: calls.append(a) or per_point(*a))
@@ -206,7 +206,7 @@ def test_near_the_trivial_line_no_false_failure(mu1, h20):
     P = np.stack([np.broadcast_to(v, (1,)) for v in space.vectors(arr)], axis=1)
     cm = compile_model(space.model)
     sm = silent_motion_vector(cm, [float(v) for v in P[0]])
-    a = silent_motions(cm, P)
+    a = silent_motions(build(cm.spec), P)
     assert a.status[0] == int(PointStatus.OK_NONTRIVIAL) and a.handover[0] == 0
     assert abs(a.q0[0, 1] - sm.q0[1]) <= 1e-10 * abs(sm.q0[1])
     state = [*sm.q0, 0, 0, 0, 0, *sm.l0, 0, 0]
@@ -230,7 +230,7 @@ def test_why_no_warm_start_from_the_neighbour():
     cm = compile_model(base.model)
     kts = np.logspace(np.log10(1.26e4), 3, 6)
     P = np.array([[float(v) for v in base.replace(k_t=kt).vector()] for kt in kts])
-    a = silent_motions(cm, P)
+    a = silent_motions(build(cm.spec), P)
     assert a.status[0] == int(PointStatus.OK_NONTRIVIAL)
     assert np.all(a.status[1:] == int(PointStatus.NO_SILENT_MOTION))
     prev = a.z[0]

@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 from scipy.optimize import root
 
-from brakesqueal.analysis.equilibrium import parameter_vector, silent_motion
+from brakesqueal import silent_motion
+from brakesqueal.analysis.equilibrium import parameter_vector
 from brakesqueal.model import Parameters, get_model
 from brakesqueal.symbolic.model import PARAMETER_SYMBOLS, STATE_SYMBOLS
 

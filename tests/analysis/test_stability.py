@@ -13,13 +13,15 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from brakesqueal.analysis.crossings import critical_speeds, critical_speeds_batch, crossings
-from brakesqueal.analysis.kernels import map_kernel, real_roots
-from brakesqueal.analysis.linear import linearize
-from brakesqueal.analysis.maps import Axis, stability_map
+from brakesqueal import critical_speeds, crossings
+from brakesqueal.analysis.crossings import critical_speeds_batch
+from brakesqueal.analysis.kernels import real_roots
+from brakesqueal import linearize
+from brakesqueal import Axis, stability_map
 from brakesqueal.analysis.equilibrium import parameter_vector
 from brakesqueal.model import ParameterSpace
 from brakesqueal.errors import ParameterError
+from brakesqueal.codegen import build
 
 FIG2 = ParameterSpace.from_preset("paper-fig2")
 
@@ -39,7 +41,7 @@ def test_real_roots_against_numpy():
 
 
 def test_map_kernel_matches_eigenvalues_on_random_points():
-    kern = map_kernel(FIG2, "k_ip", "mu")
+    kern = build(FIG2.model).map_kernel(FIG2, "k_ip", "mu")
     assert kern is not None
     rng = np.random.default_rng(0)
     kip = 10 ** rng.uniform(5, 10, 120)
@@ -61,7 +63,7 @@ def test_points_just_off_the_boundary():
         vals = [f(k) for k in grid]
         roots = [brentq(f, a, b, rtol=1e-14) for a, b, fa, fb in zip(grid, grid[1:], vals, vals[1:]) if fa * fb < 0]
         assert roots
-        kern = map_kernel(space, "k_ip", "mu")
+        kern = build(space.model).map_kernel(space, "k_ip", "mu")
         for k0 in roots:
             ks = np.array([k0 * (1 - 1e-7), k0 * (1 + 1e-7)])
             m = stability_map(space, Axis("k_ip", ks[0], ks[1], 2, True), Axis("mu", mu, mu * (1 + 1e-12), 2))
@@ -188,7 +190,7 @@ def test_critical_speed_batch_equals_single_and_fallback():
     mus = [0.5, 0.6, 0.7]
     spaces = [ParameterSpace.from_preset("paper-fig3", {"mu1": m, "mu2": 1 - m}) for m in mus]
     P = np.array([parameter_vector(s.resolve({})) for s in spaces])
-    roots, dirs, counts, start = critical_speeds_batch(P, 1.0, 1e5)
+    roots, dirs, counts, start = critical_speeds_batch(build('paper'), P, 1.0, 1e5)
     for i, s in enumerate(spaces):
         numeric = crossings(s, Axis("Omega", 1.0, 1e5, 2, True))  # independent: sympy polynomial path
         assert counts[i] == len(numeric.crossings)

@@ -25,7 +25,7 @@ import pytest
 from brakesqueal import linearize, resolve_space
 from brakesqueal.analysis.equilibrium import parameter_vector
 from brakesqueal.analysis.linear import accurate_jacobian
-from brakesqueal.analysis.maps import Axis, stability_map
+from brakesqueal import Axis, stability_map
 from brakesqueal.analysis.points import linear_verdict
 from brakesqueal.analysis.robust import STABLE, UNDECIDED, UNSTABLE
 from brakesqueal.codegen import compile_model

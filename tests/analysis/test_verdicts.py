@@ -26,10 +26,11 @@ import mpmath
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.crossings import critical_speeds, critical_speeds_batch, crossings, exact_omega_crossings
+from brakesqueal import critical_speeds, crossings
+from brakesqueal.analysis.crossings import critical_speeds_batch, exact_omega_crossings
 from brakesqueal.analysis.equilibrium import parameter_vector
-from brakesqueal.analysis.kernels import map_kernel
-from brakesqueal.analysis.maps import STATUS, Axis, stability_map
+from brakesqueal import Axis, stability_map
+from brakesqueal.analysis.maps import STATUS
 from brakesqueal.analysis.robust import (
     STABLE, UNDECIDED, UNSTABLE, eigen_verdicts, isolate_real_roots, isolate_real_roots_float, routh_exact,
     routh_verdicts,
@@ -37,6 +38,7 @@ from brakesqueal.analysis.robust import (
 from brakesqueal.errors import BrakesquealError
 from brakesqueal.model import ParameterSpace
 from brakesqueal.sweep.compute import build_space
+from brakesqueal.codegen import build
 
 pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")
 
@@ -283,9 +285,9 @@ def test_critical_speed_batch_kernel_equals_exact_isolation():
         P.append(parameter_vector(prm))
     P = np.array(P)
     for lo, hi in [(1.0, 1e5), (1e-3, 1e9), (1e-30, 1e30)]:
-        roots, dirs, counts, start, status = critical_speeds_batch(P, lo, hi, 16, return_status=True)
+        roots, dirs, counts, start, status = critical_speeds_batch(build('paper'), P, lo, hi, 16, return_status=True)
         for i in range(len(P)):
-            st, found, und = exact_omega_crossings(P[i], lo, hi)
+            st, found, und = exact_omega_crossings(build('paper'), P[i], lo, hi)
             assert not und and status[i] == 0
             assert counts[i] == len(found) and bool(start[i]) == st
             for k, (v, d) in enumerate(found):
@@ -301,7 +303,7 @@ def test_critical_speed_batch_kernel_equals_exact_isolation():
 ])
 def test_built_model_maps_against_mpmath_eigenvalues(model, x, y):
     """Every built-in model: certified verdicts vs mpmath eigenvalues of the model's own M, D, K (40 digits)."""
-    from brakesqueal.analysis.linear import linearize
+    from brakesqueal import linearize
     from brakesqueal.model import resolve_space
 
     space = resolve_space(model)
@@ -530,7 +532,7 @@ def test_map_kernel_has_no_axis_sign_assumption(preset, tied, x, y, xr, yr):
     from brakesqueal.analysis.robust import exact_trivial_entries
 
     space = build_space(preset, (), tied)
-    k = map_kernel(space, x, y)
+    k = build(space.model).map_kernel(space, x, y)
     assert k is not None
     ax = {x: np.linspace(*xr, 9), y: np.linspace(*yr, 8)}
     o, i = ax[k.outer], ax[k.inner]
@@ -544,7 +546,7 @@ def test_map_kernel_has_no_axis_sign_assumption(preset, tied, x, y, xr, yr):
             p = [float(v[a, b]) for v in vec]
             if not all(math.isfinite(v) for v in p):
                 continue
-            e = exact_trivial_entries(p, space.model)
+            e = exact_trivial_entries(build(space.model), p)
             q = [e[8] * e[11] - e[9] * e[10],
                  e[4] * e[11] + e[8] * e[7] - e[5] * e[10] - e[9] * e[6],
                  e[0] * e[11] + e[4] * e[7] + e[8] * e[3] - e[1] * e[10] - e[5] * e[6] - e[9] * e[2],

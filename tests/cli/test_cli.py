@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from brakesqueal.analysis.linear import linearize
+from brakesqueal import linearize
 from brakesqueal.model import get_preset
 
 

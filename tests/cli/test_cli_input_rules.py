@@ -11,7 +11,8 @@ import warnings
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.maps import Axis, MapSummary, resolution_problem
+from brakesqueal import Axis
+from brakesqueal.analysis.maps import MapSummary, resolution_problem
 from brakesqueal.cli import main
 from brakesqueal.errors import ParameterError
 from brakesqueal.results import CriticalSpeedResult

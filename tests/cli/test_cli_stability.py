@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from brakesqueal.cli import main
-from brakesqueal.analysis.linear import linearize
+from brakesqueal import linearize
 from brakesqueal.model import get_preset
 from brakesqueal.results import open_map
 
@@ -115,7 +115,8 @@ def test_map_no_eigen_leaves_the_eigenvalue_variables_out(tmp_path, capsys):
 ])
 def test_map_of_any_model_uses_the_shared_options(tmp_path, capsys, model, args):
     """--model/--set are resolved like everywhere else: the map equals stability_map on resolve_space."""
-    from brakesqueal.analysis.maps import parse_axis, stability_map
+    from brakesqueal import stability_map
+    from brakesqueal.analysis.maps import parse_axis
     from brakesqueal.model import resolve_space
 
     nc = tmp_path / "m.nc"

@@ -213,7 +213,7 @@ def test_limit_cycles_end_at_the_contact_loss(page):
     s = page.wait(lambda s: "cycles" in s, timeout=900)
     assert "error" not in s["cycles"], s["cycles"]
     from brakesqueal import resolve_space
-    from brakesqueal.analysis.maps import Axis
+    from brakesqueal import Axis
     from brakesqueal.explorer.state import slider_range
     from brakesqueal.nonlinear.models import hopf_points
 

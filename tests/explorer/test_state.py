@@ -144,7 +144,7 @@ def test_non_loopback_host_warns():
 def test_hopf_line_names_the_predicted_lift_off_and_drops_the_amplitude_beyond_it():
     # found in review: at mu = 0.5 the line gave an amplitude "here" although `brakesqueal hopf` predicts the
     # pads lift off at mu = 0.41027, beyond which the normal form of the bilateral equations does not hold
-    from brakesqueal.analysis.maps import Axis
+    from brakesqueal import Axis
     from brakesqueal.explorer.state import SliderRange, hopf_scan, hopf_text
     from brakesqueal.nonlinear.models import hopf_points
 
@@ -165,7 +165,7 @@ def test_critical_speed_line_says_unstable_at_start(tmp_path):
     import re
     from pathlib import Path
 
-    from brakesqueal.analysis.crossings import critical_speeds
+    from brakesqueal import critical_speeds
     from brakesqueal.explorer.state import critical_speed_text
     from brakesqueal.model import load_model
 

@@ -44,8 +44,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.equilibrium import silent_motion
-from brakesqueal.analysis.linear import linearize
+from brakesqueal import silent_motion
+from brakesqueal import linearize
 from brakesqueal.cli import main
 from brakesqueal.codegen import compile_model
 from brakesqueal.errors import ParameterError

@@ -11,7 +11,7 @@ import tomllib
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.linear import linearize
+from brakesqueal import linearize
 from brakesqueal.errors import ParameterError
 from brakesqueal.model import MODELS, Caliper, Disk, FrictionLaw, ModelSpec, Pad, get_model, model_to_toml, spec_from_dict
 

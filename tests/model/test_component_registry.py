@@ -27,7 +27,7 @@ import pytest
 import numpy as np
 import symengine as se
 
-from brakesqueal.analysis.linear import linearize
+from brakesqueal import linearize
 from brakesqueal.errors import ParameterError
 from brakesqueal.model import io as model_io
 from brakesqueal.model.components import COMPONENTS, Kind, ModelSpec, Pad, Value, attribute, param

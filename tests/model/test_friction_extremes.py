@@ -33,8 +33,9 @@ import mpmath
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.linear import linearize
-from brakesqueal.analysis.points import evaluate_point, linear_verdict
+from brakesqueal import linearize
+from brakesqueal import evaluate_point
+from brakesqueal.analysis.points import linear_verdict
 from brakesqueal.analysis.robust import STABLE, UNDECIDED, UNSTABLE
 from brakesqueal.cli import main
 from brakesqueal.codegen import compile_model

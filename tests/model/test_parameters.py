@@ -17,7 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from brakesqueal.errors import ParameterError
-from brakesqueal.expressions import (
+from brakesqueal.model.expressions import (
     CONSTANTS,
     FUNCTIONS,
     dependency_order,
@@ -71,7 +71,7 @@ def compliances(p: Parameters) -> tuple[float, float]:
 
 def trivial(p: Parameters) -> bool:
     """Whether the silent motion is the zero state (eq. 49), from the package's silent-motion solver."""
-    from brakesqueal.analysis.equilibrium import silent_motion
+    from brakesqueal import silent_motion
 
     return silent_motion(p).trivial
 
@@ -499,14 +499,6 @@ def test_resolve_parameters_combinations(tmp_path: Path) -> None:
         resolve_parameters(sets=["mu"])
     full = write(tmp_path, parameters_to_toml(make()), "full.toml")
     assert resolve_parameters(params=full, sets=["mu1=0.1"]) == make(mu1=0.1)
-
-
-def test_the_parameters_alias_re_exports_the_model_names() -> None:
-    import brakesqueal.parameters as alias
-    from brakesqueal import model
-
-    assert alias.Parameters is model.Parameters and alias.get_preset is model.get_preset
-    assert alias.resolve_parameters is model.resolve_parameters and alias.Preset is model.Preset
 
 
 # ------------------------------------------------------------------------ properties

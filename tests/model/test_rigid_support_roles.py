@@ -24,8 +24,9 @@ import math
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.linear import linearize
-from brakesqueal.analysis.points import evaluate, evaluate_point, linear_verdict, valid_points
+from brakesqueal import linearize
+from brakesqueal import evaluate, evaluate_point
+from brakesqueal.analysis.points import linear_verdict, valid_points
 from brakesqueal.analysis.robust import STABLE, UNDECIDED, UNSTABLE
 from brakesqueal.cli import main
 from brakesqueal.errors import ParameterError

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from _nl_systems import bautin
 
-from brakesqueal.analysis.maps import Axis
+from brakesqueal import Axis
 from brakesqueal.errors import ParameterError
 from brakesqueal.model.parameters import ParameterSpace
 from brakesqueal.nonlinear import continue_cycles, find_periodic_orbit, first_lyapunov

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.maps import Axis
+from brakesqueal import Axis
 from brakesqueal.cli import main
 from brakesqueal.errors import ParameterError
 from brakesqueal.model import MODELS, get_model

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.maps import Axis
+from brakesqueal import Axis
 from brakesqueal.model import ParameterSpace
 from brakesqueal.nonlinear import find_periodic_orbit
 from brakesqueal.nonlinear.models import model_system, squeal_branch

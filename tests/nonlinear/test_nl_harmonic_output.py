@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from brakesqueal.analysis.maps import Axis
+from brakesqueal import Axis
 from brakesqueal.cli import main
 from brakesqueal.model.options import resolve_space
 from brakesqueal.nonlinear.harmonic import harmonic_branch

@@ -19,7 +19,7 @@ import math
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.maps import Axis
+from brakesqueal import Axis
 from brakesqueal.cli import main
 from brakesqueal.model import MODELS, ParameterSpace
 from brakesqueal.model.io import model_to_toml

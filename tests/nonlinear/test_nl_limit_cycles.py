@@ -10,7 +10,7 @@ import math
 
 import pytest
 
-from brakesqueal.analysis.maps import Axis
+from brakesqueal import Axis
 from brakesqueal.errors import ParameterError
 from brakesqueal.model.parameters import ParameterSpace
 from brakesqueal.nonlinear.harmonic import HarmonicBranch, harmonic_branch

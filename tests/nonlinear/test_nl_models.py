@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from brakesqueal.analysis.linear import linearize
-from brakesqueal.analysis.maps import Axis
+from brakesqueal import linearize
+from brakesqueal import Axis
 from brakesqueal.cli import main
 from brakesqueal.model import MODELS, ParameterSpace
 from brakesqueal.nonlinear import find_periodic_orbit

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.maps import Axis
+from brakesqueal import Axis
 from brakesqueal.model.options import damped_pads, resolve_space
 from brakesqueal.nonlinear.harmonic import harmonic_branch
 from brakesqueal.nonlinear.models import squeal_branch

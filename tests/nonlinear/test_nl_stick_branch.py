@@ -14,7 +14,7 @@ import json
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.maps import Axis
+from brakesqueal import Axis
 from brakesqueal.cli import main
 from brakesqueal.errors import ParameterError
 from brakesqueal.model.options import resolve_space

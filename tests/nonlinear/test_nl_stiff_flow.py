@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.maps import Axis
+from brakesqueal import Axis
 from brakesqueal.errors import ParameterError
 from brakesqueal.model.options import damped_pads, resolve_space
 from brakesqueal.nonlinear import PiecewiseSystem, ScipyFlow, SmoothSystem, Transition

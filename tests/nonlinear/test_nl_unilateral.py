@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.maps import Axis
+from brakesqueal import Axis
 from brakesqueal.model import ParameterSpace
 from brakesqueal.nonlinear import find_periodic_orbit
 from brakesqueal.nonlinear.models import _duty_cycle, hopf_points, model_piecewise_system, model_system

@@ -106,7 +106,7 @@ def test_compiled_parameter_derivative(preset, overrides, name):
 
 def test_branch_with_compiled_jacobian_equals_python_route():
     """The limit-cycle branch of the paper's model: compiled flow (generated Jacobian) vs ScipyFlow (Python)."""
-    from brakesqueal.analysis.maps import Axis
+    from brakesqueal import Axis
     from brakesqueal.nonlinear import ScipyFlow, continue_cycles
     from brakesqueal.nonlinear.compiled import model_flow
     from brakesqueal.nonlinear.models import hopf_points, model_system

@@ -9,7 +9,7 @@ import wave
 import numpy as np
 import pytest
 
-from brakesqueal.analysis.linear import linearize
+from brakesqueal import linearize
 from brakesqueal.errors import ParameterError
 from brakesqueal.model import get_preset
 from brakesqueal.simulation import simulate

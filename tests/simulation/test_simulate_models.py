@@ -30,7 +30,7 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from brakesqueal.analysis.linear import linearize
+from brakesqueal import linearize
 from brakesqueal.cli import main
 from brakesqueal.model.components import Disk, FrictionLaw, ModelSpec, Pad
 from brakesqueal.model.library import paper_parameters_full

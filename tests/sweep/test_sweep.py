@@ -14,7 +14,8 @@ xr = pytest.importorskip("xarray")
 pytest.importorskip("zarr")
 pytest.importorskip("dask")
 
-from brakesqueal.analysis.stability import ParameterSpace, critical_speeds, parse_axis, stability_map  # noqa: E402
+from brakesqueal import critical_speeds, stability_map
+from brakesqueal.analysis.stability import ParameterSpace, parse_axis  # noqa: E402
 from brakesqueal.cli import main  # noqa: E402
 from brakesqueal.errors import ParameterError  # noqa: E402
 from brakesqueal.sweep import load_study, open_sweep, sweep, sweep_status  # noqa: E402

@@ -9,7 +9,13 @@ import sys
 import numpy as np
 import pytest
 
-from brakesqueal.builder import get_model, linearize_model, model_to_toml
+from brakesqueal import linearize
+from brakesqueal.model import get_model, model_to_toml
+
+
+def linearize_model(spec, overrides=None):
+    """The linear model of ``spec`` at its default values with ``overrides``."""
+    return linearize(spec.get_preset().resolve(dict(overrides or {})))
 from brakesqueal.errors import ParameterError
 from brakesqueal.sweep import sweep
 

@@ -7,7 +7,12 @@ import pytest
 import symengine as se
 import sympy as sp
 
-from brakesqueal.numeric.compiled import compiled_model
+from brakesqueal.codegen import build
+
+
+def compiled_model():
+    """The paper's compiled equations (its engine's)."""
+    return build("paper").compiled
 from brakesqueal.symbolic.linearize import trivial_blocks
 from brakesqueal.symbolic.model import PARAMETER_SYMBOLS, STATE_SYMBOLS, derive_equations
 
