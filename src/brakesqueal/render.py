@@ -100,6 +100,10 @@ def verdict_lines(v: Any) -> list[str]:
         f = "" if not math.isfinite(v.frequency) else f" at {v.frequency:.6g} Hz"
         head += f", carried by a {v.carrier} mode{f}"
     lines = [f"{head} ({how})"]
+    if not v.listed_resolved:
+        lines.append(f"  note: the listed eigenvalues are those of the matrices rounded to double precision; here they "
+                     f"are not resolved (largest real part {v.listed:.3e} 1/s, error bound {v.listed_bound:.1e} "
+                     "1/s); the verdict is that of the exact linearization")
     if v.pad_mode:
         c = v.pad_damping
         pad = v.carrier.removesuffix(" tangential rate")

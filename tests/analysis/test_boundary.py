@@ -17,7 +17,7 @@ import pytest
 import scipy.linalg
 
 from brakesqueal.analysis.boundary import stability_boundary
-from brakesqueal import crossings
+from brakesqueal import crossings, evaluate
 from brakesqueal import linearize
 from brakesqueal import Axis, stability_map, write_map
 from brakesqueal.errors import ParameterError
@@ -25,11 +25,17 @@ from brakesqueal.model import ParameterSpace, get_model
 from brakesqueal.results import open_map, plot_map_file
 
 
+def _ev(space):
+    """The maps' bisection evaluator: the dispatcher's certified verdicts."""
+    return lambda values: evaluate(space, values, eigen=False)
+
+
 def _boundary(space, x, y, **kw):
     m = stability_map(space, x, y, boundary=False)
     outer, inner = m.dims
     ax = {x.name: x, y.name: y}
-    return m, stability_boundary(space, ax[outer], ax[inner], m.data.stable.values, m.data.status.values, **kw)
+    return m, stability_boundary(space, ax[outer], ax[inner], m.data.stable.values, m.data.status.values,
+                                 evaluator=_ev(space), **kw)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -141,11 +147,11 @@ def test_boundary_bad_options():
     st = np.zeros((4, 5), bool)
     ss = np.zeros((4, 5), np.int8)
     with pytest.raises(ParameterError, match="iterations"):
-        stability_boundary(space, y, x, st, ss, iterations=99)
+        stability_boundary(space, y, x, st, ss, iterations=99, evaluator=_ev(space))
     with pytest.raises(ParameterError, match="shape"):
-        stability_boundary(space, x, y, st, ss)
+        stability_boundary(space, x, y, st, ss, evaluator=_ev(space))
     # a uniformly stable map has no boundary
-    assert stability_boundary(space, y, x, st | True, ss).vertices == 0
+    assert stability_boundary(space, y, x, st | True, ss, evaluator=_ev(space)).vertices == 0
 
 
 def test_fig3_tips_close_the_squeal_region():

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from brakesqueal import silent_motion
+from brakesqueal.analysis.equilibrium import silent_motion_vector
 from brakesqueal.analysis.equilibrium import parameter_vector
 from brakesqueal.codegen import CONTACT_FIELDS, compile_model
 from brakesqueal.errors import ContactLossError, NoSilentMotionError
@@ -143,7 +144,7 @@ def test_contact_loss_is_reported_with_parameter_names():
     model = dataclasses.replace(real, contact=lifted)
     params = get_preset("paper-fig2").resolve()
     with pytest.raises(ContactLossError, match=r"pad '2' .*loses contact.*normal force -5 N.*N0=3600.*k2=6e\+06"):
-        silent_motion(params, model=model)
+        silent_motion_vector(model, [float(v) for v in params.vector()])
 
 
 def test_trivial_silent_motion_has_preload_forces():

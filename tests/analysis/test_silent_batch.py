@@ -137,6 +137,23 @@ def test_newton_stage_lands_on_the_continuation_root():
     assert accepted >= 6
 
 
+def _per_point_reference(spec, values):
+    """``(status, stable, max_real, frequency)`` of one point by ``linearize`` and the linear model's verdict."""
+    from brakesqueal import linearize
+    from brakesqueal.analysis.points import linear_verdict
+    from brakesqueal.errors import SilentMotionError
+    from brakesqueal.status import status_of_error
+
+    try:
+        lm = linearize(Parameters(spec, values))
+    except SilentMotionError as exc:
+        return int(status_of_error(exc)), False, np.nan, np.nan
+    code, m1, f1 = linear_verdict(lm)
+    if code == 2:
+        return int(PointStatus.UNDECIDED), False, m1, f1
+    return int(PointStatus.OK if lm.silent.trivial else PointStatus.OK_NONTRIVIAL), code == 1, m1, f1
+
+
 @pytest.mark.parametrize("model,preset,sets,axes", [
     (None, "paper-fig3", {"h10": 0.012}, (("mu1", 0.1, 0.9), ("mu2", 0.1, 0.9))),
     (None, "paper-fig3", {"h10": 0.015, "k_ip": float("inf")}, (("mu1", 0.1, 0.9), ("mu2", 0.1, 0.9))),
@@ -155,10 +172,12 @@ def test_evaluate_arrays_batched_equals_per_point(model, preset, sets, axes, mon
     yv = np.sort(rng.uniform(y0, y1, ny))
     arr = space.arrays({xn: xv[None, :], yn: yv[:, None]})
     silent_motions(build(space.model), _rows(space, {xn: xv[:2]}))  # the kernel compiled: small grids take the batch too
+    from brakesqueal.analysis.verdict import _linear as vl
+
     calls = []
-    per_point = pts._nontrivial_point
-    monkeypatch.setattr(pts, "_nontrivial_point", lambda *a: calls.append(a) or per_point(*a))
-    r = pts.evaluate_arrays(space, arr)
+    per_point = vl._per_point
+    monkeypatch.setattr(vl, "_per_point", lambda ctx, i: calls.append(i) or per_point(ctx, i))
+    r = pts.evaluate_arrays(build(space.model), space, arr)
     monkeypatch.undo()
     batched = np.count_nonzero(r.status == int(PointStatus.OK_NONTRIVIAL)) - len(calls)
     if model == "in-plane-pad":
@@ -167,13 +186,12 @@ def test_evaluate_arrays_batched_equals_per_point(model, preset, sets, axes, mon
         assert batched == 0 and len(calls) > 0
     else:
         assert batched > 0  # the batched route decided these
-    m = pts._Model.of(space.model)
     shape = r.status.shape
     nontrivial = 0
     for i in range(r.status.size):
         pi = np.unravel_index(i, shape)
         values = {k: float(np.broadcast_to(arr[k], shape)[pi]) for k in space.model.parameters}
-        s, sb, m1, f1 = pts._nontrivial_point(m, values)
+        s, sb, m1, f1 = _per_point_reference(space.model, values)
         assert s == r.status[pi], (pi, values)
         assert sb == bool(r.stable[pi]), (pi, values)
         if np.isnan(m1):

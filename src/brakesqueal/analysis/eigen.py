@@ -59,6 +59,12 @@ class Verdict:
         ``G_dL`` [N s/m] (normalised to a positive stiffness; negative: the pad's own mode grows).
     disk : Verdict or None
         The verdict of the disk's modes alone when the verdict is carried by a pad's tangential rate.
+    listed : float
+        The largest real part of the listed eigenvalues (those of the matrices in double precision); it can
+        differ in sign from a verdict decided exactly on the parameters where rounding the matrices' entries
+        moves the roots (entries spanning ~1e50); see :attr:`listed_resolved`.
+    listed_bound : float
+        The listed eigenvalue's error bound.
     """
 
     status: str
@@ -70,6 +76,15 @@ class Verdict:
     frequency: float = math.nan
     pad_damping: float | None = None
     disk: Verdict | None = None
+    listed: float = math.nan
+    listed_bound: float = math.nan
+
+    @property
+    def listed_resolved(self) -> bool:
+        """Whether the listed eigenvalues agree with the verdict (or their largest real part is resolved)."""
+        if self.status == "undecided" or not math.isfinite(self.listed):
+            return True
+        return (self.listed < 0) == (self.status == "stable") or not abs(self.listed) <= self.listed_bound
 
     @property
     def stable(self) -> bool:
@@ -189,7 +204,7 @@ class EigenAnalysis:
         if carrier is not None and carrier.endswith("tangential rate") and modes == "all":
             pad_damping = self._pad_damping(carrier)
             disk = self.verdict(safety, modes="disk")
-        return Verdict(status, mr, bound, margin, carrier, method, freq, pad_damping, disk)
+        return Verdict(status, mr, bound, margin, carrier, method, freq, pad_damping, disk, listed, listed_bound)
 
     def _pad_damping(self, carrier: str) -> float | None:
         """The effective tangential damping ``G_dL`` [N s/m] of the pad named in a carrier label."""

@@ -330,11 +330,14 @@ def trivial_entries(engine: Engine, P: np.ndarray) -> tuple[np.ndarray, np.ndarr
         Entries of ``M, D, K`` (row-major) and bounds on their rounding errors
         (exact for the given parameter vector).
     """
+    from ._pure import SMALL
+
     P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
     E = np.empty((P.shape[0], 12))
     R = np.empty((P.shape[0], 12))
     with np.errstate(all="ignore"):
-        engine.entries_kernel().entries_batch(P, E, R)
+        # a few points (a command's one point): the same source as plain Python, no numba import
+        engine.entries_kernel(plain=P.shape[0] <= SMALL).entries_batch(P, E, R)
     return E, R
 
 

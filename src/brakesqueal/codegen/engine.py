@@ -261,8 +261,9 @@ class Engine:
         return self._get(("charpoly", space.key(), names), make)  # type: ignore[no-any-return]
 
     # ---------------------------------------------------------------- closed-form entries (generated)
-    def entries_kernel(self) -> types.ModuleType:
-        """Compiled ``entries_batch(P, V, R)``: the 12 closed-form entries of ``M, D, K`` with rounding bounds."""
+    def entries_kernel(self, plain: bool = False) -> types.ModuleType:
+        """Compiled ``entries_batch(P, V, R)``: the 12 closed-form entries of ``M, D, K`` with rounding bounds
+        (``plain``: the same source as plain Python, for a few points without importing numba)."""
         def make() -> Any:
             from .stability import bounded_source, load_keyed
 
@@ -276,9 +277,9 @@ class Engine:
                 return bounded_source("entries_batch", entry_slots(form), "Mbar, Dbar, Kbar entries (row-major)",
                                       len(form.symbols))
 
-            return load_keyed("entries", self.key, source)
+            return load_keyed("entries", self.key, source, plain=plain)
 
-        return self._get("entries", make)  # type: ignore[no-any-return]
+        return self._get(("entries", plain), make)  # type: ignore[no-any-return]
 
     def omega_kernel(self) -> types.ModuleType | None:
         """Compiled ``entries_batch(P, V, R)``: Laurent coefficients in Ω of the 12 entries with rounding bounds

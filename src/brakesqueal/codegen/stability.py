@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import re
 from dataclasses import dataclass
 from typing import Any, Callable
 
@@ -29,7 +30,7 @@ import numpy as np
 
 __all__ = ["GridKernel", "MapKernel", "RateBlocks", "CharpolyTable", "kernel_source", "bounded_source",
            "rate_source", "load_generated", "load_keyed", "disk_json", "inner_exponent", "kernel_segments",
-           "charpoly_from_data"]
+           "charpoly_from_data", "plain_module"]
 
 _U = 2.0 ** -53
 
@@ -471,11 +472,47 @@ def load_generated(source: str, tag: str) -> Any:
     return cache.load_module("stability-kernels", f"brakesqueal_kernel_{tag}_{digest}.py", lambda: source)
 
 
-def load_keyed(tag: str, key: str, generate: Callable[[], str]) -> Any:
-    """Import a generated module named by a model key; ``generate`` (SymPy) only runs on a cache miss."""
+def load_keyed(tag: str, key: str, generate: Callable[[], str], *, plain: bool = False) -> Any:
+    """Import a generated module named by a model key; ``generate`` (SymPy) only runs on a cache miss.
+
+    With ``plain`` the same cached source runs as plain Python (``numba.njit`` a no-op): for a few points that is
+    faster than importing numba and loading machine code (the command line's ``linearize``); the arithmetic is
+    the same IEEE double precision (the kernels use no ``fastmath``).
+    """
     from . import cache
 
-    return cache.load_module("stability-kernels", f"brakesqueal_kernel_{tag}_{key}.py", generate)
+    name = f"brakesqueal_kernel_{tag}_{key}.py"
+    if not plain:
+        return cache.load_module("stability-kernels", name, generate)
+    source = cache.cached_text("stability-kernels", name, generate)
+    return plain_module(source, f"<brakesqueal plain {name}>")
+
+
+class _NoJit:
+    """Stands in for ``numba`` when generated kernels run as plain Python: ``njit`` returns the function."""
+
+    @staticmethod
+    def njit(*args: Any, **kwargs: Any) -> Any:
+        if args and callable(args[0]):
+            return args[0]
+        return lambda f: f
+
+
+_PLAIN: dict[str, Any] = {}
+
+
+def plain_module(source: str, label: str) -> Any:
+    """A generated numba module executed as plain Python (memoized by its source)."""
+    import types
+
+    digest = hashlib.sha256(source.encode()).hexdigest()
+    if digest not in _PLAIN:
+        mod = types.ModuleType(label)
+        mod.__dict__["numba"] = _NoJit
+        text = re.sub(r"(?m)^import numba\n", "", source, count=1)
+        exec(compile(text, label, "exec"), mod.__dict__)  # noqa: S102 (the package's own generated source)
+        _PLAIN[digest] = mod
+    return _PLAIN[digest]
 
 
 def disk_json(kind: str, ident: str, build: Callable[[], Any]) -> Any:
