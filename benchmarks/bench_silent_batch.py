@@ -24,23 +24,23 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import BenchResult, best_time, emit  # noqa: E402
-from brakesqueal.codegen import build
 
 
 def run(size: int = 100, baseline_points: int = 300) -> list[BenchResult]:
     from brakesqueal.analysis import points as pts
     from brakesqueal.analysis.equilibrium import silent_motion_vector, silent_motions
-    from brakesqueal.codegen import compile_model
+    from brakesqueal.codegen import build
     from brakesqueal.model import resolve_space
 
     space = resolve_space(preset="paper-fig3", sets={"h10": 0.012})
-    cm = compile_model(space.model)
+    engine = build(space.model)
+    cm = engine.compiled
     mu = np.linspace(0.2, 0.8, size)
     arr = space.arrays({"mu1": mu[None, :], "mu2": mu[:, None]})
     P = np.stack([np.broadcast_to(v, (size, size)).ravel() for v in space.vectors(arr)], axis=1)
-    silent_motions(build(cm.spec), P[:8])  # load / compile the kernel
-    t_batch = best_time(lambda: silent_motions(build(cm.spec), P), repeat=3)
-    res = silent_motions(build(cm.spec), P)
+    silent_motions(engine, P[:8])  # load / compile the kernel
+    t_batch = best_time(lambda: silent_motions(engine, P), repeat=3)
+    res = silent_motions(engine, P)
     sub = P[np.random.default_rng(0).choice(P.shape[0], min(baseline_points, P.shape[0]), replace=False)]
     t0 = time.perf_counter()
     for p in sub:
@@ -48,8 +48,8 @@ def run(size: int = 100, baseline_points: int = 300) -> list[BenchResult]:
     base = sub.shape[0] / (time.perf_counter() - t0)
     rate = P.shape[0] / t_batch
     handed = int(np.count_nonzero(res.handover[~res.trivial] != 0))
-    pts.evaluate_arrays(space, arr)  # warm
-    t_eval = best_time(lambda: pts.evaluate_arrays(space, arr), repeat=2)
+    pts.evaluate_arrays(engine, space, arr)  # warm
+    t_eval = best_time(lambda: pts.evaluate_arrays(engine, space, arr), repeat=2)
     return [
         BenchResult("non-trivial silent motions, compiled batched Newton (paper-fig3, h10 = 0.012)", rate, "points/s",
                     base, rate / base,

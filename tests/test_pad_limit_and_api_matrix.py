@@ -269,7 +269,7 @@ def test_linearize_and_eigen_analysis(name):
     assert isinstance(fig, Figure) and fig.axes
 
     # the deprecated builder alias of the issue (it crashed with AttributeError 'as_dict')
-    old = bs.eigen_analysis(bs.linearize_model(bs.get_model(name), {}))
+    old = bs.eigen_analysis(bs.linearize(bs.get_model(name).get_preset(None).resolve({})))
     assert old.verdict().status == v.status and same_spectrum(old.eigenvalues, lam, SPEC_TOL)
 
 

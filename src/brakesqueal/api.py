@@ -94,7 +94,18 @@ def linearize(params: Parameters, *, pad_rates: str = "kept") -> LinearModel:
 
 
 def pad_rate_eigenvalues(params: Parameters) -> np.ndarray:
-    """Finite eigenvalues with the pads' tangential rates kept (``linearize(params).eigenvalues``)."""
+    """Finite eigenvalues with the pads' tangential rates kept (``linearize(params).eigenvalues``).
+
+    Parameters
+    ----------
+    params : Parameters
+        The model and its parameter values.
+
+    Returns
+    -------
+    ndarray of complex
+        Sorted by decreasing real part [1/s].
+    """
     return linearize(params).eigenvalues
 
 
@@ -143,7 +154,22 @@ def evaluate(space: ParameterSpace, values: Mapping[str, Any], *, eigen: bool = 
 
 def evaluate_point(space: ParameterSpace, values: Mapping[str, float] | None = None, *,
                    modes: str = "all") -> PointVerdict:
-    """Status and certified verdict of one point of a parameter space (default: its current point)."""
+    """Status and certified verdict of one point of a parameter space (default: its current point).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space.
+    values : Mapping[str, float], optional
+        Settable names → values.
+    modes : {"all", "disk"}
+        Judge every eigenvalue, or leave out the modes of a massless pad's own tangential rate.
+
+    Returns
+    -------
+    PointVerdict
+        Status, verdict, ``max_real``, frequency, the carrier mode and the deciding route.
+    """
     from .analysis.points import evaluate_point as _evaluate_point
 
     return _evaluate_point(engine(space), space, values, modes=modes)
@@ -153,6 +179,25 @@ def stability_map(space: ParameterSpace, x: Axis, y: Axis, *, force: bool = Fals
                   chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None,
                   boundary: bool = True, modes: str = "all") -> Any:
     """A stability map over two settable parameters (:func:`brakesqueal.analysis.maps.stability_map`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides; tied names follow the axes.
+    x, y : Axis
+        The axes.
+    force : bool
+        Allow more than 1e9 points.
+    eigen : bool
+        Compute ``max_real`` and ``frequency`` (otherwise only classify).
+    chunk_points : int
+        Points per block (bounds the temporary memory).
+    progress : callable, optional
+        Called with the completed fraction after each block.
+    boundary : bool
+        Also locate the stability boundary by bisection.
+    modes : {"all", "disk"}
+        Judge every eigenvalue, or leave out the modes of a massless pad's own tangential rate.
 
     Returns
     -------
@@ -167,7 +212,23 @@ def stability_map(space: ParameterSpace, x: Axis, y: Axis, *, force: bool = Fals
 def write_map(space: ParameterSpace, x: Axis, y: Axis, path: str, *, force: bool = False, eigen: bool = True,
               chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None, boundary: bool = True,
               modes: str = "all") -> MapSummary:
-    """A stability map written to NetCDF block by block (:func:`brakesqueal.analysis.maps.write_map`)."""
+    """A stability map written to NetCDF block by block (:func:`brakesqueal.analysis.maps.write_map`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    x, y : Axis
+        The axes.
+    path : str
+        The NetCDF file.
+    force, eigen, chunk_points, progress, boundary, modes
+        As :func:`stability_map`.
+
+    Returns
+    -------
+    MapSummary
+    """
     from .analysis.maps import write_map as _write
 
     return _write(engine(space), space, x, y, path, force=force, eigen=eigen, chunk_points=chunk_points,
@@ -176,6 +237,13 @@ def write_map(space: ParameterSpace, x: Axis, y: Axis, path: str, *, force: bool
 
 def crossings(space: ParameterSpace, axis: Axis) -> Any:
     """Every stability change along one settable parameter (:func:`brakesqueal.analysis.crossings.crossings`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    axis : Axis
+        The path (its ``num`` is ignored).
 
     Returns
     -------
@@ -189,6 +257,13 @@ def crossings(space: ParameterSpace, axis: Axis) -> Any:
 def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5) -> Any:
     """All onsets and re-stabilisations along Ω (:func:`brakesqueal.analysis.crossings.critical_speeds`).
 
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides; the spin must be a settable name.
+    lo, hi : float
+        The Ω range [rad/s], ``0 < lo < hi``.
+
     Returns
     -------
     CriticalSpeedResult
@@ -200,7 +275,26 @@ def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5) -> 
 
 def critical_speeds_many(space: ParameterSpace, changes: dict[str, Any], lo: float = 1.0, hi: float = 1e5,
                          max_crossings: int = 8, *, return_status: bool = False) -> tuple[Any, ...]:
-    """Critical speeds of many parameter sets, batched (:func:`brakesqueal.analysis.crossings.critical_speeds_many`)."""
+    """Critical speeds of many parameter sets, batched (:func:`brakesqueal.analysis.crossings.critical_speeds_many`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    changes : dict of str to array_like
+        Settable names → values (broadcast to one length).
+    lo, hi : float
+        The Ω range [rad/s].
+    max_crossings : int
+        Columns of the outputs.
+    return_status : bool
+        Also return a per-set status.
+
+    Returns
+    -------
+    tuple of ndarray
+        ``(crossings, directions, counts, stable_at_start[, status])``.
+    """
     from .analysis.crossings import critical_speeds_many as _many
 
     return _many(engine(space), space, changes, lo, hi, max_crossings, return_status=return_status)
@@ -208,7 +302,27 @@ def critical_speeds_many(space: ParameterSpace, changes: dict[str, Any], lo: flo
 
 def modes_along(space: ParameterSpace, name: str, start: float, stop: float, *, num: int = 200, log: bool = False,
                 pad_rates: str = "kept") -> ModeTracks:
-    """Mode-coupling diagram along one settable parameter (:func:`brakesqueal.analysis.modes.modes_along`)."""
+    """Mode-coupling diagram along one settable parameter (:func:`brakesqueal.analysis.modes.modes_along`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    name : str
+        A settable name.
+    start, stop : float
+        The path.
+    num : int
+        Points of the path.
+    log : bool
+        Logarithmic spacing.
+    pad_rates : {"kept", "quasi-static"}
+        How the massless pads' tangential rates enter.
+
+    Returns
+    -------
+    ModeTracks
+    """
     from .analysis.modes import modes_along as _modes
 
     return _modes(engine(space), space, name, start, stop, num=num, log=log, pad_rates=pad_rates)

@@ -15,7 +15,7 @@ __all__ = ["PointStatus", "RunStatus", "STATUS_MEANINGS", "status_of_error", "DE
 #: The one rule of a trivial silent motion, for every command: a zero-state residual is zero "to rounding" when
 #: ``|F_i| <= TRIVIAL_NOISE_FLOOR eps S_i`` (``S_i`` the magnitude of the terms that cancel in it); at one point
 #: :func:`brakesqueal.analysis.equilibrium.is_trivial`, along a path or a map's axes its symbolic analogue
-#: (:func:`brakesqueal.symbolic.closed_form.quartic_numerators`, per monomial of the path's variables).
+#: (:func:`brakesqueal.symbolic.stability_forms.quartic_numerators`, per monomial of the path's variables).
 TRIVIAL_NOISE_FLOOR = 64.0
 
 

@@ -85,7 +85,7 @@ def test_output_paths_are_checked_before_computing(tmp_path, capsys, monkeypatch
     import brakesqueal.analysis.maps as maps
 
     called = []
-    monkeypatch.setattr(maps, "evaluate_arrays", lambda *a, **k: called.append(1))
+    monkeypatch.setattr(maps, "decide", lambda *a, **k: called.append(1))
     rc, _, err = run(capsys, "map", "--x", "k_ip=1e5:1e10:5:log", "--y", "mu=0.1:1:5", "--out", str(tmp_path / "m.txt"))
     assert rc == 2 and ".nc" in err and not called
     old = tmp_path / "old.nc"
@@ -100,7 +100,7 @@ def test_map_no_eigen_leaves_the_eigenvalue_variables_out(tmp_path, capsys):
     rc, out, err = run(capsys, "map", "--x", "k_ip=1e5:1e10:12:log", "--y", "mu=0.1:1:9", "--out", str(nc), "--no-eigen")
     assert rc == 0, err
     m = open_map(str(nc))
-    assert {v for v in m.data.data_vars if not v.startswith("boundary_")} == {"stable", "status"}
+    assert {v for v in m.data.data_vars if not v.startswith("boundary_")} == {"stable", "status", "carrier", "route"}
     assert {"boundary_k_ip", "boundary_mu"} <= set(m.data.data_vars)  # the refined boundary needs no eigenvalues
     full = run(capsys, "map", "--x", "k_ip=1e5:1e10:12:log", "--y", "mu=0.1:1:9", "--out", str(tmp_path / "f.nc"))
     assert full[0] == 0

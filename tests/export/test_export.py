@@ -316,7 +316,7 @@ def cases(angled_path) -> dict[str, Case]:
         for _ in range(3):
             v = {k: (val if math.isinf(val) else val * rng.uniform(0.8, 1.25)) for k, val in params.items()}
             pt = Parameters(spec, _tie(name, v))
-            assert silent_motion(pt, model=cm).trivial, (name, pt)
+            assert silent_motion(pt).trivial, (name, pt)
             trivial.append(pt)
         out[name] = Case(name, spec, cm, params, kept, points, trivial)
     return out
@@ -422,9 +422,9 @@ def check_nonlinear(api: Api, case: Case) -> None:
 
 
 def ref_linear(case: Case, params: Parameters) -> list[np.ndarray]:
-    lm = linearize(params, model=case.cm, pad_rates="kept")
+    lm = linearize(params, pad_rates="kept")
     if not case.kept:
-        qs = linearize(params, model=case.cm, pad_rates="quasi-static")
+        qs = linearize(params, pad_rates="quasi-static")
         assert np.array_equal(qs.M, lm.M) and np.array_equal(qs.D, lm.D) and np.array_equal(qs.K, lm.K)
         return [lm.M, lm.D, lm.K]
     assert lm.pad_states == case.kept and not np.any(lm.G_ddQ)  # G does not depend on Qddot

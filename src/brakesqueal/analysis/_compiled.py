@@ -31,7 +31,7 @@ os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 __all__ = ["peval", "real_roots", "routh_interval", "routh_batch", "quartic_interval_batch", "horner_interval",
            "descartes", "isolate_roots", "critical_batch", "quartic_factor", "quartic_top_grid", "quartic_top_rows",
            "charpoly_grid", "charpoly_points", "critical_batch_chunks", "charpoly_grid_chunks",
-           "quartic_top_grid_chunks", "PARALLEL_MIN", "UNSTABLE", "STABLE", "UNDECIDED"]
+           "quartic_top_grid_chunks", "balance_batch", "PARALLEL_MIN", "UNSTABLE", "STABLE", "UNDECIDED"]
 
 _JIT = dict(cache=True, error_model="numpy")
 
@@ -1474,6 +1474,44 @@ def quartic_top_grid_chunks(A, lam_e, mr, fr, ok, block):  # type: ignore[no-unt
         a = q * block
         b = min(n, a + block)
         quartic_top_grid(A[:, a:b], lam_e[a:b], mr[a:b], fr[a:b], ok[a:b])
+
+
+@numba.njit(**_JIT)
+def balance_batch(B, t, iterations):  # type: ignore[no-untyped-def]
+    """In place: a power-of-two diagonal similarity ``T^-1 B T`` of every ``B[i]`` (``t[i]`` its diagonal).
+
+    The sweeps of :func:`~.robust.balance_scaling`: every row and column's off-diagonal sums are equilibrated
+    simultaneously by ``2^round(log2(r/c)/2)``, until no scale changes (exact: powers of two).
+    """
+    N, m = B.shape[0], B.shape[1]
+    e = np.zeros(m)
+    for i in range(N):
+        for j in range(m):
+            t[i, j] = 1.0
+        for _ in range(iterations):
+            changed = False
+            for j in range(m):
+                c = 0.0
+                r = 0.0
+                for k in range(m):
+                    if k != j:
+                        c += abs(B[i, k, j])
+                        r += abs(B[i, j, k])
+                e[j] = 0.0
+                if c > 0.0 and r > 0.0 and c < math.inf and r < math.inf:
+                    v = np.rint(0.5 * math.log2(r / c))
+                    if v == v and abs(v) < 1e300:
+                        e[j] = v
+                        if v != 0.0:
+                            changed = True
+            if not changed:
+                break
+            for a in range(m):
+                for b in range(m):
+                    if e[a] != e[b]:
+                        B[i, a, b] = B[i, a, b] * math.ldexp(1.0, int(e[b]) - int(e[a]))
+            for j in range(m):
+                t[i, j] = t[i, j] * math.ldexp(1.0, int(e[j]))
 
 
 def _guard() -> None:

@@ -54,7 +54,7 @@ PROFILE_POINTS = 200
 #: Grid points of the numeric route.
 NUMERIC_GRID = 801
 
-_DIGITS = 80  # significant digits of constants in inexact tables (symbolic.closed_form.UNIVARIATE_DIGITS)
+_DIGITS = 80  # significant digits of constants in inexact tables (symbolic.stability_forms.UNIVARIATE_DIGITS)
 
 
 def _peval(c: list[Fraction], x: Fraction) -> tuple[Fraction, Fraction]:

@@ -484,7 +484,7 @@ def trivial_rows(cm: CompiledModel, P: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return np.asarray(is_trivial(F, S), dtype=bool) & np.all(np.isfinite(F), axis=0), np.ascontiguousarray(S.T)
 
 
-def silent_motions(engine: Engine, P: Any, *, use_cache: bool = True, compiled: bool = True) -> SilentMotions:
+def silent_motions(engine: Engine, P: Any, *, use_cache: bool | None = None, compiled: bool = True) -> SilentMotions:
     """Silent motions of many points: compiled Newton stage, the per-point solver wherever it is not clean.
 
     Parameters
@@ -498,7 +498,7 @@ def silent_motions(engine: Engine, P: Any, *, use_cache: bool = True, compiled: 
         <brakesqueal.model.parameters.ParameterSpace.vectors>` stacked).
         Assumed valid.
     use_cache : bool, optional
-        Use the on-disk code cache for the compiled kernel (default ``True``).
+        Use the on-disk code cache for the compiled kernel (default: the engine's setting).
     compiled : bool, optional
         ``False`` skips the compiled stage: every non-trivial point goes
         through :func:`silent_motion_vector` (the reference the tests

@@ -20,7 +20,7 @@ recomputes it by a robust route (:mod:`.robust`).
 
 The kernels themselves are generated once per model (or per parameter space
 and axes) by the model's :class:`~brakesqueal.codegen.engine.Engine` from its
-closed form (:mod:`brakesqueal.symbolic.closed_form`) and kept in the on-disk
+closed form (:mod:`brakesqueal.symbolic.stability_forms`) and kept in the on-disk
 cache; this module only *runs* them:
 
 * :func:`kernel_eigen`, :func:`classify_numpy`, :func:`run_classify` — the

@@ -341,9 +341,19 @@ def balance(S: np.ndarray, iterations: int = 12) -> np.ndarray:
     return balance_scaling(S, iterations)[0]
 
 
+#: Batches from this size are balanced by the compiled kernel (:func:`~._compiled.balance_batch`).
+BALANCE_COMPILED_MIN = 256
+
+
 def balance_scaling(S: np.ndarray, iterations: int = 12) -> tuple[np.ndarray, np.ndarray]:
     """:func:`balance` and the diagonal ``t`` of its ``T`` (powers of 2), shape ``(N, m)``."""
     B = np.array(S, dtype=float, copy=True)
+    if B.ndim == 3 and B.shape[0] >= BALANCE_COMPILED_MIN and np.all(np.isfinite(B)):
+        from ._compiled import balance_batch
+
+        t = np.empty(B.shape[:-1])
+        balance_batch(B, t, iterations)
+        return B, t
     m = B.shape[-1]
     t = np.ones(B.shape[:-1])
     off = ~np.eye(m, dtype=bool)

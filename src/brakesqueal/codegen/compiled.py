@@ -219,6 +219,9 @@ def _generate(spec: Any) -> str:
     specs = [
         FunctionSpec("residuals", (xa, pa), res, "(R, G) at the state x: eqs. (44), (33)-(34) generalized."),
         FunctionSpec("jacobians", (xa, pa), jac, "d(R, G)/dx, row-major (n + m) x (3n + 2m)."),
+        FunctionSpec("rate_jacobians", (xa, pa), [jac[r * nx + 3 * n + m + j] for r in range(n + m) for j in range(m)],
+                     "d(R, G)/dLdot, row-major (n + m) x m: the pads' rate coefficients alone (checked in extended "
+                     "precision at tilted silent motions)."),
         FunctionSpec("contact", (xa, pa), contact,
                      "Per pad: F_n [N], v_r (3) [m/s], h [m], hdot [m/s], l [m] (eqs. 12-34)."),
         FunctionSpec("zero_residuals", (pa,), res0, "(R, G) at x = 0."),

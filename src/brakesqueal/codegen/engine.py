@@ -20,7 +20,7 @@ derives anything itself.  The engine
 
 Each artefact is generated at most once per process and kept in the on-disk
 cache (:mod:`.cache`), so that a warm start imports no computer algebra: the
-SymPy work lives in :mod:`brakesqueal.symbolic.closed_form` and runs only on
+SymPy work lives in :mod:`brakesqueal.symbolic.stability_forms` and runs only on
 a cache miss.
 """
 
@@ -35,7 +35,7 @@ from .compiled import CompiledModel, compile_model, model_key
 if TYPE_CHECKING:
     from ..model.components import ModelSpec
     from ..model.parameters import ParameterSpace
-    from ..symbolic.closed_form import ModelForm
+    from ..symbolic.stability_forms import ModelForm
     from .stability import CharpolyTable, GridKernel, MapKernel, RateBlocks
 
 __all__ = ["Engine", "Capabilities", "build"]
@@ -98,12 +98,15 @@ class Engine:
         Residuals, Jacobians and contact quantities (math- and NumPy-bound).
     caps : Capabilities
         What the model allows.
+    use_cache : bool
+        Whether generated artefacts are read from and written to the on-disk cache.
     """
 
     spec: ModelSpec
     key: str
     compiled: CompiledModel
     caps: Capabilities
+    use_cache: bool = True
     _memo: dict[Any, Any] = field(default_factory=dict, repr=False, compare=False)
 
     def __repr__(self) -> str:
@@ -119,7 +122,7 @@ class Engine:
         """The model's closed form about the zero state (SymPy; ``None`` where :attr:`Capabilities.closed_form`
         is false).  Only generators and symbolic consumers need it; the kernels below are cached."""
         def make() -> Any:
-            from ..symbolic.closed_form import build_model_form
+            from ..symbolic.stability_forms import build_model_form
 
             cm = self.compiled
             return build_model_form(self.spec, self.key, cm.param_names, cm.n, cm.rate_free_at_zero)
@@ -139,12 +142,12 @@ class Engine:
         return f"{self.key}|{space.key()}|{tuple(names)!r}"
 
     def quartic(self, space: ParameterSpace, names: tuple[str, ...]) -> Any:
-        """:func:`~brakesqueal.symbolic.closed_form.quartic_numerators` of a space with ``names`` symbolic
+        """:func:`~brakesqueal.symbolic.stability_forms.quartic_numerators` of a space with ``names`` symbolic
         (SymPy; memoized).  ``None`` where the closed-form route does not apply."""
         names = tuple(names)
 
         def make() -> Any:
-            from ..symbolic.closed_form import quartic_numerators
+            from ..symbolic.stability_forms import quartic_numerators
 
             return quartic_numerators(self.closed_form(), space, names)
 
@@ -173,14 +176,15 @@ class Engine:
             from .stability import disk_json
 
             ident = self._space_ident(space, names)
-            return bool(disk_json("closed", ident, lambda: self.quartic(space, names) is not None))
+            return bool(disk_json("closed", ident, lambda: self.quartic(space, names) is not None,
+                                  use_cache=self.use_cache))
 
         return self._get(("closed", space.key(), names), make)  # type: ignore[no-any-return]
 
     def grid_kernel(self, space: ParameterSpace, names: tuple[str, ...]) -> GridKernel | None:
         """The certified compiled Hurwitz classifier of a grid over ``names`` (``None`` where it does not apply:
         no closed form, a non-trivial silent motion somewhere on the grid, non-rational dependence, degrees
-        above :data:`~brakesqueal.symbolic.closed_form.MAX_INNER_DEGREE`)."""
+        above :data:`~brakesqueal.symbolic.stability_forms.MAX_INNER_DEGREE`)."""
         names = tuple(names)
 
         def make() -> Any:
@@ -192,16 +196,16 @@ class Engine:
                 return None
 
             def table() -> Any:
-                from ..symbolic.closed_form import grid_table
+                from ..symbolic.stability_forms import grid_table
 
                 return grid_table(self.quartic(space, names), names)
 
-            tab = disk_json("grid", self._space_ident(space, names), table)
+            tab = disk_json("grid", self._space_ident(space, names), table, use_cache=self.use_cache)
             if tab is None:
                 return None
             degrees = tuple(int(d) for d in tab["degrees"])
             source = kernel_source(degrees)
-            mod = load_generated(source, "map")
+            mod = load_generated(source, "map", use_cache=self.use_cache)
             nt = len(tab["slot"])
             return GridKernel(names=names, inner=int(tab["inner"]), degrees=degrees,
                               exps=np.array(tab["exps"], dtype=np.int64).reshape(nt, len(names) - 1),
@@ -224,9 +228,9 @@ class Engine:
         return MapKernel(outer=names[1 - g.inner], inner=names[g.inner], degrees=g.degrees, grid=g)
 
     def univariate(self, space: ParameterSpace, name: str) -> dict[str, Any] | None:
-        """Exact univariate coefficients of the quartic's numerators along ``name`` (for exact crossings),
-        ``None`` where the closed-form route does not apply (:func:`~brakesqueal.symbolic.closed_form.univariate_table`;
-        kept on disk)."""
+        """Exact univariate coefficients of the quartic's numerators along ``name`` (for exact crossings), kept on
+        disk; ``None`` where the closed-form route does not apply
+        (:func:`~brakesqueal.symbolic.stability_forms.univariate_table`)."""
         def make() -> Any:
             from .stability import disk_json
 
@@ -234,29 +238,30 @@ class Engine:
                 return None
 
             def table() -> Any:
-                from ..symbolic.closed_form import univariate_table
+                from ..symbolic.stability_forms import univariate_table
 
                 return univariate_table(self.quartic(space, (name,)))
 
-            return disk_json("univariate", self._space_ident(space, (name,)), table)
+            return disk_json("univariate", self._space_ident(space, (name,)), table, use_cache=self.use_cache)
 
         return self._get(("univariate", space.key(), name), make)
 
     def charpoly_table(self, space: ParameterSpace, outer: str, inner: str) -> CharpolyTable | None:
         """The exact characteristic polynomial of a map's zero state in its two axes (any model size), or
-        ``None`` where it does not apply (see :func:`~brakesqueal.symbolic.closed_form.charpoly_data`)."""
+        ``None`` where it does not apply (see :func:`~brakesqueal.symbolic.stability_forms.charpoly_data`)."""
         names = (outer, inner)
 
         def make() -> Any:
             from .stability import charpoly_from_data, disk_json
 
             def data() -> Any:
-                from ..symbolic.closed_form import charpoly_data, nd_form
+                from ..symbolic.stability_forms import charpoly_data, nd_form
 
                 form = self._get("nd-form", lambda: nd_form(self.spec, self.compiled.rate_free_at_zero))
                 return charpoly_data(form, space, names)
 
-            return charpoly_from_data(outer, inner, disk_json("charpoly", self._space_ident(space, names), data))
+            return charpoly_from_data(outer, inner, disk_json("charpoly", self._space_ident(space, names), data,
+                                                              use_cache=self.use_cache))
 
         return self._get(("charpoly", space.key(), names), make)  # type: ignore[no-any-return]
 
@@ -271,13 +276,13 @@ class Engine:
                 self._require_form()
 
             def source() -> str:
-                from ..symbolic.closed_form import entry_slots
+                from ..symbolic.stability_forms import entry_slots
 
                 form = self._require_form()
                 return bounded_source("entries_batch", entry_slots(form), "Mbar, Dbar, Kbar entries (row-major)",
                                       len(form.symbols))
 
-            return load_keyed("entries", self.key, source, plain=plain)
+            return load_keyed("entries", self.key, source, plain=plain, use_cache=self.use_cache)
 
         return self._get(("entries", plain), make)  # type: ignore[no-any-return]
 
@@ -291,13 +296,13 @@ class Engine:
                 return None
 
             def source() -> str:
-                from ..symbolic.closed_form import omega_slots
+                from ..symbolic.stability_forms import omega_slots
 
                 form = self._require_form()
                 return bounded_source("entries_batch", omega_slots(form), "Laurent coefficients in Omega",
                                       len(form.symbols))
 
-            return load_keyed("omega", self.key, source)
+            return load_keyed("omega", self.key, source, use_cache=self.use_cache)
 
         return self._get("omega", make)  # type: ignore[no-any-return]
 
@@ -308,13 +313,13 @@ class Engine:
             from . import cache
 
             def source() -> str:
-                from ..symbolic.closed_form import exact_entries_source
+                from ..symbolic.stability_forms import exact_entries_source
 
                 return exact_entries_source(self._require_form())
 
             if not self.caps.closed_form:
                 self._require_form()
-            return cache.load_module(self.key, "exact_entries.py", source)
+            return cache.load_module(self.key, "exact_entries.py", source, use_cache=self.use_cache)
 
         return self._get("exact-entries", make)  # type: ignore[no-any-return]
 
@@ -325,13 +330,13 @@ class Engine:
             from . import cache
 
             def source() -> str:
-                from ..symbolic.closed_form import exact_omega_source
+                from ..symbolic.stability_forms import exact_omega_source
 
                 return exact_omega_source(self._require_form())
 
             if not self.caps.omega_kernel:
                 raise NotImplementedError(f"model '{self.spec.name}' has no Laurent form in its spin")
-            return cache.load_module(self.key, "exact_omega.py", source)
+            return cache.load_module(self.key, "exact_omega.py", source, use_cache=self.use_cache)
 
         return self._get("exact-omega", make)  # type: ignore[no-any-return]
 
@@ -342,35 +347,36 @@ class Engine:
             from .stability import RateBlocks, rate_source
 
             def source() -> str:
-                from ..symbolic.closed_form import rate_block_exprs
+                from ..symbolic.stability_forms import rate_block_exprs
 
                 _, _, args, exprs = rate_block_exprs(self.spec)
                 return rate_source(args, exprs)
 
-            mod = cache.load_module(self.key, "rate_blocks.py", source)
+            mod = cache.load_module(self.key, "rate_blocks.py", source, use_cache=self.use_cache)
             return RateBlocks(n=self.caps.n, m=self.caps.m, function=mod.rate_blocks)
 
         return self._get("rates", make)  # type: ignore[no-any-return]
 
     # ---------------------------------------------------------------- batched silent motions
-    def silent_kernel(self, use_cache: bool = True) -> types.ModuleType:
+    def silent_kernel(self, use_cache: bool | None = None) -> types.ModuleType:
         """The compiled batched silent-motion kernel (:mod:`.silent`; numba compiles it on first use)."""
         from .silent import load_kernel
 
-        mod = self._get(("silent", use_cache), lambda: load_kernel(self.compiled, self.key, use_cache))
+        uc = self.use_cache if use_cache is None else use_cache
+        mod = self._get(("silent", uc), lambda: load_kernel(self.compiled, self.key, uc))
         return mod  # type: ignore[no-any-return]
 
-    def silent_ready(self, use_cache: bool = True) -> bool:
+    def silent_ready(self, use_cache: bool | None = None) -> bool:
         """Whether the silent-motion kernel runs without compiling (already run here, or in numba's disk cache)."""
         from .silent import kernel_ready
 
-        return kernel_ready(self.key, use_cache=use_cache)
+        return kernel_ready(self.key, use_cache=self.use_cache if use_cache is None else use_cache)
 
-    def mark_silent_ready(self, use_cache: bool = True) -> None:
+    def mark_silent_ready(self, use_cache: bool | None = None) -> None:
         """Record that the silent-motion kernel has run in this process."""
         from .silent import mark_ready
 
-        mark_ready(self.key, use_cache)
+        mark_ready(self.key, self.use_cache if use_cache is None else use_cache)
 
     # ---------------------------------------------------------------- variants
     def with_spec(self, spec: ModelSpec) -> Engine:
@@ -381,19 +387,20 @@ class Engine:
         cm2 = CompiledModel(spec=spec, coords=cm.coords, algebraic=cm.algebraic, param_names=cm.param_names,
                             residuals=cm.residuals, jacobians=cm.jacobians, contact=cm.contact,
                             vectorized=cm.vectorized, source=cm.source, rate_free_at_zero=cm.rate_free_at_zero)
-        return Engine(spec=spec, key=self.key, compiled=cm2, caps=self.caps, _memo=self._memo)
+        return Engine(spec=spec, key=self.key, compiled=cm2, caps=self.caps, use_cache=self.use_cache,
+                      _memo=self._memo)
 
 
 _ENGINES: dict[tuple[str, bool], Engine] = {}
 _MAX_ENGINES = 64
 
 
-def _form_info(spec: ModelSpec, key: str, cm: CompiledModel) -> dict[str, Any]:
+def _form_info(spec: ModelSpec, key: str, cm: CompiledModel, use_cache: bool = True) -> dict[str, Any]:
     """``{"form": bool, "omega_kernel": bool}`` of a model, built once with SymPy and kept on disk."""
     from .stability import disk_json
 
     def make() -> dict[str, Any]:
-        from ..symbolic.closed_form import build_model_form, omega_slots
+        from ..symbolic.stability_forms import build_model_form, omega_slots
 
         form = build_model_form(spec, key, cm.param_names, cm.n, cm.rate_free_at_zero)
         ok = False
@@ -404,7 +411,7 @@ def _form_info(spec: ModelSpec, key: str, cm: CompiledModel) -> dict[str, Any]:
                 ok = False
         return {"form": form is not None, "omega_kernel": ok}
 
-    return disk_json("form", key, make)  # type: ignore[no-any-return]
+    return disk_json("form", key, make, use_cache=use_cache)  # type: ignore[no-any-return]
 
 
 def build(spec: ModelSpec | str, *, use_cache: bool = True) -> Engine:
@@ -428,12 +435,12 @@ def build(spec: ModelSpec | str, *, use_cache: bool = True) -> Engine:
     eng = _ENGINES.get((key, use_cache))
     if eng is None:
         cm = compile_model(spec, use_cache=use_cache)
-        info = _form_info(spec, key, cm)
+        info = _form_info(spec, key, cm, use_cache)
         caps = Capabilities(n=cm.n, m=cm.m, coords=cm.coords, algebraic=cm.algebraic,
                             treatment=tuple(t for t in (p.treatment for p in spec.pads) if t is not None),
                             rate_free_at_zero=tuple(cm.rate_free_at_zero), closed_form=bool(info["form"]),
                             omega_kernel=bool(info["omega_kernel"]), tilting=bool(spec.disk.tilting))
-        eng = Engine(spec=spec, key=key, compiled=cm, caps=caps)
+        eng = Engine(spec=spec, key=key, compiled=cm, caps=caps, use_cache=use_cache)
         if len(_ENGINES) >= _MAX_ENGINES:
             _ENGINES.pop(next(iter(_ENGINES)))
         _ENGINES[(key, use_cache)] = eng

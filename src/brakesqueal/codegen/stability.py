@@ -1,6 +1,6 @@
 r"""Generated stability kernels: their sources, data types and on-disk cache (no computer algebra here).
 
-What :mod:`brakesqueal.symbolic.closed_form` computes once per model (or per
+What :mod:`brakesqueal.symbolic.stability_forms` computes once per model (or per
 parameter space and axes) becomes source text or JSON tables here, kept in
 the on-disk cache (:mod:`.cache`) and loaded as compiled callables:
 
@@ -399,7 +399,7 @@ class CharpolyTable:
 
 
 def charpoly_from_data(outer: str, inner: str, data: dict[str, Any] | None) -> CharpolyTable | None:
-    """A :class:`CharpolyTable` from its JSON data (:func:`brakesqueal.symbolic.closed_form.charpoly_data`)."""
+    """A :class:`CharpolyTable` from its JSON data (:func:`brakesqueal.symbolic.stability_forms.charpoly_data`)."""
     if data is None:
         return None
     shape = tuple(int(v) for v in data["shape"])
@@ -420,7 +420,7 @@ class RateBlocks:
     the sliding direction along the sliding velocity vanishes); generated
     code evaluates such differences to rounding noise, which would give a
     spurious pad mode ``-G_L / G_dL`` of any sign.  These are simplified
-    (:func:`brakesqueal.symbolic.closed_form.rate_block_exprs`), so only the
+    (:func:`brakesqueal.symbolic.stability_forms.rate_block_exprs`), so only the
     genuine part remains (e.g. ``c_ip N0 mu'(v*)`` of a falling friction law)
     and an exact zero stays zero.
 
@@ -464,15 +464,17 @@ def rate_source(args: list[Any], exprs: list[Any]) -> str:
             f"def rate_blocks({', '.join(names)}):\n    return ({body}{',' if exprs else ''})\n")
 
 
-def load_generated(source: str, tag: str) -> Any:
+def load_generated(source: str, tag: str, *, use_cache: bool = True) -> Any:
     """Import generated kernel source from the on-disk cache (numba caches beside it), keyed by its content."""
     from . import cache
 
     digest = hashlib.sha256(source.encode()).hexdigest()[:16]
-    return cache.load_module("stability-kernels", f"brakesqueal_kernel_{tag}_{digest}.py", lambda: source)
+    return cache.load_module("stability-kernels", f"brakesqueal_kernel_{tag}_{digest}.py", lambda: source,
+                             use_cache=use_cache)
 
 
-def load_keyed(tag: str, key: str, generate: Callable[[], str], *, plain: bool = False) -> Any:
+def load_keyed(tag: str, key: str, generate: Callable[[], str], *, plain: bool = False,
+               use_cache: bool = True) -> Any:
     """Import a generated module named by a model key; ``generate`` (SymPy) only runs on a cache miss.
 
     With ``plain`` the same cached source runs as plain Python (``numba.njit`` a no-op): for a few points that is
@@ -483,8 +485,8 @@ def load_keyed(tag: str, key: str, generate: Callable[[], str], *, plain: bool =
 
     name = f"brakesqueal_kernel_{tag}_{key}.py"
     if not plain:
-        return cache.load_module("stability-kernels", name, generate)
-    source = cache.cached_text("stability-kernels", name, generate)
+        return cache.load_module("stability-kernels", name, generate, use_cache=use_cache)
+    source = cache.cached_text("stability-kernels", name, generate, use_cache=use_cache)
     return plain_module(source, f"<brakesqueal plain {name}>")
 
 
@@ -515,7 +517,7 @@ def plain_module(source: str, label: str) -> Any:
     return _PLAIN[digest]
 
 
-def disk_json(kind: str, ident: str, build: Callable[[], Any]) -> Any:
+def disk_json(kind: str, ident: str, build: Callable[[], Any], *, use_cache: bool = True) -> Any:
     """A JSON-able value built once and kept in the on-disk cache (so that warm starts need no SymPy).
 
     Keyed by ``kind`` and a hash of ``ident`` (model key, space key, axes); the
@@ -526,4 +528,4 @@ def disk_json(kind: str, ident: str, build: Callable[[], Any]) -> Any:
     from . import cache
 
     name = f"{kind}-{hashlib.sha256(ident.encode()).hexdigest()[:24]}.json"
-    return json.loads(cache.cached_text("stability-tables", name, lambda: json.dumps(build())))
+    return json.loads(cache.cached_text("stability-tables", name, lambda: json.dumps(build()), use_cache=use_cache))

@@ -129,7 +129,18 @@ class Points:
 
 
 def compact(a: Any) -> np.ndarray:
-    """The smallest broadcastable array equal to a broadcast view (stride-0 axes reduced to length 1)."""
+    """The smallest broadcastable array equal to a broadcast view (stride-0 axes reduced to length 1).
+
+    Parameters
+    ----------
+    a : array_like
+        Typically a view returned by :func:`numpy.broadcast_to`.
+
+    Returns
+    -------
+    ndarray
+        Same values, broadcastable to ``a.shape``.
+    """
     a = np.asarray(a)
     return a[tuple(slice(0, 1) if st == 0 and n > 1 else slice(None) for st, n in zip(a.strides, a.shape))]
 
@@ -143,6 +154,13 @@ def valid_points(space: ParameterSpace, arr: Mapping[str, Any]) -> np.ndarray:
     :func:`brakesqueal.model.roles.parameter_roles`), but combined per array
     shape first, so that a grid whose parameters each depend on one axis costs
     only a few full-size operations.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space.
+    arr : Mapping[str, ndarray]
+        Model parameter arrays (:meth:`ParameterSpace.arrays`).
 
     Returns
     -------
@@ -183,6 +201,11 @@ def carrier_labels(engine: Engine) -> tuple[tuple[str, ...], np.ndarray, np.ndar
     A mode is *carried* by the component whose states hold the largest share of its (balanced) eigenvector:
     the disk (its tilts ``q1``, ``q2``), a pad (its own coordinates), a caliper, or — for a massless pad whose
     deformation keeps a rate state — that pad's tangential rate (a non-oscillatory mode of the pad alone).
+
+    Parameters
+    ----------
+    engine : Engine
+        The model's engine.
 
     Returns
     -------
@@ -272,10 +295,17 @@ class LinearGroup:
 class Result:
     """What a route returns for the points it was given (arrays of their length).
 
-    ``code`` is :data:`STABLE`, :data:`UNSTABLE` or :data:`UNDECIDED`; ``max_real`` [1/s] and ``frequency``
-    [Hz] of the least-stable eigenvalue (NaN where not computed); ``bound`` an error bound of ``max_real``
-    when the route certified the verdict through it (NaN otherwise: e.g. a Routh test); ``carrier`` the
-    label index of the mode carrying the verdict (-1: not determined by the route).
+    Attributes
+    ----------
+    code : ndarray of uint8
+        :data:`STABLE`, :data:`UNSTABLE` or :data:`UNDECIDED`.
+    max_real, frequency : ndarray
+        The least-stable eigenvalue's real part [1/s] and frequency [Hz] (NaN where not computed).
+    bound : ndarray or None
+        An error bound of ``max_real`` where the route certified the verdict through it (NaN otherwise: e.g.
+        a Routh test).
+    carrier : ndarray of int or None
+        The label index of the mode carrying the verdict (-1: not determined by the route).
     """
 
     code: np.ndarray
@@ -384,6 +414,8 @@ class Verdicts:
 class Context:
     """One :func:`~._dispatch.decide` call: the request and everything computed for it once.
 
+    (Linear systems are kept by :meth:`add_group`; :func:`~._linear.linear_groups` reads them.)
+
     Attributes
     ----------
     engine : Engine
@@ -392,6 +424,8 @@ class Context:
         The parameter space (``None`` for linear systems given directly).
     points : Points or None
         The parameter points.
+    size : int
+        Number of points.
     eigen : bool
         ``max_real`` and ``frequency`` are wanted wherever a cheaper verdict exists.
     modes : str
@@ -420,8 +454,10 @@ class Context:
         self.closed = False
         #: silent motions (Q0, L0) of non-trivial points, NaN elsewhere
         self.z: np.ndarray | None = None
-        #: linear systems already built, by flat index: (group, position)
-        self.linear_cache: dict[int, tuple[LinearGroup, int]] = {}
+        #: linear systems already built: the groups, and per point its group (-1: none yet) and position in it
+        self.groups: list[LinearGroup] = []
+        self.group_of = np.full(size, -1, dtype=np.int64)
+        self.pos_of = np.zeros(size, dtype=np.int64)
         #: per point, the LinearModel given or built per point (for the parameter routes' reports)
         self.models: dict[int, Any] = {}
         #: what routes compute once per call (kernels, tables)
@@ -432,6 +468,12 @@ class Context:
         if engine is not None:
             labels, coord, pad = carrier_labels(engine)
         self.carriers, self.coord_label, self.pad_label = labels, coord, pad
+
+    def add_group(self, g: LinearGroup) -> None:
+        """Keep the linear systems of a group (each point's system is built once per call)."""
+        self.groups.append(g)
+        self.group_of[g.idx] = len(self.groups) - 1
+        self.pos_of[g.idx] = np.arange(g.idx.size)
 
     @property
     def disk_only(self) -> bool:

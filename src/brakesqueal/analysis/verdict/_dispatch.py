@@ -132,6 +132,15 @@ def decide_model(lm: Any, *, eigen: bool = True, modes: str = "all") -> Verdicts
     parameter point it is, so that its verdict is the one maps, sweeps and crossings give there; a model built
     by hand is decided from its matrices alone.
 
+    Parameters
+    ----------
+    lm : LinearModel
+        The linear model.
+    eigen : bool
+        Also compute ``max_real`` and the frequency where a cheaper certified verdict exists.
+    modes : {"all", "disk"}
+        As :func:`decide`.
+
     Returns
     -------
     Verdicts
@@ -150,8 +159,7 @@ def decide_model(lm: Any, *, eigen: bool = True, modes: str = "all") -> Verdicts
     ctx.status[0] = int(PointStatus.OK if trivial or engine is None else PointStatus.OK_NONTRIVIAL)
     ctx.trivial[0] = trivial and engine is not None
     ctx.models[0] = lm
-    g = group_of_model(lm, np.array([0]))
-    ctx.linear_cache[0] = (g, 0)
+    ctx.add_group(group_of_model(lm, np.array([0])))
     return _choose(ctx)
 
 

@@ -91,8 +91,7 @@ def _per_point(ctx: Context, i: int) -> None:
     ctx.status[i] = int(PointStatus.OK if lm.silent.trivial else PointStatus.OK_NONTRIVIAL)
     ctx.trivial[i] = bool(lm.silent.trivial)
     ctx.models[i] = lm
-    g = group_of_model(lm, np.array([i]))
-    ctx.linear_cache[i] = (g, 0)
+    ctx.add_group(group_of_model(lm, np.array([i])))
 
 
 def group_of_model(lm: Any, idx: np.ndarray) -> LinearGroup:
@@ -115,26 +114,20 @@ def group_of_model(lm: Any, idx: np.ndarray) -> LinearGroup:
 
 # ---------------------------------------------------------------- linear systems
 def linear_groups(ctx: Context, idx: np.ndarray) -> list[LinearGroup]:
-    """The linear systems at points ``idx`` (built once per point and cached in ``ctx``), grouped by shape.
+    """The linear systems at points ``idx`` (built once per point and kept in ``ctx``), grouped by shape.
 
     Points whose linearization fails get their status set in ``ctx`` and are left out.
     """
-    missing = np.array([i for i in idx if int(i) not in ctx.linear_cache], dtype=np.int64)
+    idx = np.asarray(idx, dtype=np.int64)
+    missing = idx[ctx.group_of[idx] < 0]
     if missing.size:
         _build(ctx, missing)
-    by: dict[int, list[tuple[int, int]]] = {}
-    groups: dict[int, LinearGroup] = {}
-    for i in idx:
-        hit = ctx.linear_cache.get(int(i))
-        if hit is None:
-            continue
-        g, pos = hit
-        by.setdefault(id(g), []).append((int(i), pos))
-        groups[id(g)] = g
+    have = idx[ctx.group_of[idx] >= 0]
+    gid = ctx.group_of[have]
     out = []
-    for gid, items in by.items():
-        g = groups[gid]
-        pos = np.array([p for _, p in items], dtype=np.int64)
+    for k in np.unique(gid):
+        g = ctx.groups[int(k)]
+        pos = ctx.pos_of[have[gid == k]]
         out.append(g if pos.size == g.idx.size and np.array_equal(pos, np.arange(g.idx.size)) else g.subset(pos))
     return _merge(out)
 
@@ -161,8 +154,7 @@ def _merge(groups: list[LinearGroup]) -> list[LinearGroup]:
 
 
 def _cache(ctx: Context, g: LinearGroup) -> None:
-    for pos, i in enumerate(g.idx):
-        ctx.linear_cache[int(i)] = (g, pos)
+    ctx.add_group(g)
 
 
 def _build(ctx: Context, idx: np.ndarray) -> None:
@@ -291,11 +283,11 @@ def _unresolved_rates(ctx: Context, P: np.ndarray, Z: np.ndarray, Jf: np.ndarray
     p = [P[:, k].astype(np.longdouble) for k in range(P.shape[1])]
     cols = np.arange(3 * n + m, nx)
     with np.errstate(all="ignore"):
-        vals = cm.vectorized.jacobians(x, p)
-        J = np.empty((N, n + m, cols.size), dtype=np.longdouble)
+        vals = cm.vectorized.rate_jacobians(x, p)  # only the rate columns: a fraction of the Jacobian's work
+        J = np.empty((N, n + m, m), dtype=np.longdouble)
         for r in range(n + m):
-            for c_i, c in enumerate(cols):
-                J[:, r, c_i] = np.broadcast_to(np.asarray(vals[r * nx + c], dtype=np.longdouble), (N,))
+            for c_i in range(m):
+                J[:, r, c_i] = np.broadcast_to(np.asarray(vals[r * m + c_i], dtype=np.longdouble), (N,))
         Jd = Jf.reshape(N, n + m, nx)[:, :, cols]
         bad = np.abs(Jd - J) > RATE_AGREEMENT * np.abs(J)
         bad |= ~np.isfinite(J)
