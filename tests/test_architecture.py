@@ -176,3 +176,132 @@ def test_private_import_detector_sees_relative_forms() -> None:
                                             ("brakesqueal.model.parameters", ["_model"])]
     assert [b for b, _, _ in _imports("brakesqueal.sweep.runner", tree, import_time=True)] == [
         "brakesqueal.simulation._interrupt", "brakesqueal.results"]
+
+
+# ------------------------------------------------------------------ layering, every import (function level too)
+#: The layers, lowest first.  A module may import its own unit and lower layers only, at module level or inside a
+#: function alike (``if TYPE_CHECKING:`` imports are annotations and do not count).  ``results`` (result types,
+#: their files and figures) sits below the computations that construct them and imports none of them.
+LAYERS: dict[str, int] = {
+    "brakesqueal": 0, "errors": 0, "status": 0, "suggest": 0, "fingerprint": 0, "outputs": 0, "interrupts": 0,
+    "model": 1, "symbolic": 2, "codegen": 3, "labels": 4, "results": 4, "plotting": 4, "analysis": 5,
+    "simulation": 6, "export": 6, "nonlinear": 7, "sweep": 7, "render": 8, "reproduce": 8, "api": 8,
+    "api_nonlinear": 8, "cli": 9, "explorer": 9, "demo": 9, "__main__": 9,
+}
+
+
+def _runtime_imports(module: str, tree: ast.Module) -> list[tuple[str, list[str], int]]:
+    """Every import that can run (module level and inside functions), not those under ``if TYPE_CHECKING:``."""
+    found: list[tuple[str, list[str], int]] = []
+
+    def visit(nodes: list[ast.stmt]) -> None:
+        for node in nodes:
+            if isinstance(node, ast.Import):
+                found.extend((a.name, [], node.lineno) for a in node.names
+                             if a.name == ROOT or a.name.startswith(ROOT + "."))
+            elif isinstance(node, ast.ImportFrom):
+                base = _base(module, node)
+                if base is not None:
+                    found.append((base, [a.name for a in node.names], node.lineno))
+            elif isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+                visit(node.orelse)
+            else:
+                for child in ast.iter_child_nodes(node):
+                    if isinstance(child, ast.stmt):
+                        visit([child])
+                    elif isinstance(child, ast.excepthandler):
+                        visit(child.body)
+    visit(tree.body)
+    return found
+
+
+def test_every_unit_has_a_layer() -> None:
+    units = {unit(m) for m in MODULES}
+    assert units <= set(LAYERS), f"units without a layer: {sorted(units - set(LAYERS))}"
+
+
+def test_imports_follow_the_layers_at_every_depth() -> None:
+    bad = []
+    for module, tree in TREES.items():
+        u = unit(module)
+        for base, names, line in _runtime_imports(module, tree):
+            for target in _targets(base, names):
+                v = unit(target)
+                if v != u and LAYERS[v] > LAYERS[u]:
+                    bad.append(f"{MODULES[module].relative_to(SRC)}:{line}: {u} (layer {LAYERS[u]}) imports "
+                               f"{target} ({v}, layer {LAYERS[v]})")
+    assert not bad, "imports against the layers:\n" + "\n".join(sorted(set(bad)))
+
+
+def test_layer_check_sees_function_level_imports() -> None:
+    tree = ast.parse("def f():\n    from ..cli import main\nif TYPE_CHECKING:\n    from ..api import engine\n")
+    assert [b for b, _, _ in _runtime_imports("brakesqueal.analysis.maps", tree)] == ["brakesqueal.cli"]
+
+
+# ------------------------------------------------------------------ one engine, one dispatcher
+#: Where an engine may be built (``build``/``compile_model`` called): the entry points.  A sweep's chunk runs in a
+#: worker process and its study file names a model: both build the model they read; ``export`` writes a model it
+#: builds.  Everything else receives the engine as a value.
+ENTRY_MODULES = {
+    "brakesqueal.api", "brakesqueal.api_nonlinear", "brakesqueal.sweep.compute", "brakesqueal.sweep.study",
+    "brakesqueal.export.model", "brakesqueal.codegen.engine",
+}
+ENTRY_UNITS = {"cli", "explorer"}
+#: Modules still building their own engine while their package moves onto the engine (none when done).
+PENDING_BUILD = {"brakesqueal.simulation._integrate"}
+
+
+def _calls(tree: ast.AST, names: set[str]) -> list[int]:
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call):
+            f = node.func
+            name = f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else ""
+            if name in names:
+                out.append(node.lineno)
+    return out
+
+
+def test_engines_are_built_only_at_entry_points() -> None:
+    bad, pending = [], set()
+    for module, tree in TREES.items():
+        if module in ENTRY_MODULES or unit(module) in ENTRY_UNITS:
+            continue
+        lines = _calls(tree, {"build", "compile_model"})
+        if not lines:
+            continue
+        if module in PENDING_BUILD:
+            pending.add(module)
+            continue
+        bad += [f"{MODULES[module].relative_to(SRC)}:{ln}" for ln in lines]
+    assert not bad, "an engine built below the entry points (pass it down instead):\n" + "\n".join(bad)
+    assert pending == PENDING_BUILD, f"no longer pending: {sorted(PENDING_BUILD - pending)}"
+
+
+#: The certified primitives a route runs; only route modules (and the primitives' own module) may call them.
+VERDICT_PRIMITIVES = {
+    "routh_verdicts", "routh_exact", "quartic_interval", "state_verdicts", "state_analysis", "eigen_verdicts",
+    "descriptor_verdicts", "extended_descriptor_verdict", "extended_analysis", "charpoly_verdicts", "classify",
+    "run_classify", "_exact_point",
+}
+PRIMITIVE_HOMES = {"brakesqueal.analysis.robust", "brakesqueal.analysis.kernels", "brakesqueal.codegen.stability"}
+
+
+def test_exactly_one_function_chooses_verdict_routes() -> None:
+    """Routes are run in one place (``_choose``); nothing outside the route modules calls a verdict primitive."""
+    runners = []
+    for module, tree in TREES.items():
+        for fn in ast.walk(tree):
+            if not isinstance(fn, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                continue
+            text = ast.unparse(fn)
+            if "ROUTES" in text and ".run(" in text:
+                runners.append(f"{module}.{fn.name}")
+    assert runners == ["brakesqueal.analysis.verdict._dispatch._choose"], runners
+    bad = []
+    for module, tree in TREES.items():
+        if module in PRIMITIVE_HOMES or module.startswith("brakesqueal.analysis.verdict."):
+            continue
+        for ln in _calls(tree, VERDICT_PRIMITIVES):
+            bad.append(f"{MODULES[module].relative_to(SRC)}:{ln}")
+    assert not bad, "verdict primitives called outside the routes (ask the dispatcher):\n" + "\n".join(bad)

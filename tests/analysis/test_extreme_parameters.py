@@ -123,7 +123,19 @@ def test_verdict_line_and_listed_eigenvalues_agree_at_extreme_values():
 
     from brakesqueal import linearize, resolve_space
     from brakesqueal import eigen_analysis
-    from brakesqueal.analysis.robust import charpoly_exact
+
+    def charpoly_exact(M, D, K):
+        """Exact ascending coefficients of det(lam^2 M + lam D + K), the floats taken as exact rationals (SymPy)."""
+        import sympy as sp
+        from fractions import Fraction
+
+        lam = sp.Symbol("lam")
+        n = np.shape(M)[0]
+        Q = sp.Matrix(n, n, lambda i, j: lam ** 2 * sp.Rational(float(M[i][j])) + lam * sp.Rational(float(D[i][j]))
+                      + sp.Rational(float(K[i][j])))
+        p = sp.Poly(Q.det(method="berkowitz"), lam)
+        return [Fraction(int(c.p), int(c.q)) for c in (sp.Rational(p.coeff_monomial(lam ** k)) for k in range(2 * n + 1))]
+
 
     rng = np.random.default_rng(27)
     cases = [("mu=1e90", "k_ip=inf"), ("k_ip=1e-100",), ("mu=1e30",), ("mu=1e50",), ("mu=0.4",)]

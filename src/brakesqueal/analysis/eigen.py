@@ -166,7 +166,7 @@ class EigenAnalysis:
         modes : {"all", "disk"}
             Judge every eigenvalue, or only the disk's (a massless pad's own tangential-rate mode left out).
         """
-        from .robust import EXTENDED_VERDICT_MAX_SIZE, STABLE, UNSTABLE, extended_descriptor_verdict
+        from .robust import EXTENDED_VERDICT_MAX_SIZE, STABLE, UNSTABLE, extended_eigen
         from .verdict import decide_model
 
         lm = self.model
@@ -179,7 +179,8 @@ class EigenAnalysis:
         if E.shape[0] <= EXTENDED_VERDICT_MAX_SIZE:
             # componentwise bound of the extended-precision route: the norm-wise one below is dominated by the
             # largest modes (pads' own modes up to 1e25 at tilted silent motions) and says little of the slow ones
-            listed_bound = extended_descriptor_verdict(E, A, len(lm.pad_states))[3]
+            ext = extended_eigen(E, A, len(lm.pad_states))
+            listed_bound = math.inf if ext is None or not ext[0].size else float(ext[1][int(np.argmax(ext[0].real))])
         else:
             listed_bound = safety * float(self.condition[i]) * _EPS * float(np.linalg.norm(lm.A, 2))
         status = "stable" if code == STABLE else "unstable" if code == UNSTABLE else "undecided"

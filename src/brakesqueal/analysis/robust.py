@@ -38,28 +38,24 @@ Matrices (any ``n``):
   :func:`eigen_verdicts` applies it to the ``2n × 2n`` state matrix of
   eq. (47), :func:`descriptor_verdicts` to ``E^-1 A`` of a descriptor system
   (massless pads kept as first-order states: every eigenvalue counts).
-* :func:`charpoly_exact` — exact rational ``det(λ²M + λD + K)`` of float
-  matrices (fraction-free, SymPy Berkowitz) for :func:`routh_exact`.
 
 2-DOF closed form (``n = 2``):
 
 * :func:`quartic_interval` — interval coefficients of the quartic from
   entries with radii.
-* :func:`trivial_verdicts` — the per-point robust route for parameter
-  vectors at the trivial silent motion: bounded closed-form entries →
-  interval quartic → certified Routh; undecided points → exact rational
-  evaluation of the closed form and :func:`routh_exact`; ``max_real`` and the
-  frequency reconciled with the verdict (:func:`reconcile`).
+* :func:`exact_trivial_entries` — the closed form evaluated in exact rational
+  arithmetic at a parameter vector (for :func:`routh_exact`).
 
-Consistency rule (:func:`reconcile`): a point marked stable has
-``max_real < 0``, an unstable one ``max_real >= 0``; disagreements are
-recomputed with 50-digit arithmetic and otherwise marked undecided.
+These are primitives: which of them decides a point is chosen in one place,
+the verdict dispatcher (:mod:`brakesqueal.analysis.verdict`), whose route
+modules call them; it also enforces the consistency rule (a point marked
+stable has ``max_real < 0``, an unstable one ``max_real >= 0``).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
@@ -71,10 +67,9 @@ if TYPE_CHECKING:
 __all__ = [
     "UNSTABLE", "STABLE", "UNDECIDED", "STATUS_UNDECIDED", "INPUT_REL", "routh_verdicts", "routh_exact",
     "horner_bound", "isolate_real_roots", "isolate_real_roots_float", "quartic_interval", "eigen_verdicts",
-    "charpoly_exact", "mp_roots_summary", "roots_summary", "trivial_verdicts", "matrix_verdicts", "reconcile",
-    "exact_trivial_entries", "balance", "state_verdicts", "descriptor_verdicts", "extended_descriptor_verdict",
-    "EXTENDED_VERDICT_MAX_SIZE", "mp_balanced", "extended_analysis", "state_analysis", "state_matrices",
-    "descriptor_states",
+    "mp_roots_summary", "roots_summary", "exact_trivial_entries", "balance", "state_verdicts", "descriptor_verdicts",
+    "extended_descriptor_verdict", "EXTENDED_VERDICT_MAX_SIZE", "mp_balanced", "extended_analysis", "extended_eigen",
+    "state_analysis", "state_matrices", "descriptor_states",
 ]
 
 UNSTABLE, STABLE, UNDECIDED = 0, 1, 2
@@ -686,6 +681,84 @@ def extended_descriptor_verdict(E: np.ndarray, A: np.ndarray, k: int, *, rel_inp
     return extended_analysis(E, A, k, rel_input=rel_input, dps=dps)[:5]  # type: ignore[return-value]
 
 
+def extended_eigen(E: np.ndarray, A: np.ndarray, k: int, *, rel_input: float = INPUT_REL, dps: int = 40
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Every finite eigenvalue of a descriptor system in extended precision, with componentwise error bounds.
+
+    The computation behind :func:`extended_descriptor_verdict` without a verdict (see there for the method).
+
+    Parameters
+    ----------
+    E, A, k, rel_input, dps
+        As :func:`extended_descriptor_verdict`.
+
+    Returns
+    -------
+    (eigenvalues, bounds, owner) or None
+        The eigenvalues, their first-order componentwise bounds ``10 δ`` and, per eigenvalue, the state
+        holding the largest component of its balanced eigenvector (an index of the original states); ``None``
+        where they cannot be computed (too large, not finite, a singular reduced ``E``, no convergence).
+    """
+    import mpmath
+
+    E, A = np.asarray(E, dtype=float), np.asarray(A, dtype=float)
+    m = E.shape[0]
+    if m > EXTENDED_VERDICT_MAX_SIZE or not (np.all(np.isfinite(E)) and np.all(np.isfinite(A))):
+        return None
+    rows = np.flatnonzero(np.all(E == 0.0, axis=1))
+    keep_c = list(range(m))
+    with mpmath.workdps(dps):
+        mE, mA = mpmath.matrix(E.tolist()), mpmath.matrix(A.tolist())
+        aE, aA = mpmath.matrix(np.abs(E).tolist()), mpmath.matrix(np.abs(A).tolist())
+        if rows.size:
+            if rows.size > k:
+                return None
+            import scipy.linalg
+
+            pads = np.arange(m - k, m)
+            _, _, piv = scipy.linalg.qr(A[np.ix_(rows, pads)], pivoting=True)
+            cols = pads[np.sort(piv[:rows.size])]
+            keep_r = [int(i) for i in np.setdiff1d(np.arange(m), rows)]
+            keep_c = [int(i) for i in np.setdiff1d(np.arange(m), cols)]
+
+            def sub(X: Any, r: Any, c: Any) -> Any:
+                return mpmath.matrix([[X[int(i), int(j)] for j in c] for i in r])
+
+            try:
+                X = mpmath.inverse(sub(mA, rows, cols)) * sub(mA, rows, keep_c)
+                aX = mpmath.matrix([[abs(v) for v in row] for row in X.tolist()])
+            except ZeroDivisionError:
+                return None
+            mE = sub(mE, keep_r, keep_c) - sub(mE, keep_r, cols) * X
+            mA = sub(mA, keep_r, keep_c) - sub(mA, keep_r, cols) * X
+            aE = sub(aE, keep_r, keep_c) + sub(aE, keep_r, cols) * aX
+            aA = sub(aA, keep_r, keep_c) + sub(aA, keep_r, cols) * aX
+        try:
+            Einv = mpmath.inverse(mE)
+            Sb, dg = mp_balanced(Einv * mA)
+            N = Sb.rows
+            lam, ELb, ERb = mpmath.eig(Sb, left=True, right=True)
+        except (ZeroDivisionError, mpmath.libmp.NoConvergence):
+            return None
+        out = np.empty(N, dtype=complex)
+        bounds = np.empty(N)
+        owner = np.zeros(N, dtype=np.int64)
+        for i in range(N):
+            owner[i] = int(np.argmax([abs(complex(ERb[r, i])) for r in range(N)]))
+            x = mpmath.matrix([ERb[r, i] * dg[r] for r in range(N)])
+            w = mpmath.matrix([[ELb[i, c] / dg[c] for c in range(N)]])
+            y = w * Einv  # y A' = λ y E'
+            den = abs((y * mE * x)[0, 0])
+            ax = mpmath.matrix([abs(v) for v in x])
+            ay = mpmath.matrix([[abs(v) for v in y]])
+            num = (ay * (aA + abs(lam[i]) * aE) * ax)[0, 0]
+            bounds[i] = float(10 * rel_input * num / den) if den > 0 else math.inf
+            out[i] = complex(lam[i])
+    tiny = np.abs(out.imag) <= 1e-30 * np.abs(out)
+    out[tiny] = out[tiny].real
+    return out, bounds, np.asarray(keep_c, dtype=np.int64)[owner]
+
+
 def extended_analysis(E: np.ndarray, A: np.ndarray, k: int, labels: np.ndarray | None = None,
                       exclude: np.ndarray | None = None, *, rel_input: float = INPUT_REL, dps: int = 40
                       ) -> tuple[int, float, float, float, np.ndarray, int]:
@@ -708,69 +781,16 @@ def extended_analysis(E: np.ndarray, A: np.ndarray, k: int, labels: np.ndarray |
         As :func:`extended_descriptor_verdict` (over the judged eigenvalues), and the carrier label of the
         least-stable judged one (-1 without ``labels``).
     """
-    import mpmath
-
-    E, A = np.asarray(E, dtype=float), np.asarray(A, dtype=float)
-    m = E.shape[0]
-    none = (UNDECIDED, math.nan, math.nan, math.inf, np.empty(0, dtype=complex), -1)
-    if m > EXTENDED_VERDICT_MAX_SIZE or not (np.all(np.isfinite(E)) and np.all(np.isfinite(A))):
-        return none
-    rows = np.flatnonzero(np.all(E == 0.0, axis=1))
-    keep_c = list(range(m))
-    with mpmath.workdps(dps):
-        mE, mA = mpmath.matrix(E.tolist()), mpmath.matrix(A.tolist())
-        aE, aA = mpmath.matrix(np.abs(E).tolist()), mpmath.matrix(np.abs(A).tolist())
-        if rows.size:
-            if rows.size > k:
-                return none
-            import scipy.linalg
-
-            pads = np.arange(m - k, m)
-            _, _, piv = scipy.linalg.qr(A[np.ix_(rows, pads)], pivoting=True)
-            cols = pads[np.sort(piv[:rows.size])]
-            keep_r = [int(i) for i in np.setdiff1d(np.arange(m), rows)]
-            keep_c = [int(i) for i in np.setdiff1d(np.arange(m), cols)]
-
-            def sub(X: Any, r: Any, c: Any) -> Any:
-                return mpmath.matrix([[X[int(i), int(j)] for j in c] for i in r])
-
-            try:
-                X = mpmath.inverse(sub(mA, rows, cols)) * sub(mA, rows, keep_c)
-                aX = mpmath.matrix([[abs(v) for v in row] for row in X.tolist()])
-            except ZeroDivisionError:
-                return none
-            mE = sub(mE, keep_r, keep_c) - sub(mE, keep_r, cols) * X
-            mA = sub(mA, keep_r, keep_c) - sub(mA, keep_r, cols) * X
-            aE = sub(aE, keep_r, keep_c) + sub(aE, keep_r, cols) * aX
-            aA = sub(aA, keep_r, keep_c) + sub(aA, keep_r, cols) * aX
-        try:
-            Einv = mpmath.inverse(mE)
-            Sb, dg = mp_balanced(Einv * mA)
-            N = Sb.rows
-            lam, ELb, ERb = mpmath.eig(Sb, left=True, right=True)
-        except (ZeroDivisionError, mpmath.libmp.NoConvergence):
-            return none
-        out = np.empty(N, dtype=complex)
-        bounds = np.empty(N)
-        owner = np.zeros(N, dtype=np.int64)
-        for i in range(N):
-            owner[i] = int(np.argmax([abs(complex(ERb[r, i])) for r in range(N)]))
-            x = mpmath.matrix([ERb[r, i] * dg[r] for r in range(N)])
-            w = mpmath.matrix([[ELb[i, c] / dg[c] for c in range(N)]])
-            y = w * Einv  # y A' = λ y E'
-            den = abs((y * mE * x)[0, 0])
-            ax = mpmath.matrix([abs(v) for v in x])
-            ay = mpmath.matrix([[abs(v) for v in y]])
-            num = (ay * (aA + abs(lam[i]) * aE) * ax)[0, 0]
-            bounds[i] = float(10 * rel_input * num / den) if den > 0 else math.inf
-            out[i] = complex(lam[i])
-    tiny = np.abs(out.imag) <= 1e-30 * np.abs(out)
-    out[tiny] = out[tiny].real
+    res = extended_eigen(E, A, k, rel_input=rel_input, dps=dps)
+    if res is None:
+        return UNDECIDED, math.nan, math.nan, math.inf, np.empty(0, dtype=complex), -1
+    out, bounds, owner = res
+    N = out.size
     carriers = np.full(N, -1, dtype=np.int64)
     judged = np.ones(N, dtype=bool)
     if labels is not None:
         lab = np.asarray(labels, dtype=np.int64)
-        carriers = lab[np.asarray(keep_c, dtype=np.int64)[owner]]
+        carriers = lab[owner]
         if exclude is not None and len(exclude):
             judged = ~np.isin(carriers, np.asarray(exclude, dtype=np.int64))
     if not judged.any():  # every mode excluded
@@ -787,23 +807,13 @@ def extended_analysis(E: np.ndarray, A: np.ndarray, k: int, labels: np.ndarray |
             int(carriers[j]))
 
 
+
+
 def _solve_or_nan(E: np.ndarray, A: np.ndarray) -> np.ndarray:
     try:
         return np.linalg.solve(E, A)
     except np.linalg.LinAlgError:
         return np.full(A.shape, np.nan)
-
-
-def charpoly_exact(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> list[Fraction]:
-    """Exact ascending coefficients of ``det(λ²M + λD + K)`` for float matrices taken as exact rationals."""
-    import sympy as sp
-
-    lam = sp.Symbol("lam")
-    n = np.shape(M)[0]
-    Q = sp.Matrix(n, n, lambda i, j: lam ** 2 * sp.Rational(float(M[i][j])) + lam * sp.Rational(float(D[i][j]))
-                  + sp.Rational(float(K[i][j])))
-    p = sp.Poly(Q.det(method="berkowitz"), lam)
-    return [_to_fraction(p.coeff_monomial(lam ** k)) for k in range(2 * n + 1)]
 
 
 def mp_roots_summary(coeffs: Sequence[Any], dps: int = 50) -> tuple[float, float]:
@@ -859,30 +869,6 @@ def roots_summary(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return mr, fr
 
 
-def reconcile(codes: np.ndarray, max_real: np.ndarray, recompute: Callable[[int], tuple[int, float, float]] | None,
-              frequency: np.ndarray | None = None) -> np.ndarray:
-    """Apply the consistency rule in place: stable ⇔ ``max_real < 0``, unstable ⇔ ``max_real >= 0``.
-
-    Points whose certified verdict contradicts the sign of their (floating
-    point) ``max_real`` are passed to ``recompute(i) -> (code, max_real,
-    frequency)`` (higher precision); if the contradiction remains, or no
-    ``recompute`` is given, the point becomes :data:`UNDECIDED`.  Returns the
-    indices that were changed.
-    """
-    mr = np.asarray(max_real)
-    bad = np.flatnonzero(((codes == STABLE) & ~(mr < 0)) | ((codes == UNSTABLE) & ~(mr >= 0)))
-    for i in bad:
-        if recompute is not None:
-            c, m, f = recompute(int(i))
-            codes[i] = c
-            max_real[i] = m
-            if frequency is not None:
-                frequency[i] = f
-        if (codes[i] == STABLE and not max_real[i] < 0) or (codes[i] == UNSTABLE and not max_real[i] >= 0):
-            codes[i] = UNDECIDED
-    return bad
-
-
 # ---------------------------------------------------------------- 2-DOF closed form, exact
 def exact_trivial_entries(engine: Engine, p: Sequence[float]) -> list[Fraction]:
     """The 12 closed-form entries of ``M, D, K`` (trivial silent motion) evaluated exactly at parameter vector ``p``.
@@ -925,92 +911,3 @@ def _exact_point(engine: Engine, p: Sequence[float], eigen: bool) -> tuple[int, 
     return code, mr, fr
 
 
-def trivial_verdicts(engine: Engine, P: np.ndarray, *, eigen: bool = True, codes: np.ndarray | None = None
-                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per-point robust route for 2-DOF parameter vectors at the trivial silent motion.
-
-    Parameters
-    ----------
-    engine : Engine
-        The model's engine; it needs a closed form (:attr:`Capabilities.closed_form
-        <brakesqueal.codegen.engine.Capabilities.closed_form>`).
-    P : ndarray, shape (n, n_parameters)
-        Parameter vectors (the model's packing order, compliances), valid and
-        with a trivial silent motion (for the paper's model ``mu1 h10 = mu2 h20``).
-    eigen : bool
-        Also compute ``max_real`` and ``frequency`` (and reconcile them with
-        the verdicts).
-    codes : ndarray of uint8, optional
-        Verdicts already certified elsewhere (e.g. by a compiled map kernel);
-        only entries equal to :data:`UNDECIDED` are recomputed.
-
-    Returns
-    -------
-    codes, max_real, frequency : ndarray, shape (n,)
-        Verdict codes (certified, or :data:`UNDECIDED` only for points exactly
-        on the stability boundary), and the least-stable root (NaN if
-        ``eigen`` is false).
-
-    Notes
-    -----
-    Route: bounded closed-form entries (:func:`~.kernels.trivial_entries`) →
-    :func:`quartic_interval` → :func:`routh_verdicts`; undecided points are
-    evaluated exactly (closed form in rational arithmetic at the parameter
-    vector, :func:`routh_exact`).  With ``eigen``, ``max_real`` comes from the
-    balanced companion matrix of the quartic; contradictions with the verdict
-    are recomputed with mpmath roots of the exact quartic (:func:`reconcile`).
-    """
-    from .kernels import trivial_entries
-
-    P = np.ascontiguousarray(np.atleast_2d(P), dtype=float)
-    n = P.shape[0]
-    mr = np.full(n, np.nan)
-    fr = np.full(n, np.nan)
-    if n == 0:
-        return np.zeros(0, dtype=np.uint8), mr, fr
-    todo = np.ones(n, bool) if codes is None else (codes == UNDECIDED)
-    out = np.full(n, UNDECIDED, dtype=np.uint8) if codes is None else codes.astype(np.uint8).copy()
-    A = RA = None
-    if todo.any() or eigen:
-        E, R = trivial_entries(engine, P)
-        A, RA = quartic_interval(E, R)
-    if todo.any():
-        ix = np.flatnonzero(todo)
-        out[ix] = routh_verdicts(A[ix], RA[ix])
-        for i in ix[out[ix] == UNDECIDED]:
-            if np.all(np.isfinite(P[i])):
-                out[i] = _exact_point(engine, P[i], False)[0]
-    if eigen and A is not None:
-        mr, fr = roots_summary(A)
-        reconcile(out, mr, lambda i: _exact_point(engine, P[i], True), fr)
-    return out, mr, fr
-
-
-def matrix_verdicts(M: np.ndarray, D: np.ndarray, K: np.ndarray, *, rel_input: float = INPUT_REL,
-                    eigen: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Robust verdicts for numerically computed matrices (any ``n``), e.g. non-trivial silent motions.
-
-    ``n = 2``: interval quartic with norm-wise input radii ``rel_input max|X|``
-    per matrix → certified Routh; then (any ``n``) the eigenvalue route
-    (:func:`eigen_verdicts`) for what is left; ``max_real`` reconciled (a
-    contradiction makes the point :data:`UNDECIDED`).  Returns
-    ``(codes, max_real, frequency)``.
-    """
-    M, D, K = (np.asarray(X, dtype=float) for X in (M, D, K))
-    if M.ndim == 2:
-        M, D, K = M[None], D[None], K[None]
-    N, n = M.shape[0], M.shape[-1]
-    codes = np.full(N, UNDECIDED, dtype=np.uint8)
-    if n == 2:
-        E = np.concatenate([M.reshape(N, 4), D.reshape(N, 4), K.reshape(N, 4)], axis=1)
-        with np.errstate(all="ignore"):
-            R = np.concatenate([np.repeat(rel_input * np.max(np.abs(X.reshape(N, 4)), axis=1, keepdims=True), 4, axis=1)
-                                for X in (M, D, K)], axis=1)
-        A, RA = quartic_interval(E, R)
-        codes = routh_verdicts(A, RA)
-    ec, mr, fr = eigen_verdicts(M, D, K, rel_input=rel_input)
-    und = codes == UNDECIDED
-    codes[und] = ec[und]
-    if eigen:
-        reconcile(codes, mr, None, fr)
-    return codes, mr, fr

@@ -74,6 +74,7 @@ GENERATOR_MODULES: tuple[str, ...] = (
     "render.py",  # the rendered closed forms cached by ``derive``
     "nonlinear/*.py",  # compiled flows of the continuation (numba) and what they import
     "fingerprint.py",  # the fingerprint itself
+    "status.py",  # the triviality rule (TRIVIAL_NOISE_FLOOR) decides the cached closed-route tables
 )
 
 

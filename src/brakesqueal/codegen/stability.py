@@ -517,7 +517,7 @@ def plain_module(source: str, label: str) -> Any:
     return _PLAIN[digest]
 
 
-def disk_json(kind: str, ident: str, build: Callable[[], Any], *, use_cache: bool = True) -> Any:
+def disk_json(kind: str, ident: str, make: Callable[[], Any], *, use_cache: bool = True) -> Any:
     """A JSON-able value built once and kept in the on-disk cache (so that warm starts need no SymPy).
 
     Keyed by ``kind`` and a hash of ``ident`` (model key, space key, axes); the
@@ -528,4 +528,4 @@ def disk_json(kind: str, ident: str, build: Callable[[], Any], *, use_cache: boo
     from . import cache
 
     name = f"{kind}-{hashlib.sha256(ident.encode()).hexdigest()[:24]}.json"
-    return json.loads(cache.cached_text("stability-tables", name, lambda: json.dumps(build()), use_cache=use_cache))
+    return json.loads(cache.cached_text("stability-tables", name, lambda: json.dumps(make()), use_cache=use_cache))
