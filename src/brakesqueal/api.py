@@ -177,7 +177,7 @@ def evaluate_point(space: ParameterSpace, values: Mapping[str, float] | None = N
 
 def stability_map(space: ParameterSpace, x: Axis, y: Axis, *, force: bool = False, eigen: bool = True,
                   chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None,
-                  boundary: bool = True, modes: str = "all") -> Any:
+                  boundary: bool = True, modes: str = "all", quantities: tuple[str, ...] | None = None) -> Any:
     """A stability map over two settable parameters (:func:`brakesqueal.analysis.maps.stability_map`).
 
     Parameters
@@ -198,6 +198,8 @@ def stability_map(space: ParameterSpace, x: Axis, y: Axis, *, force: bool = Fals
         Also locate the stability boundary by bisection.
     modes : {"all", "disk"}
         Judge every eigenvalue, or leave out the modes of a massless pad's own tangential rate.
+    quantities : tuple of str, optional
+        Further quantities to store (default ``carrier`` and ``route``; :mod:`brakesqueal.analysis.quantities`).
 
     Returns
     -------
@@ -206,12 +208,12 @@ def stability_map(space: ParameterSpace, x: Axis, y: Axis, *, force: bool = Fals
     from .analysis.maps import stability_map as _map
 
     return _map(engine(space), space, x, y, force=force, eigen=eigen, chunk_points=chunk_points, progress=progress,
-                boundary=boundary, modes=modes)
+                boundary=boundary, modes=modes, quantities=quantities)
 
 
 def write_map(space: ParameterSpace, x: Axis, y: Axis, path: str, *, force: bool = False, eigen: bool = True,
               chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None, boundary: bool = True,
-              modes: str = "all") -> MapSummary:
+              modes: str = "all", quantities: tuple[str, ...] | None = None) -> MapSummary:
     """A stability map written to NetCDF block by block (:func:`brakesqueal.analysis.maps.write_map`).
 
     Parameters
@@ -222,7 +224,7 @@ def write_map(space: ParameterSpace, x: Axis, y: Axis, path: str, *, force: bool
         The axes.
     path : str
         The NetCDF file.
-    force, eigen, chunk_points, progress, boundary, modes
+    force, eigen, chunk_points, progress, boundary, modes, quantities
         As :func:`stability_map`.
 
     Returns
@@ -232,10 +234,10 @@ def write_map(space: ParameterSpace, x: Axis, y: Axis, path: str, *, force: bool
     from .analysis.maps import write_map as _write
 
     return _write(engine(space), space, x, y, path, force=force, eigen=eigen, chunk_points=chunk_points,
-                  progress=progress, boundary=boundary, modes=modes)
+                  progress=progress, boundary=boundary, modes=modes, quantities=quantities)
 
 
-def crossings(space: ParameterSpace, axis: Axis) -> Any:
+def crossings(space: ParameterSpace, axis: Axis, *, modes: str = "all") -> Any:
     """Every stability change along one settable parameter (:func:`brakesqueal.analysis.crossings.crossings`).
 
     Parameters
@@ -244,6 +246,8 @@ def crossings(space: ParameterSpace, axis: Axis) -> Any:
         The model, preset and overrides.
     axis : Axis
         The path (its ``num`` is ignored).
+    modes : {"all", "disk"}
+        Judge every eigenvalue, or leave out the modes of a massless pad's own tangential rate.
 
     Returns
     -------
@@ -251,10 +255,10 @@ def crossings(space: ParameterSpace, axis: Axis) -> Any:
     """
     from .analysis.crossings import crossings as _crossings
 
-    return _crossings(engine(space), space, axis)
+    return _crossings(engine(space), space, axis, modes=modes)
 
 
-def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5) -> Any:
+def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5, *, modes: str = "all") -> Any:
     """All onsets and re-stabilisations along Ω (:func:`brakesqueal.analysis.crossings.critical_speeds`).
 
     Parameters
@@ -263,6 +267,8 @@ def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5) -> 
         The model, preset and overrides; the spin must be a settable name.
     lo, hi : float
         The Ω range [rad/s], ``0 < lo < hi``.
+    modes : {"all", "disk"}
+        Judge every eigenvalue, or leave out the modes of a massless pad's own tangential rate.
 
     Returns
     -------
@@ -270,7 +276,7 @@ def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5) -> 
     """
     from .analysis.crossings import critical_speeds as _critical
 
-    return _critical(engine(space), space, lo, hi)
+    return _critical(engine(space), space, lo, hi, modes=modes)
 
 
 def critical_speeds_many(space: ParameterSpace, changes: dict[str, Any], lo: float = 1.0, hi: float = 1e5,

@@ -20,7 +20,7 @@ import numpy as np
 from .labels import unit
 
 __all__ = ["StabilityMap", "CrossingResult", "CriticalSpeedResult", "open_map", "MapFile", "plot_map_file",
-           "NC3_MAX_VAR_BYTES", "MAX_PLOT_POINTS", "plot_indices", "label_attrs", "label_names"]
+           "NC3_MAX_VAR_BYTES", "MAX_PLOT_POINTS", "plot_indices", "label_names"]
 
 def _status_attrs() -> dict[str, Any]:
     from .status import STATUS_MEANINGS, PointStatus
@@ -45,17 +45,8 @@ _VAR_ATTRS = {
 _STABLE_FLAGS = {"flag_values": np.array([0, 1], dtype=np.int8), "flag_meanings": "unstable stable"}
 
 
-def label_attrs(kind: str, labels: tuple[str, ...]) -> dict[str, Any]:
-    """Attributes of a ``carrier`` or ``route`` variable: CF flags naming its codes (-1: none)."""
-    long = {"carrier": "mode carrying the verdict (the component holding the largest share of the least-stable "
-                       "eigenvector; -1: no verdict)",
-            "route": "stability route that decided the point (brakesqueal.analysis.verdict; 0: none)"}[kind]
-    return {"long_name": long, "flag_values": np.arange(len(labels), dtype=np.int8),
-            "flag_meanings": " ".join(lab.replace(" ", "_") for lab in labels)}
-
-
 def label_names(attrs: Any) -> tuple[str, ...]:
-    """The labels of a ``carrier``/``route`` variable from its attributes (:func:`label_attrs`)."""
+    """The labels of a flag variable (``carrier``, ``route``) from its attributes (``flag_meanings``)."""
     return tuple(m.replace("_", " ") for m in str(attrs.get("flag_meanings", "")).split())
 
 
@@ -215,7 +206,7 @@ class MapFile:
 
     def __init__(self, path: str, space: Any, outer: Any, inner: Any, *, eigen: bool,
                  float_dtype: Any = np.float64, method: str = "", boundary: bool = True,
-                 carriers: tuple[str, ...] = (), routes: tuple[str, ...] = ()) -> None:
+                 extras: tuple[tuple[str, Any, dict[str, Any]], ...] = ()) -> None:
         from .errors import ParameterError
 
         self.space, self.outer, self.inner = space, outer, inner
@@ -233,10 +224,10 @@ class MapFile:
                       for ax in (outer, inner)]
         grid = [("stable", np.dtype("i1"), {**_VAR_ATTRS["stable"], **_STABLE_FLAGS}),
                 ("status", np.dtype("i1"), _status_attrs())]
-        if carriers:
-            grid.append(("carrier", np.dtype("i1"), label_attrs("carrier", carriers)))
-        if routes:
-            grid.append(("route", np.dtype("i1"), label_attrs("route", routes)))
+        for name, dt, attrs in extras:
+            d = np.dtype(dt)
+            d = ft if d.kind == "f" else d.newbyteorder(">") if d.itemsize > 1 else d
+            grid.append((name, d, {**attrs, "_FillValue": d.type(np.nan)} if d.kind == "f" else dict(attrs)))
         if eigen:
             grid.insert(0, ("max_real", ft, {**_VAR_ATTRS["max_real"], "_FillValue": ft.type(np.nan)}))
             grid.insert(2, ("frequency", ft, {**_VAR_ATTRS["frequency"], "_FillValue": ft.type(np.nan)}))
@@ -279,13 +270,14 @@ class MapFile:
 
     def write_rows(self, r0: int, r1: int, stable: np.ndarray, status: np.ndarray,
                    max_real: np.ndarray | None = None, frequency: np.ndarray | None = None, *, c0: int = 0,
-                   carrier: np.ndarray | None = None, route: np.ndarray | None = None) -> None:
+                   extra: dict[str, np.ndarray] | None = None) -> None:
         """Write the block ``[r0:r1, c0:c0 + width]`` of the map: whole outer rows, or a piece of one row.
 
         The arrays have shape ``(r1 - r0, width)``: ``width = inner.num``
         (and ``c0 = 0``) for whole rows; a piece of one row (``r1 = r0 + 1``)
         may start at any ``c0``.  ``max_real`` and ``frequency`` are required
-        when the file stores them (``eigen``) and ignored otherwise.
+        when the file stores them (``eigen``) and ignored otherwise; ``extra`` holds the further variables given
+        at creation (``extras``).
         """
         n_i = self.inner.num
         width = int(np.shape(stable)[-1]) if np.ndim(stable) == 2 else -1
@@ -295,11 +287,11 @@ class MapFile:
                              f"one row of the ({self.outer.num}, {n_i}) grid")
         start = r0 * n_i + c0
         cells = {"stable": stable, "status": status}
-        for name, values in (("carrier", carrier), ("route", route)):
-            if name in self._grid:
-                if values is None:
+        for name in self._grid:
+            if name not in ("stable", "status", "max_real", "frequency"):
+                if extra is None or name not in extra:
                     raise ValueError(f"this map file stores {name}: give it")
-                cells[name] = values
+                cells[name] = extra[name]
         if self.eigen:
             if max_real is None or frequency is None:
                 raise ValueError("this map file stores max_real and frequency: give both")
@@ -384,8 +376,8 @@ class StabilityMap:
     @classmethod
     def from_arrays(cls, space: Any, outer: Any, inner: Any, *, stable: np.ndarray, status: np.ndarray,
                     max_real: np.ndarray | None, frequency: np.ndarray | None, method: str,
-                    boundary: Any = None, carrier: np.ndarray | None = None, carriers: tuple[str, ...] = (),
-                    route: np.ndarray | None = None, routes: tuple[str, ...] = ()) -> StabilityMap:
+                    boundary: Any = None, extra: dict[str, tuple[np.ndarray, dict[str, Any]]] | None = None
+                    ) -> StabilityMap:
         """Build the Dataset from computed arrays (``max_real``/``frequency`` ``None``: not computed, left out).
 
         Parameters
@@ -403,11 +395,9 @@ class StabilityMap:
         boundary : Boundary, optional
             The refined stability boundary (:func:`~brakesqueal.analysis.boundary.stability_boundary`),
             stored as ``boundary_<outer>``, ``boundary_<inner>`` along the dimension ``boundary_vertex``.
-        carrier, route : ndarray of int8, optional
-            Per point the mode carrying the verdict and the route that decided (codes of ``carriers`` and
-            ``routes``).
-        carriers, routes : tuple of str
-            Their labels.
+        extra : dict, optional
+            Further variables ``name -> (array, attributes)`` (the map's other quantities, e.g. ``carrier`` and
+            ``route``: :mod:`brakesqueal.analysis.quantities`).
 
         Returns
         -------
@@ -426,10 +416,8 @@ class StabilityMap:
         if frequency is not None:
             data["frequency"] = (dims, frequency, dict(_VAR_ATTRS["frequency"]))
         data["status"] = (dims, status, _status_attrs())
-        if carrier is not None:
-            data["carrier"] = (dims, np.asarray(carrier, dtype=np.int8), label_attrs("carrier", carriers))
-        if route is not None:
-            data["route"] = (dims, np.asarray(route, dtype=np.int8), label_attrs("route", routes))
+        for name, (values, attrs) in (extra or {}).items():
+            data[name] = (dims, values, dict(attrs))
         if boundary is not None and boundary.coords[0].size:
             for name, values in zip(boundary.names, boundary.coords):
                 data[f"boundary_{name}"] = ((BOUNDARY_DIM,), values, _boundary_attrs(name, space))

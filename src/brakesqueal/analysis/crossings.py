@@ -275,20 +275,20 @@ def _grid(axis: Axis, n: int) -> np.ndarray:
     return np.linspace(axis.start, axis.stop, n)
 
 
-def _profile(engine: Engine, space: ParameterSpace, axis: Axis, n: int = PROFILE_POINTS
+def _profile(engine: Engine, space: ParameterSpace, axis: Axis, n: int = PROFILE_POINTS, modes: str = "all"
              ) -> tuple[np.ndarray, np.ndarray]:
     """``(values, max_real)`` along a path from the per-point evaluator (NaN where undecidable)."""
     from .points import evaluate
 
     grid = _grid(axis, n)
-    r = evaluate(engine, space, {axis.name: grid})
+    r = evaluate(engine, space, {axis.name: grid}, modes=modes)
     return grid, np.where(np.isin(r.status, _DECIDED), r.max_real, np.nan)
 
 
 _DECIDED = (int(PointStatus.OK), int(PointStatus.OK_NONTRIVIAL))
 
 
-def _numeric(engine: Engine, space: ParameterSpace, axis: Axis, n: int = NUMERIC_GRID
+def _numeric(engine: Engine, space: ParameterSpace, axis: Axis, n: int = NUMERIC_GRID, modes: str = "all"
              ) -> tuple[bool, list[tuple[float, str]], list[tuple[float, float]], tuple[np.ndarray, np.ndarray]]:
     """Certified per-point verdicts on a grid, sign changes bracketed, Brent on max Re λ."""
     from scipy.optimize import brentq
@@ -296,7 +296,7 @@ def _numeric(engine: Engine, space: ParameterSpace, axis: Axis, n: int = NUMERIC
     from .points import evaluate, evaluate_point
 
     grid = _grid(axis, n)
-    r = evaluate(engine, space, {axis.name: grid})
+    r = evaluate(engine, space, {axis.name: grid}, modes=modes)
     ok = np.isin(r.status, _DECIDED)
     st = r.stable & ok
     mr = r.max_real
@@ -306,7 +306,7 @@ def _numeric(engine: Engine, space: ParameterSpace, axis: Axis, n: int = NUMERIC
     out: list[tuple[float, str]] = []
 
     def f(v: float) -> float:
-        return evaluate_point(engine, space, {axis.name: v}).max_real
+        return evaluate_point(engine, space, {axis.name: v}, modes=modes).max_real
 
     dec = np.flatnonzero(ok)
     for k0, k1 in zip(dec[:-1], dec[1:]):
@@ -337,7 +337,7 @@ def _valid_fn(space: Any, name: str) -> Any:
     return valid
 
 
-def crossings(engine: Engine, space: ParameterSpace, axis: Axis) -> Any:
+def crossings(engine: Engine, space: ParameterSpace, axis: Axis, *, modes: str = "all") -> Any:
     """Every value of ``axis.name`` in ``(start, stop)`` where stability of the silent motion changes.
 
     Stability is that of the linearized equations (47) about the silent
@@ -358,6 +358,9 @@ def crossings(engine: Engine, space: ParameterSpace, axis: Axis) -> Any:
         sampled between candidates (geometric instead of arithmetic
         midpoints) and the spacing of the numeric route's grid; ``num`` is
         ignored.
+    modes : {"all", "disk"}
+        Judge every eigenvalue (default), or leave out the modes carried by a massless pad's own tangential
+        rate (a model with a closed form has none: both are the same there).
 
     Returns
     -------
@@ -392,12 +395,12 @@ def crossings(engine: Engine, space: ParameterSpace, axis: Axis) -> Any:
     space.check_axis(axis.name)
     _check_some_valid(space, axis)
     table = engine.univariate(space, axis.name)
-    if table is not None:
+    if table is not None:  # a closed form: no pad keeps a rate state, every mode is judged either way
         start, found, undecided = exact_crossings(table, axis.start, axis.stop, axis.log, _valid_fn(space, axis.name))
         method, exhaustive = "exact (isolated real roots of the Hurwitz polynomials of the closed form)", True
         prof = _profile(engine, space, axis)
     else:
-        start, found, undecided, prof = _numeric(engine, space, axis)
+        start, found, undecided, prof = _numeric(engine, space, axis, modes=modes)
         method = (f"numeric (certified per-point verdicts on a {NUMERIC_GRID}-point grid + Brent on max Re lambda; "
                   "grid search)")
         exhaustive = False
@@ -459,7 +462,8 @@ def _omega_batchable(engine: Engine, space: ParameterSpace, name: str) -> bool:
     return engine.closed_route(space, ())
 
 
-def critical_speeds(engine: Engine, space: ParameterSpace, lo: float = 1.0, hi: float = 1e5) -> Any:
+def critical_speeds(engine: Engine, space: ParameterSpace, lo: float = 1.0, hi: float = 1e5, *,
+                    modes: str = "all") -> Any:
     """All onsets and re-stabilisations of squeal along the spin rate Ω in ``(lo, hi)`` [rad/s].
 
     Uses the certified compiled Laurent-polynomial kernel when the model has
@@ -482,6 +486,9 @@ def critical_speeds(engine: Engine, space: ParameterSpace, lo: float = 1.0, hi: 
         (:func:`omega_name`) must be one of its settable names (not tied).
     lo, hi : float, optional
         The Ω range [rad/s], ``0 < lo < hi`` (default ``1.0`` to ``1e5``).
+    modes : {"all", "disk"}
+        Judge every eigenvalue (default), or leave out the modes carried by a massless pad's own tangential
+        rate (:func:`crossings`).
 
     Returns
     -------
@@ -522,7 +529,7 @@ def critical_speeds(engine: Engine, space: ParameterSpace, lo: float = 1.0, hi: 
                                    crossings=found, method="exact (certified compiled Laurent-polynomial Hurwitz "
                                    "kernel, exact rational fallback)", space=space, undecided_ranges=undecided,
                                    profile=_profile(engine, space, axis))
-    r = crossings(engine, space, axis)
+    r = crossings(engine, space, axis, modes=modes)
     return CriticalSpeedResult(parameter=name, start=lo, stop=hi, log=True, stable_at_start=r.stable_at_start,
                                crossings=r.crossings, method=r.method, space=space,
                                undecided_ranges=r.undecided_ranges, exhaustive=r.exhaustive, profile=r.profile)

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..status import PointStatus
-from .verdict import ROUTES, Points, Verdicts, decide
+from .verdict import Points, Verdicts, route_names
 
 if TYPE_CHECKING:
     from ..codegen.engine import Engine
@@ -322,7 +322,7 @@ class _Plan:
 def routes_text(closed: bool) -> str:
     """The ``method`` of a map or study: the routes in the order the dispatcher tries them (ASCII, NetCDF3)."""
     return "certified verdicts by the first route that decides (per point: variable 'route'): " + ", ".join(
-        r.name for r in ROUTES)
+        route_names()[1:])
 
 
 def _plan(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, force: bool, eigen: bool,
@@ -337,7 +337,7 @@ def _plan(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, force: bool, 
     return _Plan(engine, outer, inner, routes_text(closed), ftype)
 
 
-_Block = tuple[int, int, int, int, Verdicts]
+_Block = tuple[int, int, int, int, "dict[str, np.ndarray]"]
 
 
 def _blocks(n_o: int, n_i: int, points: int) -> Iterator[tuple[int, int, int, int]]:
@@ -354,14 +354,21 @@ def _blocks(n_o: int, n_i: int, points: int) -> Iterator[tuple[int, int, int, in
             yield r0, r0 + 1, c0, min(n_i, c0 + points)
 
 
-def _rows(space: ParameterSpace, plan: _Plan, eigen: bool, chunk_points: int, modes: str = "all"
+#: The quantities a map stores besides ``stable``, ``status``, ``max_real`` and ``frequency`` (by default).
+MAP_EXTRAS = ("carrier", "route")
+
+
+def _rows(space: ParameterSpace, plan: _Plan, names: tuple[str, ...], chunk_points: int, modes: str = "all"
           ) -> Iterator[_Block]:
-    """Yield ``(r0, r1, c0, c1, verdicts)`` for blocks of the grid (bounded memory).
+    """Yield ``(r0, r1, c0, c1, values)`` for blocks of the grid (bounded memory).
 
     A block is ``[r0:r1, c0:c1]`` of the ``(outer, inner)`` grid with at most
     ``chunk_points`` points: whole outer rows, or pieces of one row when a row
-    is longer; each block is decided by :func:`~.verdict.decide` as a grid.
+    is longer; each block is computed by the one grid evaluator of maps and sweeps
+    (:func:`~.quantities.evaluate_block`: the dispatcher's verdicts and the quantities ``names``).
     """
+    from .quantities import evaluate_block
+
     outer, inner = plan.outer, plan.inner
     n_o, n_i = outer.num, inner.num
     iv_all = inner.values() if n_i <= max(1, chunk_points) else None  # whole rows: the inner values formed once
@@ -370,12 +377,25 @@ def _rows(space: ParameterSpace, plan: _Plan, eigen: bool, chunk_points: int, mo
         iv = iv_all if iv_all is not None else inner.values_range(c0, c1)
         ov = outer.values_range(r0, r1)
         pts = Points.of(space, {outer.name: ov, inner.name: iv}, grid=True)
-        yield r0, r1, c0, c1, decide(plan.engine, space, pts, eigen=eigen, modes=modes)
+        yield r0, r1, c0, c1, evaluate_block(plan.engine, space, pts, names, modes=modes)
+
+
+def _names(eigen: bool, extras: tuple[str, ...] | None) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """``(all quantity names, the extras)`` of a map: ``max_real``/``frequency`` with ``eigen``, and the extras
+    (default :data:`MAP_EXTRAS`; quantities needing eigenvalues are left out without ``eigen``)."""
+    from .quantities import quantity
+
+    ex = tuple(MAP_EXTRAS if extras is None else extras)
+    for n in ex:
+        quantity(n)  # unknown names: one error naming the allowed ones
+    ex = tuple(n for n in ex if n not in ("stable", "status", "max_real", "frequency") and (eigen or not
+                                                                                              quantity(n).eigen))
+    return (("max_real", "frequency") if eigen else ()) + ex, ex
 
 
 def stability_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, *, force: bool = False,
                   eigen: bool = True, chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None,
-                  boundary: bool = True, modes: str = "all") -> Any:
+                  boundary: bool = True, modes: str = "all", quantities: tuple[str, ...] | None = None) -> Any:
     """Compute a stability map over two settable parameters of ``space``.
 
     Parameters
@@ -407,6 +427,9 @@ def stability_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, *, fo
     modes : {"all", "disk"}
         Judge every eigenvalue (default), or leave out the modes carried by a massless pad's own tangential
         rate (:func:`~.verdict.decide`).
+    quantities : tuple of str, optional
+        Further quantities to store (:mod:`~.quantities`; default :data:`MAP_EXTRAS`: ``carrier`` and
+        ``route``); ``max_real`` and ``frequency`` follow ``eigen``.
 
     Returns
     -------
@@ -426,30 +449,31 @@ def stability_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, *, fo
     """
     from ..results import StabilityMap
 
+    from .quantities import attributes, quantity
+
     plan = _plan(engine, space, x, y, force, eigen)
+    names, ex = _names(eigen, quantities)
     n_o, n_i = plan.outer.num, plan.inner.num
     stable = np.zeros((n_o, n_i), dtype=bool)
     status = np.zeros((n_o, n_i), dtype=np.int8)
-    carrier = np.full((n_o, n_i), -1, dtype=np.int8)
-    route = np.zeros((n_o, n_i), dtype=np.int8)
     max_real = np.full((n_o, n_i), np.nan, dtype=plan.ftype) if eigen else None
     freq = np.full((n_o, n_i), np.nan, dtype=plan.ftype) if eigen else None
-    labels: tuple[tuple[str, ...], tuple[str, ...]] = ((), ())
-    for r0, r1, c0, c1, v in _rows(space, plan, eigen, chunk_points, modes):
-        stable[r0:r1, c0:c1] = v.stable
-        status[r0:r1, c0:c1] = v.status
-        carrier[r0:r1, c0:c1] = v.carrier
-        route[r0:r1, c0:c1] = v.method
-        labels = (v.carriers, v.methods)
+    extra = {n: np.full((n_o, n_i), quantity(n).fill, dtype=plan.ftype if np.dtype(quantity(n).dtype).kind == "f"
+                        else quantity(n).dtype) for n in ex}
+    for r0, r1, c0, c1, v in _rows(space, plan, names, chunk_points, modes):
+        stable[r0:r1, c0:c1] = v["stable"]
+        status[r0:r1, c0:c1] = v["status"]
+        for n in ex:
+            extra[n][r0:r1, c0:c1] = v[n]
         if max_real is not None and freq is not None:
-            max_real[r0:r1, c0:c1] = v.max_real
-            freq[r0:r1, c0:c1] = v.frequency
+            max_real[r0:r1, c0:c1] = v["max_real"]
+            freq[r0:r1, c0:c1] = v["frequency"]
         if progress is not None:
             progress(((r1 - 1) * n_i + c1) / (n_o * n_i))
     b = _boundary(space, plan, stable, status, modes) if boundary else None
     return StabilityMap.from_arrays(space, plan.outer, plan.inner, stable=stable, status=status, max_real=max_real,
-                                    frequency=freq, method=plan.method, boundary=b, carrier=carrier,
-                                    carriers=labels[0], route=route, routes=labels[1])
+                                    frequency=freq, method=plan.method, boundary=b,
+                                    extra={n: (extra[n], attributes(n, engine)) for n in ex})
 
 
 def _boundary(space: ParameterSpace, plan: _Plan, stable: np.ndarray, status: np.ndarray, modes: str = "all"
@@ -517,7 +541,7 @@ class MapSummary:
 
 def write_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, path: str, *, force: bool = False,
               eigen: bool = True, chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None,
-              boundary: bool = True, modes: str = "all") -> MapSummary:
+              boundary: bool = True, modes: str = "all", quantities: tuple[str, ...] | None = None) -> MapSummary:
     """Compute a stability map and write it to a NetCDF3 file block by block (memory bounded for any size).
 
     Same results and file content as ``stability_map(...).to_netcdf(path)``
@@ -541,7 +565,7 @@ def write_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, path: str
         The axes.
     path : str
         The NetCDF file to write (the caller makes it atomic).
-    force, eigen, chunk_points, progress, boundary, modes
+    force, eigen, chunk_points, progress, boundary, modes, quantities
         As :func:`stability_map`.
 
     Returns
@@ -555,9 +579,10 @@ def write_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, path: str
         than 4 GiB.
     """
     from ..results import MapFile
-    from .verdict import carrier_labels
+    from .quantities import attributes, quantity
 
     plan = _plan(engine, space, x, y, force, eigen, in_memory=False)
+    names, ex = _names(eigen, quantities)
     n_o, n_i = plan.outer.num, plan.inner.num
     # the boundary needs the verdicts and status codes of the whole grid (2 bytes per point, at most
     # BOUNDARY_MAX_POINTS points); nothing else of the map is held: each block of rows goes to the file at once
@@ -565,14 +590,13 @@ def write_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, path: str
     stable = np.zeros((n_o, n_i), dtype=bool) if keep else None
     status = np.zeros((n_o, n_i), dtype=np.int8) if keep else None
     f = MapFile(path, space, plan.outer, plan.inner, eigen=eigen, float_dtype=plan.ftype, method=plan.method,
-                boundary=keep, carriers=carrier_labels(engine)[0], routes=("none",) + tuple(r.name for r in ROUTES))
+                boundary=keep, extras=tuple((n, quantity(n).dtype, attributes(n, engine)) for n in ex))
     n_stable = n_unstable = 0
     counts = np.zeros(len(PointStatus), dtype=np.int64)
     try:
-        for r0, r1, c0, c1, v in _rows(space, plan, eigen, chunk_points, modes):
-            st, ss = v.stable, v.status
-            f.write_rows(r0, r1, st, ss, v.max_real if eigen else None, v.frequency if eigen else None, c0=c0,
-                         carrier=v.carrier.astype(np.int8), route=v.method.astype(np.int8))
+        for r0, r1, c0, c1, v in _rows(space, plan, names, chunk_points, modes):
+            st, ss = v["stable"], v["status"]
+            f.write_rows(r0, r1, st, ss, v.get("max_real"), v.get("frequency"), c0=c0, extra={n: v[n] for n in ex})
             n_stable += int(np.count_nonzero(st))
             codes = np.asarray(ss, dtype=np.int64).ravel()
             counts += np.bincount(codes, minlength=counts.size)[:counts.size]

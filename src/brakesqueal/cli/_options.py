@@ -13,7 +13,7 @@ from typing import Annotated, Any, Optional
 import typer
 
 __all__ = ["PLOT_SUFFIXES", "ContactLaw", "ModelOpt", "PresetOpt", "ParamsOpt", "SetOpt", "FormatOpt", "OutFormat",
-           "NoCacheOpt", "ProgressOpt", "space_from", "note", "refuse_set_of_axes"]
+           "NoCacheOpt", "ProgressOpt", "Modes", "ModesOpt", "space_from", "note", "refuse_set_of_axes"]
 
 
 class OutFormat(str, Enum):
@@ -25,6 +25,13 @@ class OutFormat(str, Enum):
 
 #: Formats of every command's ``--plot`` figure.
 PLOT_SUFFIXES = (".png", ".svg", ".pdf")
+
+
+class Modes(str, Enum):
+    """``--modes``: what a verdict judges (every eigenvalue, or the disk's modes alone)."""
+
+    all = "all"
+    disk = "disk"
 
 
 class ContactLaw(str, Enum):
@@ -56,6 +63,10 @@ PadDampingOpt = Annotated[Optional[float], typer.Option(
     "--pad-damping", help="Give every massless pad a tangential damper d_ip beside its spring (N s/m, in (0, 1e6]; "
                           "not in the paper): the pads' rates are kept as states, also through lift-off and "
                           "re-contact (--contact unilateral). Default: none.")]
+ModesOpt = Annotated[Modes, typer.Option(
+    "--modes", help="What the verdict judges: every eigenvalue (all, the default), or the disk's modes alone "
+                    "(disk: a non-oscillatory mode of a massless pad's own tangential rate is reported, not "
+                    "judged).")]
 ProgressOpt = Annotated[Optional[bool], typer.Option(
     "--progress/--no-progress", help="Progress on stderr (default: a bar on a terminal, periodic lines otherwise).")]
 

@@ -18,9 +18,9 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ..errors import ParameterError
-from ._options import (PLOT_SUFFIXES, ContactLaw, FormatOpt, ModelOpt, OutFormat, PadDampingOpt, PadSlopeOpt,
-                       ParamsOpt, PresetOpt, ProgressOpt, SetOpt, StickSpeedOpt, pads_option, refuse_set_of_axes,
-                       space_from)
+from ._options import (PLOT_SUFFIXES, ContactLaw, FormatOpt, ModelOpt, Modes, ModesOpt, OutFormat, PadDampingOpt,
+                       PadSlopeOpt, ParamsOpt, PresetOpt, ProgressOpt, SetOpt, StickSpeedOpt, pads_option,
+                       refuse_set_of_axes, space_from)
 
 __all__ = ["register"]
 
@@ -61,7 +61,7 @@ _HopfOpt = Annotated[bool, typer.Option("--hopf", help="Add the Hopf normal form
 def crossings(
     along: Annotated[str, typer.Option("--along", help="NAME=START:STOP[:log] path to search.")],
     model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
-    fmt: FormatOpt = OutFormat.text, plot: _PlotOpt = None, hopf: _HopfOpt = False,
+    fmt: FormatOpt = OutFormat.text, plot: _PlotOpt = None, hopf: _HopfOpt = False, modes: ModesOpt = Modes.all,
 ) -> None:
     """Every parameter value on a path where the stability of the silent motion changes (exact where possible)."""
     from ..analysis.maps import parse_axis
@@ -73,7 +73,7 @@ def crossings(
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     space = space_from(model, preset, params, set_)
-    r = _crossings(space, axis)
+    r = _crossings(space, axis, modes=modes.value)
     if plot:
         _write_plot(r.plot(), plot)  # type: ignore[attr-defined]
     _write_crossings(r, space, axis, fmt, hopf)
@@ -99,7 +99,7 @@ def critical_speed(
     range_: Annotated[str, typer.Option("--range", help="Omega range START:STOP [rad/s], 0 < START < STOP "
                                         "(searched on a logarithmic path).")] = "1:1e5",
     model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
-    fmt: FormatOpt = OutFormat.text, plot: _PlotOpt = None, hopf: _HopfOpt = False,
+    fmt: FormatOpt = OutFormat.text, plot: _PlotOpt = None, hopf: _HopfOpt = False, modes: ModesOpt = Modes.all,
 ) -> None:
     """All onsets and re-stabilisations of squeal along the spin rate Omega, and Omega_crit."""
     from ..analysis.crossings import omega_name
@@ -115,7 +115,7 @@ def critical_speed(
     name = omega_name(space)
     refuse_set_of_axes(set_, {name: "--range"})
     axis = Axis(name, lo, hi, 2, True)
-    r = critical_speeds(space, axis.start, axis.stop)
+    r = critical_speeds(space, axis.start, axis.stop, modes=modes.value)
     if plot:
         _write_plot(r.plot(), plot)  # type: ignore[attr-defined]
     _write_crossings(r, space, axis, fmt, hopf)
@@ -153,8 +153,10 @@ def map_(
     progress: ProgressOpt = None,
     color: Annotated[Optional[_Color], typer.Option(
         "--color", help="What the plot's colours show: the verdict, or max Re λ or the frequency.")] = None,
+    modes: ModesOpt = Modes.all,
 ) -> None:
-    """Stability map over two parameters of any model: NetCDF (stable, status, max_real, frequency); optional plot."""
+    """Stability map over two parameters of any model: NetCDF (stable, status, max_real, frequency, the carrier
+    mode and the deciding route of every point); optional plot."""
     from ..analysis.maps import parse_axis
     from ..api import write_map
     from ..outputs import atomic_write, check_output
@@ -171,7 +173,7 @@ def map_(
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     space = space_from(model, preset, params, set_)
     with _progress("map", progress) as cb, atomic_write(out, what="--out") as tmp:
-        s = write_map(space, ax_x, ax_y, str(tmp), force=force, eigen=not no_eigen, progress=cb)
+        s = write_map(space, ax_x, ax_y, str(tmp), force=force, eigen=not no_eigen, progress=cb, modes=modes.value)
     msg = f"wrote {out}"
     if plot:
         from ..results import plot_map_file

@@ -46,7 +46,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
 
-__all__ = ["FieldDef", "LawDef", "LAWS", "SPEED_SCALE"]
+__all__ = ["FieldDef", "LawDef", "LAWS", "SPEED_SCALE", "register_law"]
 
 _INF = math.inf
 
@@ -107,8 +107,10 @@ class LawDef:
 
 _MU = FieldDef("", "kinetic friction coefficient at {owner}", 0.0, _INF, False, True)
 
-#: Every friction law, by name.
-LAWS: Mapping[str, LawDef] = MappingProxyType({law.name: law for law in (
+_LAWS: dict[str, LawDef] = {}
+#: Every friction law, by name (a read-only view; :func:`register_law` adds one).
+LAWS: Mapping[str, LawDef] = MappingProxyType(_LAWS)
+_LAWS.update({law.name: law for law in (
     LawDef("coulomb", {}, lambda sm, v, f: f["mu"], rate_dependent=False, text="mu(v) = mu"),
     LawDef("linear", {"slope": FieldDef("s/m", "friction slope -dmu/dv at {owner}", -_INF, _INF, True, True)},
            lambda sm, v, f: f["mu"] - f["slope"] * v, rate_dependent=True, text="mu(v) = mu - slope * v"),
@@ -124,6 +126,25 @@ LAWS: Mapping[str, LawDef] = MappingProxyType({law.name: law for law in (
            lambda sm, v, f: v * (f["mu"] / sm.sqrt(v**2 + f["v_reg"] ** 2) - f["slope"]), rate_dependent=True,
            text="mu(v) = mu * v / sqrt(v^2 + v_reg^2) - slope * v"),
 )})
+
+
+def register_law(law: LawDef) -> None:
+    """Add a friction law (model files, validation, the equations and the pads' treatment then know it).
+
+    Parameters
+    ----------
+    law : LawDef
+        The law; its name must be new.
+
+    Raises
+    ------
+    ValueError
+        A law of that name exists.
+    """
+    if law.name in _LAWS:
+        raise ValueError(f"a friction law named {law.name!r} exists already")
+    _LAWS[law.name] = law
+
 
 #: The field every law has.
 MU_FIELD = _MU

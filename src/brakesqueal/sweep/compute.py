@@ -7,15 +7,11 @@ Hurwitz kernel of a closed form, specialised once with *all* grid axes
 symbolic; same source and numba cache as ``stability_map``), every point
 they leave by the per-point routes.  The worker builds the model's engine
 once per process (:func:`engine_of`: a chunk is an entry point, like a
-command).
-* ``margin``, ``max_real``, ``frequency`` — the least-stable eigenvalue,
-  reconciled with the verdict (a stable point has ``max_real < 0``, an
-  unstable one ``max_real >= 0``).
-* ``critical_speed`` —
-  :func:`~brakesqueal.analysis.crossings.critical_speeds_many` (certified
-  compiled kernel with exact fallback where the silent motion is trivial,
-  per-point crossings otherwise); a point whose critical speed could not be
-  established gets status ``UNDECIDED``.
+command).  It stores ``stable``, ``status`` and the quantities asked for
+(:mod:`brakesqueal.analysis.quantities`, the one list (:mod:`brakesqueal.analysis.quantities`, the one list
+maps use too: ``max_real``, ``frequency``, ``margin``, ``carrier``, ``route``,
+``critical_speed`` and any registered one), computed by the same grid
+evaluator, :func:`~brakesqueal.analysis.quantities.evaluate_block`.
 
 Invalid parameters, no silent motion, contact loss, solver failures and
 undecided verdicts are flagged in ``status``
@@ -30,22 +26,11 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.verdict import Grid, Points, compact, decide
+from ..analysis.verdict import Grid, Points, compact
 from ..model.parameters import ParameterSpace, Value
-from ..status import PointStatus
 
-__all__ = ["ChunkSpec", "build_space", "compute_chunk", "engine_of", "FLOAT_QUANTITIES"]
+__all__ = ["ChunkSpec", "build_space", "compute_chunk", "engine_of"]
 
-#: Float quantities and their attributes.
-FLOAT_QUANTITIES = {
-    "margin": {"units": "1", "long_name": "damping ratio of the least-stable mode, -Re(lambda)/|lambda| "
-                                          "(> 0: stable)"},
-    "max_real": {"units": "1/s", "long_name": "largest real part of the eigenvalues"},
-    "frequency": {"units": "Hz", "long_name": "frequency of the least-stable mode"},
-    "critical_speed": {"units": "rad/s", "long_name": "smallest Omega in the searched range where the silent "
-                                                      "motion becomes unstable (NaN: none)"},
-}
-_DECIDED = (int(PointStatus.OK), int(PointStatus.OK_NONTRIVIAL))
 
 
 @dataclass(frozen=True)
@@ -157,13 +142,6 @@ def build_space(preset: str | None, values: tuple[tuple[str, Value], ...],
     return space
 
 
-# ---------------------------------------------------------------- per-point quantities
-def _summary(mr: np.ndarray, fr: np.ndarray) -> dict[str, np.ndarray]:
-    with np.errstate(all="ignore"):
-        margin = -mr / np.hypot(mr, 2 * np.pi * fr)
-    return {"max_real": mr, "frequency": fr, "margin": margin}
-
-
 def engine_of(space: ParameterSpace) -> Any:
     """The engine of a study's model in this worker process (built once per model; a chunk is an entry point)."""
     from ..codegen import build
@@ -189,12 +167,10 @@ def compute_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, n
         quantities, shaped like the chunk (dimensions in study order).  For
         status 0/1, ``stable`` ⇔ ``max_real < 0``.
     """
-    from ..analysis.crossings import critical_speeds_many
+    from ..analysis.quantities import evaluate_block
 
     space = build_space(spec.preset, spec.values, spec.tied, spec.model)
     engine = engine_of(space)
-    floats = [q for q in FLOAT_QUANTITIES if q in spec.quantities]
-    eig = bool(set(floats) - {"critical_speed"})
     if spec.kind == "grid":
         shape = tuple(int(np.size(coords[n])) for n in spec.names)
         nd = len(shape)
@@ -202,36 +178,14 @@ def compute_chunk(spec: ChunkSpec, coords: dict[str, np.ndarray]) -> dict[str, n
                 for k, n in enumerate(spec.names)}
         arr = {k: compact(v) for k, v in space.arrays(axes).items()}
         grid = Grid(tuple(spec.names), tuple(np.asarray(coords[n], dtype=float).ravel() for n in spec.names))
-        pts = Points(space, arr, tuple(spec.names), grid=grid)
+        pts = Points(space, arr, tuple(spec.names), grid=grid, settable=axes)
     else:
         shape = (int(np.size(coords[spec.names[0]])),)
         axes = {n: np.asarray(coords[n], dtype=float) for n in spec.names}
-        pts = Points(space, space.arrays(axes), tuple(spec.names))
-    res = decide(engine, space, pts, eigen=eig)
-    stable = np.asarray(res.stable, dtype=bool).reshape(shape)
-    status = np.asarray(res.status, dtype=np.int8).reshape(shape)
-    out: dict[str, np.ndarray] = {q: np.full(shape, np.nan) for q in floats}
-    if eig:
-        s = _summary(res.max_real.reshape(shape), res.frequency.reshape(shape))
-        for q in floats:
-            if q in s:
-                out[q][...] = s[q]
-    if "critical_speed" in floats:
-        dec = np.flatnonzero(np.isin(status, _DECIDED))
-        if dec.size:
-            ix = np.unravel_index(dec, shape)
-            at = {n: np.broadcast_to(axes[n], shape)[ix] for n in spec.names}
-            roots, dirs, counts, _, cst = critical_speeds_many(engine, space, at, *spec.critical_speed_range,
-                                                               return_status=True)
-            k = np.arange(roots.shape[1])
-            onset = (dirs == -1) & (k[None, :] < counts[:, None])
-            first = np.argmax(onset, axis=1)
-            crit = np.where(onset.any(axis=1), roots[np.arange(roots.shape[0]), first], np.nan)
-            out["critical_speed"][ix] = crit
-            bad = cst != int(PointStatus.OK)
-            status[tuple(a[bad] for a in ix)] = int(PointStatus.UNDECIDED)
-            stable[tuple(a[bad] for a in ix)] = False
-    for q in floats:
-        a = out[q]
-        a[np.isnan(a)] = np.nan  # one NaN bit pattern (checksums, zarr's empty-chunk test)
-    return {"stable": stable, "status": status, **out}
+        pts = Points(space, space.arrays(axes), tuple(spec.names), settable=axes)
+    out = evaluate_block(engine, space, pts, tuple(spec.quantities),
+                         options={"critical_speed_range": spec.critical_speed_range})
+    for a in out.values():
+        if a.dtype.kind == "f":
+            a[np.isnan(a)] = np.nan  # one NaN bit pattern (checksums, zarr's empty-chunk test)
+    return {k: v.reshape(shape) for k, v in out.items()}

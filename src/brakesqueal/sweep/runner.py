@@ -25,8 +25,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..labels import unit
-from ..status import PointStatus
-from .compute import FLOAT_QUANTITIES, ChunkSpec, compute_chunk
+from .compute import ChunkSpec, compute_chunk
 from .lock import StoreLock, lock_holder
 from .store import (StoreError, _NotWritable, check_location, check_skeleton, check_writable,
                     inspect_store, open_group, prepare_store, read_manifest, study_attrs, variable_attrs,
@@ -447,14 +446,14 @@ def _in_memory(st: Study, spec: ChunkSpec, workers: Any, scheduler: Any, client:
                timeout: float) -> Any:
     import xarray as xr
 
-    per_point = 2 + 8 * sum(q in st.quantities for q in FLOAT_QUANTITIES)
+    from ..analysis.quantities import quantity
+
+    per_point = sum(np.dtype(quantity(q).dtype).itemsize for q in st.variables())
     if per_point * st.n_points > _MAX_IN_MEMORY:
         raise ParameterError(f"study '{st.source}' has no store, so its results are kept in memory: "
                              f"{st.n_points} points need {per_point * st.n_points / 1e9:.3g} GB, more than the "
                              f"limit of {_MAX_IN_MEMORY / 1e9:g} GB; give a store (store= or [output] store)")
-    data: dict[str, np.ndarray] = {"stable": np.zeros(st.shape, bool),
-                                   "status": np.full(st.shape, int(PointStatus.NOT_COMPUTED), np.int8)}
-    data.update({q: np.full(st.shape, np.nan) for q in FLOAT_QUANTITIES if q in st.quantities})
+    data: dict[str, np.ndarray] = {q: np.full(st.shape, quantity(q).fill, quantity(q).dtype) for q in st.variables()}
     todo = list(range(st.n_chunks))
     with _client(workers, scheduler, client, timeout) as cl:
         bar = _Progress(st, todo, 0, stream)
@@ -515,7 +514,9 @@ def open_sweep(store: str | Path, *, verify: bool = True) -> Any:
         raise StoreError(f"store '{p}' is damaged (metadata zarr.json unreadable); run its study again "
                          "to repair it") from None
     ds = xr.open_zarr(str(p), consolidated="consolidated_metadata" in root)
-    order = ["stable", "status", *[q for q in FLOAT_QUANTITIES if q in ds.data_vars]]
+    from ..analysis.quantities import QUANTITIES
+
+    order = [q for q in QUANTITIES if q in ds.data_vars]
     return ds[order + [v for v in ds.data_vars if v not in order]]
 
 

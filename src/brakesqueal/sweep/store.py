@@ -53,8 +53,7 @@ import numpy as np
 
 from ..errors import BrakesquealError, ParameterError
 from ..labels import unit
-from ..status import STATUS_MEANINGS, PointStatus
-from .compute import FLOAT_QUANTITIES
+from ..status import PointStatus
 
 __all__ = ["StoreError", "MARKERS", "MANIFEST", "study_attrs", "variable_attrs", "coordinates", "create_store",
            "prepare_store", "inspect_store", "check_skeleton", "read_manifest", "open_group", "write_chunk",
@@ -82,7 +81,7 @@ def checksum(a: np.ndarray) -> str:
 
 
 def _variables(study: Any) -> list[str]:
-    return ["stable", "status", *[q for q in FLOAT_QUANTITIES if q in study.quantities]]
+    return list(study.variables())
 
 
 def _compressor() -> Any:
@@ -210,13 +209,14 @@ def study_attrs(study: Any) -> dict[str, Any]:
 
 def variable_attrs(study: Any) -> dict[str, dict[str, Any]]:
     """Attributes of every data variable."""
+    from ..analysis.quantities import attributes
+
     extra = {"coordinates": " ".join(study.sample_names)} if study.kind == "samples" else {}
-    out = {"stable": {"long_name": "silent motion asymptotically stable (Hurwitz)", **extra},
-           "status": {"flag_values": [int(c) for c in PointStatus], "flag_meanings": STATUS_MEANINGS,
-                      **extra}}
-    for q, qa in FLOAT_QUANTITIES.items():
-        if q in study.quantities:
-            out[q] = {**qa, **extra}
+    engine = study.engine()
+    out = {}
+    for q in _variables(study):
+        a = attributes(q, engine)
+        out[q] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in a.items()} | extra
     return out
 
 
@@ -254,16 +254,15 @@ def _build_skeleton(root: Path, study: Any, attrs: dict[str, Any], *, write_coor
                                            "sampling": f"{study.method} seed={study.seed}"})
             if write_coordinates:
                 a[:] = coords[r.name]
+    from ..analysis.quantities import quantity
+
     va = variable_attrs(study)
     comp = _compressor()
-    g.create_array("stable", shape=shape, dtype="bool", chunks=chunks, dimension_names=dims, fill_value=False,
-                   compressors=comp, attributes=va["stable"])
-    g.create_array("status", shape=shape, dtype="i1", chunks=chunks, dimension_names=dims, fill_value=_STATUS_FILL,
-                   compressors=comp, attributes=va["status"])
-    for q in FLOAT_QUANTITIES:
-        if q in study.quantities:
-            g.create_array(q, shape=shape, dtype="f8", chunks=chunks, dimension_names=dims, fill_value=np.nan,
-                           compressors=comp, attributes=va[q])
+    for name in _variables(study):
+        q = quantity(name)
+        fill = _STATUS_FILL if name == "status" else q.fill
+        g.create_array(name, shape=shape, dtype=q.dtype, chunks=chunks, dimension_names=dims, fill_value=fill,
+                       compressors=comp, attributes=va[name])
     g.create_group(MARKERS, attributes={"description": "completion markers: <chunk>.json, written after the data"})
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message=".*[Cc]onsolidated metadata.*")

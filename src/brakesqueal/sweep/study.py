@@ -45,7 +45,9 @@ __all__ = ["Study", "GridAxis", "SampleRange", "load_study", "QUANTITIES", "DEFA
            "MAX_POINTS", "MAX_CHUNKS", "MAX_CHUNK_POINTS"]
 
 #: Quantities a study may compute per point (``stable`` and ``status`` are always computed).
-QUANTITIES = ("stable", "margin", "max_real", "frequency", "critical_speed")
+#: The quantities of the built-in list a study may ask for (any registered quantity is allowed:
+#: :data:`brakesqueal.analysis.quantities.QUANTITIES`).
+QUANTITIES = ("stable", "margin", "max_real", "frequency", "carrier", "route", "critical_speed")
 DEFAULT_QUANTITIES = ("stable", "margin", "max_real", "frequency")
 #: Points per chunk by default: verdict-only studies / studies with eigenvalues.
 DEFAULT_CHUNK_POINTS = (1 << 22, 1 << 18)
@@ -239,6 +241,18 @@ class Study:
         from .compute import build_space
 
         return build_space(self.preset, tuple(self.values.items()), tuple(self.tied.items()), self.model)
+
+    def engine(self) -> Any:
+        """The engine of the study's model (a study file is an entry point: its model is built where it is read)."""
+        from ..codegen import build
+
+        return build(self.space().model)
+
+    def variables(self) -> list[str]:
+        """The stored variables: ``stable``, ``status`` and the study's other quantities, in registry order."""
+        from ..analysis.quantities import ALWAYS, QUANTITIES as REGISTERED
+
+        return [*ALWAYS, *[q for q in REGISTERED if q in self.quantities and q not in ALWAYS]]
 
 
 # ---------------------------------------------------------------- parsing helpers
@@ -598,10 +612,13 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
     quantities = ctab.get("quantities", list(DEFAULT_QUANTITIES))
     if not isinstance(quantities, list) or not all(isinstance(q, str) for q in quantities):
         raise ctx.err("compute.quantities", f"must be a list of names; got {quantities!r}")
+    from ..analysis.quantities import QUANTITIES as REGISTERED
+
     for q in quantities:
-        if q not in QUANTITIES:
-            raise ctx.err("compute.quantities", f"unknown quantity {q!r}; allowed: " + ", ".join(QUANTITIES))
-    quant = tuple(q for q in QUANTITIES if q in quantities or q == "stable")
+        if q not in REGISTERED or q == "status":
+            allowed = [n for n in REGISTERED if n != "status"]
+            raise ctx.err("compute.quantities", f"unknown quantity {q!r}; allowed: " + ", ".join(allowed))
+    quant = tuple(q for q in REGISTERED if (q in quantities or q == "stable") and q != "status")
     crit = (1.0, 1e5)
     if "critical_speed_range" in ctab:
         cr = ctab["critical_speed_range"]

@@ -77,14 +77,18 @@ class Points:
     grid : Grid, optional
         The points are this full grid (``arrays`` broadcast from its axes, in its dimension order): the
         grid routes may take them.
+    settable : Mapping[str, ndarray], optional
+        The values of the varying settable names (broadcastable to the points' shape), where they are at hand.
     """
 
     def __init__(self, space: ParameterSpace, arrays: Mapping[str, Any], names: tuple[str, ...] = (), *,
-                 valid: np.ndarray | None = None, grid: Grid | None = None) -> None:
+                 valid: np.ndarray | None = None, grid: Grid | None = None,
+                 settable: Mapping[str, Any] | None = None) -> None:
         self.space = space
         self.arrays = dict(arrays)
         self.names = tuple(names)
         self.grid = grid
+        self.settable = dict(settable or {})
         shape = tuple(np.broadcast_shapes(*(np.shape(v) for v in self.arrays.values())))
         self.shape: tuple[int, ...] = shape or (1,)  # one point: a length-1 batch
         ok = valid_points(space, self.arrays) if valid is None else valid
@@ -102,9 +106,9 @@ class Points:
             shaped = {n: a.reshape([-1 if i == k else 1 for i in range(nd)]) for k, (n, a) in enumerate(zip(names,
                                                                                                               axes))}
             arr = space.arrays(shaped)
-            return cls(space, arr, names, grid=Grid(names, tuple(axes)))
-        arr = space.arrays({k: np.asarray(v, dtype=float) for k, v in values.items()})
-        return cls(space, arr, names)
+            return cls(space, arr, names, grid=Grid(names, tuple(axes)), settable=shaped)
+        vals = {k: np.asarray(v, dtype=float) for k, v in values.items()}
+        return cls(space, space.arrays(vals), names, settable=vals)
 
     @property
     def size(self) -> int:
@@ -121,6 +125,22 @@ class Points:
             return np.zeros((flat.size, 0))
         ix = np.unravel_index(flat, self.shape)
         return np.ascontiguousarray(np.stack([np.broadcast_to(v, self.shape)[ix] for v in self._vecs], axis=1))
+
+    def settable_values(self, name: str) -> np.ndarray:
+        """The values of a varying settable name at every point (the points' shape).
+
+        Parameters
+        ----------
+        name : str
+            One of :attr:`names`.
+
+        Returns
+        -------
+        ndarray
+        """
+        if name not in self.settable:
+            raise KeyError(f"the points do not carry the values of {name!r}")
+        return np.broadcast_to(np.asarray(self.settable[name], dtype=float), self.shape)
 
     def values(self, flat: int) -> dict[str, float]:
         """Every model parameter's value at point ``flat``."""

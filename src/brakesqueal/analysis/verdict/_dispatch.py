@@ -53,7 +53,7 @@ if TYPE_CHECKING:
     from ...codegen.engine import Engine
     from ...model.parameters import ParameterSpace
 
-__all__ = ["decide", "decide_model", "ROUTES", "register", "MODES"]
+__all__ = ["decide", "decide_model", "ROUTES", "register", "route_names", "MODES"]
 
 #: The routes, in the order the dispatcher tries them.
 ROUTES: list[Route] = [ClosedGrid(), CharpolyGrid(), ClosedInterval(), ClosedExact(), QuarticInterval(), EigenBounds(),
@@ -86,6 +86,16 @@ def register(route: Route, *, before: str | None = None) -> None:
     if before not in names:
         raise ValueError(f"no route named {before!r}; routes: {', '.join(names)}")
     ROUTES.insert(names.index(before), route)
+
+
+def route_names() -> tuple[str, ...]:
+    """``("none", <route names in order>)``: the meanings of a result's ``route`` codes.
+
+    Returns
+    -------
+    tuple of str
+    """
+    return ("none",) + tuple(r.name for r in ROUTES)
 
 
 def _check_modes(modes: str) -> None:
@@ -175,7 +185,7 @@ def _consistent(code: np.ndarray, mr: np.ndarray, eigen: bool) -> np.ndarray:
 def _choose(ctx: Context) -> Verdicts:
     """The one place that chooses routes: each pending point goes through :data:`ROUTES` until one settles it."""
     pending = np.flatnonzero(np.isin(ctx.status, DECIDED))
-    methods = ("none",) + tuple(r.name for r in ROUTES)
+    methods = route_names()
     for k, route in enumerate(ROUTES, start=1):
         if pending.size == 0:
             break
