@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..status import PointStatus
-from .verdict import STABLE, UNDECIDED, UNSTABLE, Points, Verdicts, compact, decide, decide_model, valid_points
+from .verdict import Points, Verdicts, compact, decide, decide_model, valid_points
 
 if TYPE_CHECKING:
     from ..codegen.engine import Engine
@@ -180,5 +180,3 @@ def linear_verdict(lm: Any, *, modes: str = "all") -> tuple[int, float, float]:
     v = decide_model(lm, modes=modes)
     return int(v.code[0]), float(v.max_real[0]), float(v.frequency[0])
 
-
-_CODES = (STABLE, UNSTABLE, UNDECIDED)

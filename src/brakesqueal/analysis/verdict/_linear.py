@@ -22,7 +22,6 @@ vanish at the point kept as first-order states), batched:
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -373,7 +372,3 @@ def _silent(ctx: Context, idx: np.ndarray) -> list[int]:
                 A2 = A[f_, :2 * n, :2 * n] - A[f_, :2 * n, 2 * n:] @ X[fin]
                 _cache(ctx, LinearGroup(idx[sel[f_]], n, 0, E=E2, A=A2))
     return [int(i) for i in idx[back]]
-
-
-def _unused() -> float:  # pragma: no cover
-    return math.nan
