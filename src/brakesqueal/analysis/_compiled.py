@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import os
+from typing import Any
 
 import numba
 import numpy as np
@@ -33,7 +34,7 @@ __all__ = ["peval", "real_roots", "routh_interval", "routh_batch", "quartic_inte
            "charpoly_grid", "charpoly_points", "critical_batch_chunks", "charpoly_grid_chunks",
            "quartic_top_grid_chunks", "balance_batch", "PARALLEL_MIN", "UNSTABLE", "STABLE", "UNDECIDED"]
 
-_JIT = dict(cache=True, error_model="numpy")
+_JIT: dict[str, Any] = dict(cache=True, error_model="numpy")
 
 UNSTABLE, STABLE, UNDECIDED = 0, 1, 2
 _U = 2.0 ** -53

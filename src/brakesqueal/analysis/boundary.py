@@ -150,7 +150,7 @@ def stability_boundary(space: Any, outer: Any, inner: Any, stable: np.ndarray, s
     lines = [ln for ln in gen.lines(0.5) if len(ln) >= 2]
     if not lines:
         return empty
-    pts = np.concatenate(lines)  # columns: inner, outer (transformed)
+    pts: np.ndarray = np.concatenate([np.asarray(ln, dtype=float) for ln in lines])  # columns: inner, outer
     # the edge of every vertex: on a grid line of one axis, between two neighbours of the other
     ni_near, di = _nearest(ti, pts[:, 0])
     no_near, do = _nearest(to, pts[:, 1])
@@ -207,7 +207,10 @@ def stability_boundary(space: Any, outer: Any, inner: Any, stable: np.ndarray, s
     # reassemble the curves with NaN separators
     sizes = [len(ln) for ln in lines]
     bounds = np.cumsum([0, *sizes])
-    co, ci, rf, wd = [], [], [], []
+    co: list[Any] = []
+    ci: list[Any] = []
+    rf: list[Any] = []
+    wd: list[Any] = []
     for s0, s1 in zip(bounds[:-1], bounds[1:]):
         co += [_v(out_o[s0:s1], outer.log), [np.nan]]
         ci += [_v(out_i[s0:s1], inner.log), [np.nan]]

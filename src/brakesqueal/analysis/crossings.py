@@ -302,7 +302,7 @@ def _numeric(engine: Engine, space: ParameterSpace, axis: Axis, n: int = NUMERIC
     mr = r.max_real
     undecided: list[tuple[float, float]] = []
     for k in np.flatnonzero(~ok):
-        undecided.append((float(grid[max(k - 1, 0)]), float(grid[min(k + 1, n - 1)])))
+        undecided.append((float(grid[max(int(k) - 1, 0)]), float(grid[min(int(k) + 1, n - 1)])))
     out: list[tuple[float, str]] = []
 
     def f(v: float) -> float:
@@ -623,7 +623,7 @@ def critical_speeds_many(engine: Engine, space: ParameterSpace, changes: dict[st
         r, d, c, s0, st = critical_speeds_batch(engine, P[ix], lo, hi, max_crossings, return_status=True)
         roots[ix], dirs[ix], counts[ix], start[ix] = r, d, c, s0
         status[ix] = np.where(st != 0, int(PointStatus.UNDECIDED), int(PointStatus.OK))
-    for i in np.flatnonzero(~fast):
+    for i in (int(j) for j in np.flatnonzero(~fast)):
         sub = space.with_values({k: float(v[i]) for k, v in cols.items()})
         res = critical_speeds(engine, sub, lo, hi)
         found = list(res.crossings)  # type: ignore[attr-defined]

@@ -456,8 +456,8 @@ def stability_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, *, fo
     n_o, n_i = plan.outer.num, plan.inner.num
     stable = np.zeros((n_o, n_i), dtype=bool)
     status = np.zeros((n_o, n_i), dtype=np.int8)
-    max_real = np.full((n_o, n_i), np.nan, dtype=plan.ftype) if eigen else None
-    freq = np.full((n_o, n_i), np.nan, dtype=plan.ftype) if eigen else None
+    max_real: np.ndarray | None = np.full((n_o, n_i), np.nan, dtype=plan.ftype) if eigen else None
+    freq: np.ndarray | None = np.full((n_o, n_i), np.nan, dtype=plan.ftype) if eigen else None
     extra = {n: np.full((n_o, n_i), quantity(n).fill, dtype=plan.ftype if np.dtype(quantity(n).dtype).kind == "f"
                         else quantity(n).dtype) for n in ex}
     for r0, r1, c0, c1, v in _rows(space, plan, names, chunk_points, modes):

@@ -133,7 +133,7 @@ def _mac(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return num / np.where(den > 0, den, 1.0)
 
 
-def track_modes(values: Sequence[float], linear: Callable[[float], Any], *, parameter: str = "p",
+def track_modes(values: Sequence[float] | np.ndarray, linear: Callable[[float], Any], *, parameter: str = "p",
                 log: bool = False, model: str = "", units: str = "", rtol: float = 1e-3) -> ModeTracks:
     """Track every mode along a path (the core of :func:`modes_along`).
 
@@ -204,7 +204,7 @@ def track_modes(values: Sequence[float], linear: Callable[[float], Any], *, para
     for k in range(n_modes):
         flag = np.array([unstable(z) for z in lam[:, k]])
         exists = ~np.isnan(lam[:, k])
-        for i in np.flatnonzero((flag[1:] != flag[:-1]) & exists[1:] & exists[:-1]):
+        for i in (int(j) for j in np.flatnonzero((flag[1:] != flag[:-1]) & exists[1:] & exists[:-1])):
             a, b = float(vals[i]), float(vals[i + 1])
             for _ in range(40):
                 c = mid(a, b)
@@ -232,7 +232,7 @@ def track_modes(values: Sequence[float], linear: Callable[[float], Any], *, para
             gap = np.abs(f[:, a_] - f[:, b_]) / np.maximum(np.maximum(f[:, a_], f[:, b_]), 1e-300)
             with np.errstate(invalid="ignore"):
                 close = (gap <= rtol) & (f[:, a_] > 0)
-            for i in np.flatnonzero(close[1:] != close[:-1]):
+            for i in (int(j) for j in np.flatnonzero(close[1:] != close[:-1])):
                 lo, hi = float(vals[i]), float(vals[i + 1])
                 entering = bool(close[i + 1])
                 for _ in range(30):
@@ -241,9 +241,9 @@ def track_modes(values: Sequence[float], linear: Callable[[float], Any], *, para
                         hi = c
                     else:
                         lo = c
-                j = i + 1 if entering else i
+                at = i + 1 if entering else i
                 coal.append({"value": 0.5 * (lo + hi), "modes": (int(a_), int(b_)),
-                             "frequency_hz": float(f[j, a_] / (2 * math.pi)),
+                             "frequency_hz": float(f[at, a_] / (2 * math.pi)),
                              "kind": "merge" if entering else "split"})
     return ModeTracks(parameter=parameter, values=vals, eigenvalues=lam, continuity=cont, coalescences=coal,
                       crossings=crossings, log=log, model=model, units=units)

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import types
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable
+from typing import TYPE_CHECKING, Any, Callable, cast
 
 from .compiled import CompiledModel, compile_model, model_key
 
@@ -430,7 +430,7 @@ def build(spec: ModelSpec | str, *, use_cache: bool = True) -> Engine:
     """
     from ..model.parameters import as_model_spec
 
-    spec = as_model_spec(spec)
+    spec = cast("ModelSpec", as_model_spec(spec))
     key = model_key(spec)
     eng = _ENGINES.get((key, use_cache))
     if eng is None:

@@ -417,9 +417,9 @@ class Verdicts:
 
     def reshape(self, shape: tuple[int, ...]) -> Verdicts:
         """The same verdicts in another shape."""
-        return Verdicts(*(getattr(self, f).reshape(shape) for f in ("status", "code", "max_real", "frequency",
-                                                                     "bound", "carrier", "method")),
-                        carriers=self.carriers, methods=self.methods)
+        return Verdicts(self.status.reshape(shape), self.code.reshape(shape), self.max_real.reshape(shape),
+                        self.frequency.reshape(shape), self.bound.reshape(shape), self.carrier.reshape(shape),
+                        self.method.reshape(shape), self.carriers, self.methods)
 
     def carrier_name(self, i: int | tuple[int, ...] = 0) -> str | None:
         """The carrier label at a point (``None`` where there is none)."""
