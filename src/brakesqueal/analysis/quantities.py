@@ -215,7 +215,9 @@ def evaluate_block(engine: Engine, space: ParameterSpace, points: Points, names:
     dict of ndarray
         ``stable``, ``status`` and every quantity in ``names``, each of ``points.shape`` and its type.
     """
-    v = decide(engine, space, points, eigen=needs_eigen(names), modes=modes)
+    # carriers where they cost nothing: a grid of a larger model decided from its characteristic polynomial
+    # would pay one inverse iteration per point
+    v = decide(engine, space, points, eigen=needs_eigen(names), modes=modes, carriers="cheap")
     block = Block(engine, space, points, v, np.array(v.status, dtype=np.int8), np.array(v.stable, dtype=bool),
                   dict(options or {}))
     out = {}
@@ -276,8 +278,10 @@ for _q in (
     Quantity("margin", "f8", np.nan, {"units": "1", "long_name": "damping ratio of the least-stable mode, "
                                                               "-Re(lambda)/|lambda| (> 0: stable)"},
              _margin, eigen=True),
-    Quantity("carrier", "i1", -1, {"long_name": "mode carrying the verdict (the component holding the largest share "
-                                                "of the least-stable eigenvector; -1: no verdict)"},
+    Quantity("carrier", "i1", -1, {"long_name": "mode carrying the verdict (the component with the largest "
+                                                "participation in the least-stable mode; -1: no verdict, or not "
+                                                "determined: a larger model's point decided from its "
+                                                "characteristic polynomial)"},
              lambda b: b.verdicts.carrier, labels=lambda e: carrier_labels(e)[0]),
     Quantity("route", "i1", 0, {"long_name": "stability route that decided the point (brakesqueal.analysis.verdict; "
                                              "0: none)"},

@@ -400,27 +400,32 @@ def state_verdicts(S: np.ndarray, *, rel_input: float = INPUT_REL) -> tuple[np.n
 
 def _eig_kappa(B: np.ndarray, vectors: bool = False) -> Any:
     """Eigenvalues and their condition numbers ``‖x‖ ‖y‖ / |y^H x|`` (batched; per matrix where LAPACK fails);
-    with ``vectors`` also the right eigenvectors (columns; NaN where LAPACK failed)."""
+    with ``vectors`` also the participation factors ``|W_ik V_ki|`` (state ``k``, eigenvalue ``i``; ``V`` the right
+    eigenvectors, ``W = V^-1``: unchanged by a diagonal scaling of the states), NaN where LAPACK failed."""
     try:
         lam, V = np.linalg.eig(B)
     except np.linalg.LinAlgError:
         if B.shape[0] == 1:
             nan = (np.full(B.shape[:2], np.nan + 0j), np.full(B.shape[:2], np.inf))
-            return (*nan, np.full(B.shape, np.nan + 0j)) if vectors else nan
+            return (*nan, np.full(B.shape, np.nan)) if vectors else nan
         out = [_eig_kappa(B[i:i + 1], vectors) for i in range(B.shape[0])]
         return tuple(np.concatenate([o[j] for o in out]) for j in range(3 if vectors else 2))
+    part = np.full(B.shape, np.nan)
     try:
         W = np.linalg.inv(V)
         kappa = np.linalg.norm(V, axis=1) * np.linalg.norm(W, axis=2)
+        part = np.abs(V * np.swapaxes(W, 1, 2))
     except np.linalg.LinAlgError:
         if B.shape[0] == 1:
             kappa = np.full(lam.shape, np.inf)
         else:
-            kappa = np.concatenate([_eig_kappa(B[i:i + 1])[1] for i in range(B.shape[0])])
+            sub = [_eig_kappa(B[i:i + 1], True) for i in range(B.shape[0])]
+            kappa = np.concatenate([o[1] for o in sub])
+            part = np.concatenate([o[2] for o in sub])
     except ValueError:
         kappa = np.full(lam.shape, np.inf)
     kappa = np.where(np.isfinite(kappa), kappa, np.inf)
-    return (lam, kappa, V) if vectors else (lam, kappa)
+    return (lam, kappa, part) if vectors else (lam, kappa)
 
 
 def state_analysis(S: np.ndarray, labels: np.ndarray | None = None, exclude: np.ndarray | None = None, *,
@@ -432,8 +437,9 @@ def state_analysis(S: np.ndarray, labels: np.ndarray | None = None, exclude: np.
     S : ndarray, shape (N, m, m)
         State matrices.
     labels : ndarray of int, shape (m,), optional
-        A label per state (e.g. the component it belongs to); an eigenvalue is carried by the label holding
-        the largest share of its balanced eigenvector.
+        A label per state (e.g. the component it belongs to); an eigenvalue is carried by the label with the
+        largest sum of its states' participation factors ``|W_ik V_ki|`` (unit-free: unchanged by scaling a
+        state).
     exclude : ndarray of int, optional
         Labels whose eigenvalues are left out of the verdict (reported, not judged).
     rel_input : float
@@ -465,7 +471,7 @@ def state_analysis(S: np.ndarray, labels: np.ndarray | None = None, exclude: np.
         B = balance(S[idx])
         good2 = np.all(np.isfinite(B), axis=(1, 2))
         B[~good2] = 0.0
-        lam, kappa, V = _eig_kappa(B, vectors=True)
+        lam, kappa, part = _eig_kappa(B, vectors=True)
         good2 &= np.all(np.isfinite(lam), axis=1)
         lam = np.where(np.isfinite(lam), lam, 0.0)
         eta = rel_input + 4.0 * m * 2.0 ** -53
@@ -474,7 +480,7 @@ def state_analysis(S: np.ndarray, labels: np.ndarray | None = None, exclude: np.
         own = None
         if labels is not None:
             lab = np.asarray(labels, dtype=np.int64)
-            share = np.abs(V) ** 2  # (G, state, eigenvalue)
+            share = np.nan_to_num(part)  # (G, state, eigenvalue): participation factors
             nl = int(lab.max()) + 1 if lab.size else 1
             per = np.zeros((share.shape[0], nl, share.shape[2]))
             for j in range(nl):
@@ -696,7 +702,7 @@ def extended_eigen(E: np.ndarray, A: np.ndarray, k: int, *, rel_input: float = I
     -------
     (eigenvalues, bounds, owner) or None
         The eigenvalues, their first-order componentwise bounds ``10 δ`` and, per eigenvalue, the state
-        holding the largest component of its balanced eigenvector (an index of the original states); ``None``
+        with the largest participation factor (an index of the original states); ``None``
         where they cannot be computed (too large, not finite, a singular reduced ``E``, no convergence).
     """
     import mpmath
@@ -744,7 +750,8 @@ def extended_eigen(E: np.ndarray, A: np.ndarray, k: int, *, rel_input: float = I
         bounds = np.empty(N)
         owner = np.zeros(N, dtype=np.int64)
         for i in range(N):
-            owner[i] = int(np.argmax([abs(complex(ERb[r, i])) for r in range(N)]))
+            # participation factors |w_r x_r| of the (balanced) left and right vectors: unit-free
+            owner[i] = int(np.argmax([abs(complex(ELb[i, r] * ERb[r, i])) for r in range(N)]))
             x = mpmath.matrix([ERb[r, i] * dg[r] for r in range(N)])
             w = mpmath.matrix([[ELb[i, c] / dg[c] for c in range(N)]])
             y = w * Einv  # y A' = λ y E'
@@ -770,8 +777,8 @@ def extended_analysis(E: np.ndarray, A: np.ndarray, k: int, labels: np.ndarray |
     E, A, k, rel_input, dps
         As :func:`extended_descriptor_verdict`.
     labels : ndarray of int, shape (m,), optional
-        A label per state; an eigenvalue is carried by the label of the state with the largest component of its
-        balanced eigenvector.
+        A label per state; an eigenvalue is carried by the label of the state with the largest participation
+        factor.
     exclude : ndarray of int, optional
         Labels whose eigenvalues are left out of the verdict.
 

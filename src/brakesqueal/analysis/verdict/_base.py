@@ -451,11 +451,16 @@ class Context:
     modes : str
         ``"all"``: every eigenvalue counts; ``"disk"``: the modes carried by a massless pad's own tangential rate
         are left out of the verdict (they are reported, not judged).
+    carriers_wanted : str
+        ``"all"``: every verdict gets its carrier; ``"cheap"``: only where a route gives it at no cost (the
+        eigenvalue routes, every mode of a disk-only model) — grids of larger models decided from their
+        characteristic polynomial leave it undetermined (-1).
     """
 
     def __init__(self, engine: Engine | None, space: ParameterSpace | None, points: Points | None, size: int, *,
-                 eigen: bool, modes: str) -> None:
+                 eigen: bool, modes: str, carriers: str = "all") -> None:
         self.engine = engine
+        self.carriers_wanted = carriers
         self.space = space
         self.points = points
         self.eigen = eigen

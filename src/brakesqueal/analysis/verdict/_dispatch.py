@@ -45,7 +45,7 @@ from .charpoly_grid import CharpolyGrid
 from .closed_exact import ClosedExact
 from .closed_grid import ClosedGrid
 from .closed_interval import ClosedInterval
-from .eigen_bounds import EigenBounds, excluded, state_labels
+from .eigen_bounds import EigenBounds, state_labels
 from .extended import Extended
 from .quartic_interval import QuarticInterval
 
@@ -106,7 +106,7 @@ def _check_modes(modes: str) -> None:
 
 
 def decide(engine: Engine, space: ParameterSpace, points: Points, *, eigen: bool = True,
-           modes: str = "all") -> Verdicts:
+           modes: str = "all", carriers: str = "all") -> Verdicts:
     """Statuses and certified verdicts of parameter points, each decided by the first route that can.
 
     Parameters
@@ -122,6 +122,10 @@ def decide(engine: Engine, space: ParameterSpace, points: Points, *, eigen: bool
     modes : {"all", "disk"}
         Judge every eigenvalue (default), or leave out the modes carried by a massless pad's own tangential
         rate (reported as carriers, not judged).
+    carriers : {"all", "cheap"}
+        Name the carrier of every verdict (default), or only where it costs nothing (the eigenvalue routes,
+        disk-only models; maps and sweeps: a larger model's grid decided from its characteristic polynomial
+        would otherwise pay one inverse iteration per point).
 
     Returns
     -------
@@ -129,7 +133,7 @@ def decide(engine: Engine, space: ParameterSpace, points: Points, *, eigen: bool
         Arrays of ``points.shape``.
     """
     _check_modes(modes)
-    ctx = Context(engine, space, points, points.size, eigen=eigen, modes=modes)
+    ctx = Context(engine, space, points, points.size, eigen=eigen, modes=modes, carriers=carriers)
     ctx.closed = bool(engine.closed_route(space, points.names)) if engine.caps.closed_form else False
     operating_points(ctx)
     return _choose(ctx).reshape(points.shape)
@@ -221,14 +225,18 @@ def _choose(ctx: Context) -> Verdicts:
 
 
 def _carriers(ctx: Context) -> None:
-    """The carrier of every verdict a route left without one (the leading eigenvalue's component)."""
+    """The carrier of every verdict a route left without one: the component with the largest participation in
+    the least-stable eigenvalue's mode (:func:`~..robust.state_analysis`'s rule), by one step of inverse
+    iteration from the eigenvalue the route found (right and left vectors), or from the eigenvalues."""
     todo = np.flatnonzero(np.isin(ctx.status, DECIDED) & (ctx.carrier < 0))
     if todo.size == 0:
         return
     if ctx.disk_only:
         ctx.carrier[todo] = 0
         return
-    from ..robust import descriptor_states, state_analysis, state_matrices
+    if ctx.carriers_wanted != "all":
+        return
+    from ..robust import descriptor_states, state_matrices
 
     for g in linear_groups(ctx, todo):
         if g.E is None:
@@ -237,6 +245,38 @@ def _carriers(ctx: Context) -> None:
         else:
             S, good = descriptor_states(g.E, g.A)  # type: ignore[arg-type]
         sel = np.flatnonzero(good)
-        if sel.size:
-            car = state_analysis(S[sel], state_labels(ctx, g), excluded(ctx))[4]
-            ctx.carrier[g.idx[sel]] = car
+        if sel.size == 0:
+            continue
+        labels = state_labels(ctx, g)
+        idx = g.idx[sel]
+        lam = ctx.max_real[idx] + 2j * np.pi * ctx.frequency[idx]
+        ctx.carrier[idx] = _participation_carrier(S[sel], lam, labels)
+
+
+def _participation_carrier(S: np.ndarray, lam: np.ndarray, labels: np.ndarray) -> np.ndarray:
+    """Per system, the label with the largest participation ``|x_k| |y_k|`` in the mode of ``lam`` (right and
+    left eigenvectors by one step of inverse iteration; the eigenvalue with the largest real part where ``lam``
+    is not finite)."""
+    N, m = S.shape[0], S.shape[-1]
+    lam = np.array(lam, dtype=complex)
+    missing = ~np.isfinite(lam)
+    if missing.any():
+        w = np.linalg.eigvals(S[missing])
+        lam[missing] = w[np.arange(w.shape[0]), np.argmax(w.real, axis=1)]
+    shift = lam * (1 + 1e-10) + 1e-300
+    B = S - shift[:, None, None] * np.eye(m)
+    b = np.ones((N, m, 1), dtype=complex)
+    with np.errstate(all="ignore"):
+        try:
+            x = np.linalg.solve(B, b)[..., 0]
+            y = np.linalg.solve(np.conj(np.swapaxes(B, 1, 2)), b)[..., 0]
+        except np.linalg.LinAlgError:
+            x = y = np.full((N, m), np.nan + 0j)
+        part = np.nan_to_num(np.abs(x) * np.abs(y))
+    nl = int(labels.max()) + 1 if labels.size else 1
+    per = np.zeros((N, nl))
+    for j in range(nl):
+        per[:, j] = part[:, labels == j].sum(axis=1)
+    out = np.argmax(per, axis=1).astype(np.int64)
+    out[~np.any(per > 0, axis=1)] = -1
+    return out
