@@ -4,9 +4,9 @@ Stability changes only where the characteristic quartic has a root at 0
 (``a0 = 0``), a pair on the imaginary axis (``H3 = 0``) or its degree drops
 (``a4 = 0``, Orlando's formula); with ``a_i = N_i / Den`` these are real roots
 of the exact polynomials ``N_0``, ``N_4``, ``H3(N)`` and ``Den`` in the path
-parameter (:func:`~.kernels.quartic_numerators`, rational arithmetic).  Their
+parameter (:meth:`Engine.univariate <brakesqueal.codegen.engine.Engine.univariate>`, rational arithmetic).  Their
 roots are isolated *exactly* on the requested range, whatever its width
-(:func:`~.robust.isolate_real_roots`: continued fractions over QQ; constants
+(:func:`~.robust.isolate_real_roots`: exact integer arithmetic; constants
 such as π carried with 80 significant digits), and the verdict is evaluated
 exactly between consecutive roots.  Nothing is read from a grid and nothing
 overflows, so ``--along k_ip=1e-100:1e100:log`` is as exact as ``1e5:1e10``.

@@ -23,8 +23,9 @@ ascending coefficients):
   (:class:`fractions.Fraction`); decides every polynomial not exactly on the
   stability boundary.
 * :func:`horner_bound` — interval Horner evaluation (value and rigorous bound).
-* :func:`isolate_real_roots` — exact real-root isolation (SymPy, continued
-  fractions over QQ) of several polynomials on any interval, e.g.
+* :func:`isolate_real_roots` — exact real-root isolation (plain Python
+  integers, :mod:`._roots`: Descartes' rule of signs with bisection on a
+  gcd-free basis) of several polynomials on any interval, e.g.
   ``(1e-100, 1e100)``, with disjoint isolating intervals.
 * :func:`isolate_real_roots_float` — compiled certified isolation (Descartes'
   rule of signs with interval coefficients) for float polynomials with error
@@ -60,6 +61,8 @@ from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+from ._roots import isolate_real_roots
 
 if TYPE_CHECKING:
     from ..codegen.engine import Engine
@@ -177,76 +180,6 @@ def _to_fraction(x: Any) -> Fraction:
     if hasattr(x, "p") and hasattr(x, "q"):
         return Fraction(int(x.p), int(x.q))
     return Fraction(x)
-
-
-def isolate_real_roots(polys: Sequence[Sequence[Any]], lo: Any, hi: Any, *, eps_rel: float = 1e-15
-                       ) -> list[tuple[Fraction, Fraction, dict[int, int]]]:
-    """Exact isolation of the real roots of several rational polynomials in ``[lo, hi]``.
-
-    Parameters
-    ----------
-    polys : sequence of sequences
-        Ascending exact coefficients (int, Fraction, SymPy Rational or float
-        taken exactly).  Zero polynomials are ignored.
-    lo, hi : number
-        The interval (any magnitudes, e.g. ``1e-100`` and ``1e100``; taken
-        exactly).
-    eps_rel : float
-        Each isolating interval is refined to a width ``<= eps_rel |root|``
-        (for roots away from zero; ``eps_rel * max(|lo|, |hi|)`` near zero).
-
-    Returns
-    -------
-    list of (a, b, owners)
-        Disjoint isolating intervals ``[a, b]`` (exact Fractions, ascending);
-        ``owners`` maps the index of every polynomial vanishing inside to the
-        root's multiplicity.  Guarantee: exact (SymPy's continued-fraction
-        isolation over QQ with square-free decomposition).
-    """
-    import sympy as sp
-
-    X = sp.Symbol("X")
-    lo_q, hi_q = sp.Rational(_to_fraction(lo)), sp.Rational(_to_fraction(hi))
-    idx, P = [], []
-    for i, c in enumerate(polys):
-        cs = [sp.Rational(_to_fraction(v)) for v in c]
-        if all(v == 0 for v in cs):
-            continue
-        idx.append(i)
-        P.append(sp.Poly(list(reversed(cs)), X, domain=sp.QQ))
-    if not P:
-        return []
-    res = sp.intervals(P, inf=lo_q, sup=hi_q)
-    out = []
-    scale = max(abs(lo_q), abs(hi_q))
-    for (a, b), owners in res:
-        a, b = sp.Rational(a), sp.Rational(b)
-        for _ in range(200):
-            width = b - a
-            ref = max(abs(a), abs(b))
-            tol = eps_rel * (ref if (a > 0 or b < 0) else scale)
-            if width <= tol:
-                break
-            j = next(iter(owners))
-            # refine with the first owner (square-free part: a simple root inside [a, b])
-            p = P[j].sqf_part()
-            m = (a + b) / 2
-            if a > 0 and b > 4 * a:
-                m = sp.Rational(_to_fraction(math.sqrt(float(a)) * math.sqrt(float(b)))) if float(a) > 0 else m
-                if not a < m < b:
-                    m = (a + b) / 2
-            vm = p.eval(m)
-            if vm == 0:
-                a = b = m
-                break
-            va = p.eval(a)
-            if (va > 0) == (vm > 0):
-                a = m
-            else:
-                b = m
-        out.append((Fraction(int(a.p), int(a.q)), Fraction(int(b.p), int(b.q)),
-                    {idx[k]: int(v) for k, v in owners.items()}))
-    return out
 
 
 def isolate_real_roots_float(coeffs: np.ndarray, radii: np.ndarray | None, lo: float, hi: float,
