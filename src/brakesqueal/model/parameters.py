@@ -311,6 +311,12 @@ class Preset:
             raise ParameterError(f"preset '{self.name}' is not attached to a model (use ModelSpec.get_preset)")
         return self.model
 
+    @property
+    def bound_model(self) -> ModelSpec:
+        """The model of a bound preset (:meth:`bind`, :meth:`ModelSpec.get_preset
+        <brakesqueal.model.components.ModelSpec.get_preset>`); ParameterError for an unbound one."""
+        return self._spec()
+
     # ---------------------------------------------------------------- use
     def settable_names(self) -> tuple[str, ...]:
         """Names :meth:`resolve` accepts without replacing a tie: free names first, then fixed."""
