@@ -26,13 +26,17 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..analysis.verdict import Grid, Points, compact, decide
 from ..model.parameters import ParameterSpace, Value
 from ..status import PointStatus
+
+if TYPE_CHECKING:
+    from ..codegen.engine import Engine
+    from .study import Study
 
 __all__ = ["ChunkSpec", "build_space", "compute_chunk", "engine_of", "FLOAT_QUANTITIES"]
 
@@ -72,7 +76,7 @@ class ChunkSpec:
     model: str | None = None
 
     @classmethod
-    def from_study(cls, study: Any) -> ChunkSpec:
+    def from_study(cls, study: Study) -> ChunkSpec:
         if study.kind == "grid":
             refs = tuple(a.ref for a in study.axes)
             signs = tuple(1 if np.all(a.values > 0) else -1 if np.all(a.values < 0) else 0 for a in study.axes)
@@ -135,7 +139,7 @@ def build_space(preset: str | None, values: tuple[tuple[str, Value], ...],
             space = ParameterSpace.from_parameters(Parameters(get_model("paper"), vals, source="[parameters]"))
         space.resolve({})
         return space
-    target = base.model if base is not None else get_model("paper")
+    target = base.bound_model if base is not None else get_model("paper")
     defs: dict[str, Value] = {**base.fixed, **base.free} if base else {}
     defs.update(vals)
     ties = dict(base.tied) if base else {}
@@ -164,7 +168,7 @@ def _summary(mr: np.ndarray, fr: np.ndarray) -> dict[str, np.ndarray]:
     return {"max_real": mr, "frequency": fr, "margin": margin}
 
 
-def engine_of(space: ParameterSpace) -> Any:
+def engine_of(space: ParameterSpace) -> Engine:
     """The engine of a study's model in this worker process (built once per model; a chunk is an entry point)."""
     from ..codegen import build
 
