@@ -267,7 +267,7 @@ class _Ctx:
         return data
 
     def number(self, v: object, key: str) -> float:
-        from ..expressions import evaluate
+        from ..model.expressions import evaluate
 
         if isinstance(v, str):
             try:
