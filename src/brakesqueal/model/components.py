@@ -140,7 +140,9 @@ def attribute(schema: Mapping[str, Any], default: Any = dataclasses.MISSING, *,
     default, default_factory : optional
         As for :func:`dataclasses.field` (neither: a required key).
     """
-    return field(default=default, default_factory=default_factory, metadata={"schema": dict(schema)})  # type: ignore[call-overload]
+    # field()'s overloads take a default or a default_factory, not both arguments (one of them is MISSING here)
+    return field(default=default, default_factory=default_factory,  # type: ignore[call-overload]
+                 metadata={"schema": dict(schema)})
 
 
 def _check_fields(obj: Component, component: str) -> None:
@@ -233,7 +235,7 @@ class FrictionLaw:
         return (_friction_law, (self.law, self.mu, dict(self.fields)))
 
     @property
-    def __dict__(self) -> dict[str, Any]:  # type: ignore[override]
+    def __dict__(self) -> dict[str, Any]:  # type: ignore[override]  # a property: the class has __slots__
         """``law``, ``mu`` and the fields (for ``vars()``)."""
         return {"law": self.law, **self.values()}
 

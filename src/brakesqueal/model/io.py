@@ -146,7 +146,8 @@ def _fields(kind: Kind, data: Mapping[str, Any], where: str) -> dict[str, Any]:
         if f.default_factory is FrictionLaw:
             if not isinstance(v, dict):
                 raise ParameterError(f"{where}: {f.name} must be a table like {{ law = 'coulomb', mu = 'mu1' }}")
-            v = FrictionLaw(**{k: (math.inf if x == "inf" else x) for k, x in v.items()})  # type: ignore[arg-type]
+            table: dict[str, Any] = {k: (math.inf if x == "inf" else x) for k, x in v.items()}  # checked by the law
+            v = FrictionLaw(**table)
         elif schema.get("type") == "array":
             if not isinstance(v, (list, tuple)):
                 example = ", ".join(f'"{x}"' for x in schema.get("items", {}).get("enum", ()))

@@ -261,7 +261,7 @@ class Preset:
     auxiliary: Mapping[str, str] = field(default_factory=dict)
     model: ModelSpec | None = field(default=None, repr=False, compare=False)
 
-    __hash__ = None  # type: ignore[assignment]
+    __hash__ = None  # type: ignore[assignment]  # unhashable (it holds mappings): the data-model idiom
 
     def __post_init__(self) -> None:
         for attribute in ("fixed", "free", "tied", "auxiliary"):
