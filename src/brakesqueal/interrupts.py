@@ -47,9 +47,12 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from types import FrameType
 from typing import Any
+
+_Hook = Callable[["sys.UnraisableHookArgs"], object]
 
 __all__ = ["interrupt_guard", "check_interrupt", "critical", "remove_on_exit", "exit_now", "EXIT_STATUS",
            "EXIT_AFTER_S"]
@@ -69,13 +72,15 @@ def _compiling() -> bool:
     """Whether this thread holds numba's compiler lock (an LLVM compilation must not be unwound)."""
     mod = sys.modules.get("numba.core.compiler_lock")
     lock = getattr(getattr(mod, "global_compiler_lock", None), "_lock", None)
+    if lock is None:
+        return False
     try:
-        return bool(lock._is_owned())  # type: ignore[union-attr]
+        return bool(lock._is_owned())
     except AttributeError:
         return False
 
 
-def _handler(signum: int, frame: Any) -> None:
+def _handler(signum: int, frame: FrameType | None) -> None:
     _state["flag"] = True
     if _compiling():
         # raised at the next safe point (check_interrupt) once the compilation has finished: unwinding
@@ -85,8 +90,8 @@ def _handler(signum: int, frame: Any) -> None:
     raise KeyboardInterrupt
 
 
-def _unraisable(hook: Any) -> Any:
-    def quiet(unraisable: Any) -> None:
+def _unraisable(hook: _Hook) -> _Hook:
+    def quiet(unraisable: sys.UnraisableHookArgs) -> None:
         if isinstance(unraisable.exc_value, KeyboardInterrupt):
             # swallowed by a callback: recorded, and delivered again so that it is raised as soon as the
             # interpreter runs code of its own (a bounded number of times; check_interrupt catches the rest)
@@ -250,7 +255,8 @@ def interrupt_guard(*, exit_after: float | None = None) -> Iterator[None]:
     when Python's default handler is active (a handler installed by the
     caller is left alone).
     """
-    installed = hook = None
+    installed = None
+    hook: _Hook | None = None
     watchdog: tuple[threading.Thread, threading.Event, int, int, int] | None = None
     if _state["depth"] == 0:
         _state["flag"] = False
@@ -271,9 +277,9 @@ def interrupt_guard(*, exit_after: float | None = None) -> Iterator[None]:
         if _state["depth"] == 0:
             if watchdog is not None:
                 _stop_watchdog(*watchdog)
-            if installed is not None:
+            if installed is not None and hook is not None:  # set together
                 signal.signal(signal.SIGINT, installed)
-                sys.unraisablehook = hook  # type: ignore[assignment]  # set with the handler
+                sys.unraisablehook = hook
             _state["flag"] = False
 
 

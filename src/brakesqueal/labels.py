@@ -14,8 +14,12 @@ roles (:mod:`brakesqueal.model.roles`) through :func:`unit`.
 from __future__ import annotations
 
 import re
+from typing import TYPE_CHECKING
 
-from typing import Any
+if TYPE_CHECKING:
+    from matplotlib.typing import RcKeyType
+
+    from .model.parameters import ParameterSpace
 
 __all__ = ["symbol", "axis_label", "unit", "QUANTITIES", "STYLE"]
 
@@ -36,7 +40,7 @@ QUANTITIES: dict[str, tuple[str, str]] = {
 AUX_UNITS: dict[str, str] = {"mu": "", "k_ip": "N/m", "h": "m", "R_disk": "m"}
 
 #: Matplotlib style of every figure: sizes for a single journal column (3.5 in), vector-friendly.
-STYLE: dict[str, object] = {
+STYLE: dict[RcKeyType, object] = {
     "font.size": 8, "axes.labelsize": 8, "axes.titlesize": 8, "legend.fontsize": 7, "xtick.labelsize": 7,
     "ytick.labelsize": 7, "lines.linewidth": 1.0, "axes.linewidth": 0.6, "savefig.bbox": "tight",
     "pdf.fonttype": 42, "svg.fonttype": "none", "mathtext.fontset": "cm",
@@ -109,7 +113,7 @@ def axis_label(name: str, unit: str | None = None) -> str:
     return f"{text} [{_unit_text(unit)}]" if unit else text
 
 
-def unit(name: str, space: Any = None) -> str:
+def unit(name: str, space: ParameterSpace | None = None) -> str:
     """SI unit of a settable name.
 
     Parameters

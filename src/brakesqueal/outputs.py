@@ -21,12 +21,14 @@ import os
 import tempfile
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TypeVar
 
 from .errors import OutputError
 from .interrupts import critical, remove_on_exit
 
 __all__ = ["check_output", "check_output_dir", "atomic_write", "write_with", "write_set", "describe_oserror"]
+
+_T = TypeVar("_T")
 
 
 def describe_oserror(exc: OSError) -> str:
@@ -158,12 +160,12 @@ def atomic_write(path: str | os.PathLike[str], *, what: str = "output file") -> 
         raise
 
 
-def write_with(path: str | os.PathLike[str], writer: Callable[[Path], Any], *, what: str = "output file") -> Any:
+def write_with(path: str | os.PathLike[str], writer: Callable[[Path], _T], *, what: str = "output file") -> _T:
     """Call ``writer(temporary_path)`` and move the result to ``path`` atomically (see :func:`atomic_write`).
 
     Returns
     -------
-    Any
+    object
         What ``writer`` returned.
     """
     with atomic_write(path, what=what) as tmp:

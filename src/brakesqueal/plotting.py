@@ -2,18 +2,35 @@
 
 from __future__ import annotations
 
-from typing import Any, Callable, TypeVar
+from collections.abc import Callable
+from typing import TYPE_CHECKING, ParamSpec, TypeVar, overload
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.artist import Artist
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure, SubFigure
+
+    from .analysis.modes import ModeTracks
+    from .results import CrossingResult, StabilityMap
 
 __all__ = ["new_figure", "styled", "plot_map", "plot_map_arrays", "map_title", "MAP_COLORS", "plot_path",
            "plot_critical_curves", "save"]
 
-F = TypeVar("F", bound=Callable[..., Any])
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
 
 
-def new_figure(ax: Any = None, size: tuple[float, float] = (3.5, 2.6)) -> tuple[Any, Any]:
-    """A new ``(figure, axes)`` pair on the Agg canvas (single journal column by default), or the figure of ``ax``."""
+@overload
+def new_figure(ax: None = None, size: tuple[float, float] = ...) -> tuple[Figure, Axes]: ...
+@overload
+def new_figure(ax: Axes, size: tuple[float, float] = ...) -> tuple[Figure | SubFigure, Axes]: ...
+
+
+def new_figure(ax: Axes | None = None, size: tuple[float, float] = (3.5, 2.6)) -> tuple[Figure | SubFigure, Axes]:
+    """A new ``(figure, axes)`` pair on the Agg canvas (single journal column by default), or the figure of ``ax``
+    (a :class:`~matplotlib.figure.SubFigure` for the axes of a sub-figure)."""
     if ax is not None:
         return ax.figure, ax
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -24,12 +41,12 @@ def new_figure(ax: Any = None, size: tuple[float, float] = (3.5, 2.6)) -> tuple[
     return fig, fig.add_subplot()
 
 
-def styled(func: F) -> F:
+def styled(func: Callable[_P, _R]) -> Callable[_P, _R]:
     """Draw inside the one figure style of the package (:data:`brakesqueal.labels.STYLE`)."""
     import functools
 
     @functools.wraps(func)
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
+    def wrapper(*args: _P.args, **kwargs: _P.kwargs) -> _R:
         import matplotlib
 
         from .labels import STYLE
@@ -37,7 +54,7 @@ def styled(func: F) -> F:
         with matplotlib.rc_context(STYLE):
             return func(*args, **kwargs)
 
-    return wrapper  # type: ignore[return-value]
+    return wrapper
 
 
 def _label(name: str, units: str) -> str:
@@ -50,8 +67,16 @@ def _label(name: str, units: str) -> str:
 MAP_COLORS = ("verdict", "max_real", "frequency")
 
 
-def plot_map(m: Any, ax: Any = None, *, x: str | None = None, title: str | None = None,
-             color: str = "verdict") -> Any:
+@overload
+def plot_map(m: StabilityMap, ax: None = None, *, x: str | None = None, title: str | None = None,
+             color: str = "verdict") -> Figure: ...
+@overload
+def plot_map(m: StabilityMap, ax: Axes, *, x: str | None = None, title: str | None = None,
+             color: str = "verdict") -> Figure | SubFigure: ...
+
+
+def plot_map(m: StabilityMap, ax: Axes | None = None, *, x: str | None = None, title: str | None = None,
+             color: str = "verdict") -> Figure | SubFigure:
     """Plot a :class:`~brakesqueal.results.StabilityMap`: stable region, boundary, failed points.
 
     Parameters
@@ -85,7 +110,7 @@ def plot_map(m: Any, ax: Any = None, *, x: str | None = None, title: str | None 
                            boundary=boundary_of(ds, (xn, yn)), color=color, field=field)
 
 
-def _title(fig: Any, ax: Any, title: str, own: bool) -> None:
+def _title(fig: Figure | SubFigure, ax: Axes, title: str, own: bool) -> None:
     """A figure of its own gets a centred title above the legend; axes in a user's figure get an axes title."""
     if not title:
         return
@@ -102,11 +127,23 @@ def map_title(space: str, xn: str, yn: str) -> str:
     return f"${symbol(yn)}$ vs ${symbol(xn)}$ ({space})"
 
 
+@overload
+def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, np.ndarray, str, bool],
+                    stable: np.ndarray, status: np.ndarray, *, ax: None = None, title: str = "",
+                    boundary: tuple[np.ndarray, np.ndarray] | None = None, color: str = "verdict",
+                    field: np.ndarray | None = None) -> Figure: ...
+@overload
+def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, np.ndarray, str, bool],
+                    stable: np.ndarray, status: np.ndarray, *, ax: Axes, title: str = "",
+                    boundary: tuple[np.ndarray, np.ndarray] | None = None, color: str = "verdict",
+                    field: np.ndarray | None = None) -> Figure | SubFigure: ...
+
+
 @styled
 def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, np.ndarray, str, bool],
-                    stable: np.ndarray, status: np.ndarray, *, ax: Any = None, title: str = "",
+                    stable: np.ndarray, status: np.ndarray, *, ax: Axes | None = None, title: str = "",
                     boundary: tuple[np.ndarray, np.ndarray] | None = None, color: str = "verdict",
-                    field: np.ndarray | None = None) -> Any:
+                    field: np.ndarray | None = None) -> Figure | SubFigure:
     """Plot a stability map given as arrays (what :func:`plot_map` draws, without xarray).
 
     Parameters
@@ -154,7 +191,7 @@ def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, 
     status = np.asarray(status)
     failed = status >= 2
     z = np.where(failed, np.nan, np.asarray(stable, dtype=float))
-    handles = []
+    handles: list[Artist] = []
     if color == "verdict":
         ax.pcolormesh(xs, ys, z, cmap=ListedColormap(["#f4c7c3", "#c8e6c9"]), vmin=0, vmax=1, shading="nearest",
                       rasterized=True)
@@ -199,8 +236,14 @@ def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, 
     return fig
 
 
+@overload
+def plot_path(r: CrossingResult, ax: None = None) -> Figure: ...
+@overload
+def plot_path(r: CrossingResult, ax: Axes) -> Figure | SubFigure: ...
+
+
 @styled
-def plot_path(r: Any, ax: Any = None) -> Any:
+def plot_path(r: CrossingResult, ax: Axes | None = None) -> Figure | SubFigure:
     """Largest real part along a 1-D path (the result's stored ``profile``) with its crossings marked.
 
     Parameters
@@ -239,10 +282,22 @@ def plot_path(r: Any, ax: Any = None) -> Any:
     return fig
 
 
-@styled
-def plot_critical_curves(diff: np.ndarray, curves: dict[str, np.ndarray], ax: Any = None,
+@overload
+def plot_critical_curves(diff: np.ndarray, curves: dict[str, np.ndarray], ax: None = None,
                          restab: dict[str, np.ndarray] | None = None,
-                         tips: dict[str, list[tuple[float, float]]] | None = None, title: str = "") -> Any:
+                         tips: dict[str, list[tuple[float, float]]] | None = None, title: str = "") -> Figure: ...
+@overload
+def plot_critical_curves(diff: np.ndarray, curves: dict[str, np.ndarray], ax: Axes,
+                         restab: dict[str, np.ndarray] | None = None,
+                         tips: dict[str, list[tuple[float, float]]] | None = None,
+                         title: str = "") -> Figure | SubFigure: ...
+
+
+@styled
+def plot_critical_curves(diff: np.ndarray, curves: dict[str, np.ndarray], ax: Axes | None = None,
+                         restab: dict[str, np.ndarray] | None = None,
+                         tips: dict[str, list[tuple[float, float]]] | None = None,
+                         title: str = "") -> Figure | SubFigure:
     """Ω_crit versus μ1 − μ2 for several k_ip (paper Fig. 3), optionally as closed squeal regions.
 
     Parameters
@@ -302,14 +357,14 @@ def plot_critical_curves(diff: np.ndarray, curves: dict[str, np.ndarray], ax: An
     return fig
 
 
-def save(fig: Any, path: str, dpi: int = 300) -> str:
+def save(fig: Figure, path: str, dpi: int = 300) -> str:
     """Save a figure (format from the suffix: PNG, SVG, PDF) and return the path."""
     fig.savefig(path, dpi=dpi)
     return path
 
 
 @styled
-def plot_modes(tracks: Any, fig: Any = None) -> Any:
+def plot_modes(tracks: ModeTracks, fig: Figure | None = None) -> Figure:
     """Mode-coupling diagram of :class:`~brakesqueal.analysis.modes.ModeTracks`: frequency and Re λ vs the parameter.
 
     Coalescences are marked with circles on the frequency panel, stability

@@ -4,9 +4,15 @@ from __future__ import annotations
 
 import json
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .analysis.eigen import EigenAnalysis, Verdict
+    from .analysis.linear import LinearModel
+    from .model.components import ModelSpec
+    from .symbolic.linearize import Case
 
 __all__ = ["render_closed_form", "render_linear_model", "render_eigen", "render_model_closed_form", "FORMATS"]
 
@@ -19,7 +25,7 @@ def render_closed_form(case: str, fmt: str) -> str:
 
     from .symbolic.linearize import closed_form
 
-    cf = closed_form(case)  # type: ignore[arg-type]
+    cf = closed_form(cast("Case", case))  # closed_form refuses an unknown case
     mats = {"M": cf.M, "D": cf.D, "K": cf.K}
     if fmt == "json":
         data = {
@@ -52,7 +58,7 @@ def _unit(coord: str) -> str:
     return "rad" if coord.startswith("q") else "m"
 
 
-def render_linear_model(lm: Any, fmt: str) -> str:
+def render_linear_model(lm: LinearModel, fmt: str) -> str:
     """Render a :class:`~brakesqueal.analysis.linear.LinearModel` (any model) as text or JSON.
 
     The verdict is that of :meth:`EigenAnalysis.verdict
@@ -87,7 +93,7 @@ def render_linear_model(lm: Any, fmt: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def verdict_lines(v: Any) -> list[str]:
+def verdict_lines(v: Verdict) -> list[str]:
     """The verdict in words: what it is, what carries it, how it is certified (and, for a verdict carried by a
     massless pad's own tangential rate, that pad's effective damping and the disk modes' verdict)."""
     if v.pad_mode:
@@ -106,7 +112,7 @@ def verdict_lines(v: Any) -> list[str]:
                      "1/s); the verdict is that of the exact linearization")
     if v.pad_mode:
         c = v.pad_damping
-        pad = v.carrier.removesuffix(" tangential rate")
+        pad = (v.carrier or "").removesuffix(" tangential rate")  # pad_mode: a carrier
         lines.append(f"  carried by {pad}'s tangential rate: a non-oscillatory mode of the massless pad alone, not "
                      "a disk vibration")
         if c is not None and math.isfinite(c):
@@ -119,7 +125,7 @@ def verdict_lines(v: Any) -> list[str]:
     return lines
 
 
-def _how(v: Any) -> str:
+def _how(v: Verdict) -> str:
     """How a verdict is certified: its error bound (smaller than the margin) or the route that decided it."""
     if v.status == "undecided":
         b = float(v.error_bound)
@@ -145,7 +151,7 @@ def _json_safe(obj: Any) -> Any:
     return obj
 
 
-def _verdict_dict(v: Any) -> dict[str, Any]:
+def _verdict_dict(v: Verdict) -> dict[str, Any]:
     """The verdict as JSON (a non-finite error bound is ``null``: JSON has no Infinity)."""
     b = float(v.error_bound)
     out = {"status": v.status, "max_real": v.max_real, "error_bound": b if math.isfinite(b) else None,
@@ -157,7 +163,7 @@ def _verdict_dict(v: Any) -> dict[str, Any]:
     return out
 
 
-def render_eigen(ea: Any, fmt: str, *, mode: int = 0) -> str:
+def render_eigen(ea: EigenAnalysis, fmt: str, *, mode: int = 0) -> str:
     """Render an :class:`~brakesqueal.analysis.eigen.EigenAnalysis`: modes, sensitivities, attribution of Re λ."""
     lm = ea.model
     v = ea.verdict()
@@ -197,7 +203,7 @@ def render_eigen(ea: Any, fmt: str, *, mode: int = 0) -> str:
     return "\n".join(lines) + "\n"
 
 
-def render_model_closed_form(spec: Any, fmt: str) -> str:
+def render_model_closed_form(spec: ModelSpec, fmt: str) -> str:
     """Render the symbolic ``M, D, K`` of any model about the zero state (and kept pad blocks)."""
     import sympy as sp
 

@@ -14,9 +14,12 @@ import json
 import math
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .model.parameters import ParameterSpace
 
 __all__ = ["reproduce_fig2", "reproduce_fig3", "FIG2_MU", "FIG3_KIP"]
 
@@ -74,7 +77,7 @@ def reproduce_fig2(out: str | Path, *, n_kip: int = 301, n_mu: int = 241, mu_lin
     return summary
 
 
-def fig3_tips(space: Any, diff: np.ndarray, onset: np.ndarray, certain: np.ndarray,
+def fig3_tips(space: ParameterSpace, diff: np.ndarray, onset: np.ndarray, certain: np.ndarray,
               omega_range: tuple[float, float], iterations: int = 48) -> list[tuple[float, float]]:
     """Where the squeal region of Fig. 3 closes: ``(mu1 - mu2, Omega)`` at which onset and re-stabilisation meet.
 
@@ -140,7 +143,10 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
     out = check_output_dir(out, what="--out")
     diff = np.linspace(-0.98, 0.98, n_diff)
     mu1, mu2 = (1 + diff) / 2, (1 - diff) / 2
-    crit, restab, ncross, certain = {}, {}, {}, {}
+    crit: dict[str, np.ndarray] = {}
+    restab: dict[str, np.ndarray] = {}
+    ncross: dict[str, np.ndarray] = {}
+    certain: dict[str, np.ndarray] = {}
     tips: dict[str, list[tuple[float, float]]] = {}
     for q, kip in enumerate(FIG3_KIP):
         space = ParameterSpace.from_preset("paper-fig3", {"k_ip": kip})
@@ -150,10 +156,10 @@ def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[flo
         first = np.full(diff.size, np.nan)
         second = np.full(diff.size, np.nan)
         for i in range(diff.size):
-            k = [j for j in range(min(int(counts[i]), roots.shape[1])) if dirs[i, j] < 0]
-            if k:
-                first[i] = roots[i, k[0]]
-                later = [j for j in range(k[0] + 1, min(int(counts[i]), roots.shape[1])) if dirs[i, j] > 0]
+            down = [j for j in range(min(int(counts[i]), roots.shape[1])) if dirs[i, j] < 0]
+            if down:
+                first[i] = roots[i, down[0]]
+                later = [j for j in range(down[0] + 1, min(int(counts[i]), roots.shape[1])) if dirs[i, j] > 0]
                 if later:
                     second[i] = roots[i, later[0]]
         crit[kip], restab[kip], ncross[kip] = first, second, counts.copy()

@@ -12,12 +12,23 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast, overload
 
 import numpy as np
 
 from .labels import unit
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure, SubFigure
+    from numpy.typing import DTypeLike
+
+    from .analysis.boundary import Boundary
+    from .analysis.maps import Axis
+    from .model.parameters import ParameterSpace
 
 __all__ = ["StabilityMap", "CrossingResult", "CriticalSpeedResult", "open_map", "MapFile", "plot_map_file",
            "NC3_MAX_VAR_BYTES", "MAX_PLOT_POINTS", "plot_indices", "label_names"]
@@ -28,7 +39,7 @@ def _status_attrs() -> dict[str, Any]:
     return {"flag_values": np.array([int(s) for s in PointStatus], dtype=np.int8), "flag_meanings": STATUS_MEANINGS}
 
 
-def _map_attrs(space: Any, method: str) -> dict[str, Any]:
+def _map_attrs(space: ParameterSpace, method: str) -> dict[str, Any]:
     """Global attributes of a stability map (Dataset and NetCDF file)."""
     return {"model": space.model.name, "space": space.label,
             "settings": json.dumps({k: str(v) for k, v in space.definitions().items()}),
@@ -45,12 +56,12 @@ _VAR_ATTRS = {
 _STABLE_FLAGS = {"flag_values": np.array([0, 1], dtype=np.int8), "flag_meanings": "unstable stable"}
 
 
-def label_names(attrs: Any) -> tuple[str, ...]:
+def label_names(attrs: Mapping[Any, object]) -> tuple[str, ...]:
     """The labels of a flag variable (``carrier``, ``route``) from its attributes (``flag_meanings``)."""
     return tuple(m.replace("_", " ") for m in str(attrs.get("flag_meanings", "")).split())
 
 
-def _coord_attrs(ax: Any, space: Any) -> dict[str, Any]:
+def _coord_attrs(ax: Axis, space: ParameterSpace) -> dict[str, Any]:
     return {"units": unit(ax.name, space), "scale": "log" if ax.log else "linear"}
 
 
@@ -58,13 +69,14 @@ def _coord_attrs(ax: Any, space: Any) -> dict[str, Any]:
 BOUNDARY_DIM = "boundary_vertex"
 
 
-def _boundary_attrs(name: str, space: Any) -> dict[str, Any]:
+def _boundary_attrs(name: str, space: ParameterSpace) -> dict[str, Any]:
     return {"units": unit(name, space),
             "long_name": f"{name} along the stability boundary (curves separated by NaN; vertices refined "
                          "onto the boundary by bisection, brakesqueal.analysis.boundary)"}
 
 
-def boundary_of(ds_or_vars: Any, names: tuple[str, str]) -> tuple[np.ndarray, np.ndarray] | None:
+def boundary_of(ds_or_vars: xr.Dataset | Mapping[str, Any],
+                names: tuple[str, str]) -> tuple[np.ndarray, np.ndarray] | None:
     """The stored boundary ``(values of names[0], values of names[1])`` of a map, or ``None``."""
     keys = [f"boundary_{n}" for n in names]
     if not all(k in ds_or_vars for k in keys):
@@ -204,13 +216,13 @@ class MapFile:
         If a variable would exceed :data:`NC3_MAX_VAR_BYTES` (the format's limit).
     """
 
-    def __init__(self, path: str, space: Any, outer: Any, inner: Any, *, eigen: bool,
-                 float_dtype: Any = np.float64, method: str = "", boundary: bool = True,
-                 extras: tuple[tuple[str, Any, dict[str, Any]], ...] = ()) -> None:
+    def __init__(self, path: str, space: ParameterSpace, outer: Axis, inner: Axis, *, eigen: bool,
+                 float_dtype: DTypeLike = np.float64, method: str = "", boundary: bool = True,
+                 extras: tuple[tuple[str, DTypeLike, dict[str, Any]], ...] = ()) -> None:
         from .errors import ParameterError
 
         self.space, self.outer, self.inner = space, outer, inner
-        ft = np.dtype(float_dtype).newbyteorder(">")
+        ft: np.dtype[Any] = np.dtype(float_dtype).newbyteorder(">")
         n = outer.num * inner.num
         size = ft.itemsize if eigen else 1
         if n * size > NC3_MAX_VAR_BYTES:
@@ -222,12 +234,15 @@ class MapFile:
         self._vars = [_NcVar(ax.name, (ax.name,), np.dtype(">f8"),
                              {**_coord_attrs(ax, space), "_FillValue": np.float64(np.nan)}, int(ax.num))
                       for ax in (outer, inner)]
-        grid = [("stable", np.dtype("i1"), {**_VAR_ATTRS["stable"], **_STABLE_FLAGS}),
-                ("status", np.dtype("i1"), _status_attrs())]
+        grid: list[tuple[str, np.dtype, dict[str, Any]]] = [
+            ("stable", np.dtype("i1"), {**_VAR_ATTRS["stable"], **_STABLE_FLAGS}),
+            ("status", np.dtype("i1"), _status_attrs())]
         for name, dt, attrs in extras:
-            d = np.dtype(dt)
-            d = ft if d.kind == "f" else d.newbyteorder(">") if d.itemsize > 1 else d
-            grid.append((name, d, {**attrs, "_FillValue": d.type(np.nan)} if d.kind == "f" else dict(attrs)))
+            d: np.dtype = np.dtype(dt)
+            if d.kind == "f":
+                grid.append((name, ft, {**attrs, "_FillValue": ft.type(np.nan)}))
+            else:
+                grid.append((name, d.newbyteorder(">") if d.itemsize > 1 else d, dict(attrs)))
         if eigen:
             grid.insert(0, ("max_real", ft, {**_VAR_ATTRS["max_real"], "_FillValue": ft.type(np.nan)}))
             grid.insert(2, ("frequency", ft, {**_VAR_ATTRS["frequency"], "_FillValue": ft.type(np.nan)}))
@@ -301,7 +316,7 @@ class MapFile:
                 raise ValueError(f"{name}: expected shape {(r1 - r0, width)}, got {np.shape(values)}")
             self._put(self._grid[name], start, values)
 
-    def write_boundary(self, b: Any) -> None:
+    def write_boundary(self, b: Boundary) -> None:
         """Add the refined stability boundary (:class:`~brakesqueal.analysis.boundary.Boundary`) before closing."""
         n = int(b.coords[0].size)
         if n == 0:
@@ -371,12 +386,12 @@ class StabilityMap:
         and ``tied`` (JSON), ``method`` (the route) and ``criterion``.
     """
 
-    data: Any
+    data: xr.Dataset
 
     @classmethod
-    def from_arrays(cls, space: Any, outer: Any, inner: Any, *, stable: np.ndarray, status: np.ndarray,
+    def from_arrays(cls, space: ParameterSpace, outer: Axis, inner: Axis, *, stable: np.ndarray, status: np.ndarray,
                     max_real: np.ndarray | None, frequency: np.ndarray | None, method: str,
-                    boundary: Any = None, extra: dict[str, tuple[np.ndarray, dict[str, Any]]] | None = None
+                    boundary: Boundary | None = None, extra: dict[str, tuple[np.ndarray, dict[str, Any]]] | None = None
                     ) -> StabilityMap:
         """Build the Dataset from computed arrays (``max_real``/``frequency`` ``None``: not computed, left out).
 
@@ -426,9 +441,9 @@ class StabilityMap:
     @property
     def dims(self) -> tuple[str, str]:
         """The two axis names ``(outer, inner)``."""
-        return tuple(self.data["stable"].dims)  # type: ignore[return-value]
+        return cast("tuple[str, str]", tuple(self.data["stable"].dims))  # the two axes' parameter names
 
-    def to_xarray(self) -> Any:
+    def to_xarray(self) -> xr.Dataset:
         """The :class:`xarray.Dataset`."""
         return self.data
 
@@ -469,10 +484,17 @@ class StabilityMap:
         z = self.data["stable"].values.astype(float)
         z[self.data["status"].values >= 2] = np.nan
         gen = contourpy.contour_generator(self.data[i].values, self.data[o].values, z)
-        return list(gen.lines(0.5))
+        return list(cast("list[np.ndarray]", gen.lines(0.5)))  # the default line type: one array per line
 
-    def plot(self, ax: Any = None, *, x: str | None = None, title: str | None = None,
-             color: str = "verdict") -> Any:
+    @overload
+    def plot(self, ax: None = None, *, x: str | None = None, title: str | None = None,
+             color: str = "verdict") -> Figure: ...
+    @overload
+    def plot(self, ax: Axes, *, x: str | None = None, title: str | None = None,
+             color: str = "verdict") -> Figure | SubFigure: ...
+
+    def plot(self, ax: Axes | None = None, *, x: str | None = None, title: str | None = None,
+             color: str = "verdict") -> Figure | SubFigure:
         """Stability map: stable region shaded (or ``color = "max_real" | "frequency"``), refined boundary drawn,
         points without a verdict hatched; returns the figure (:func:`~brakesqueal.plotting.plot_map`)."""
         from .plotting import plot_map
@@ -535,7 +557,7 @@ def plot_indices(n: int, most: int = MAX_PLOT_POINTS) -> np.ndarray:
     return idx if idx[-1] == n - 1 else np.append(idx, n - 1)
 
 
-def plot_map_file(path: str, *, x: str | None = None, title: str | None = None, color: str = "verdict") -> Any:
+def plot_map_file(path: str, *, x: str | None = None, title: str | None = None, color: str = "verdict") -> Figure:
     """Plot a map file written by :class:`MapFile` or :meth:`StabilityMap.to_netcdf` without xarray.
 
     Maps with more than :data:`MAX_PLOT_POINTS` points along an axis are drawn
@@ -572,7 +594,7 @@ def plot_map_file(path: str, *, x: str | None = None, title: str | None = None, 
         take = {d: plot_indices(int(f.dimensions[d]), MAX_PLOT_POINTS) for d in (outer, inner)}
         sel = np.ix_(take[outer], take[inner])
 
-        def grid(name: str, dtype: Any = None) -> np.ndarray:
+        def grid(name: str, dtype: DTypeLike | None = None) -> np.ndarray:
             return np.array(f.variables[name].data[sel], dtype=dtype)  # a copy of the drawn points only
 
         xn = x or inner
@@ -642,10 +664,10 @@ class CrossingResult:
     stable_at_start: bool
     crossings: tuple[tuple[float, str], ...]
     method: str
-    space: Any = field(default=None, repr=False, compare=False)
+    space: ParameterSpace | None = field(default=None, repr=False, compare=False)
     undecided_ranges: tuple[tuple[float, float], ...] = ()
     exhaustive: bool = True
-    profile: Any = field(default=None, repr=False, compare=False)
+    profile: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False, compare=False)
 
     @property
     def complete(self) -> bool:
@@ -659,7 +681,7 @@ class CrossingResult:
                 "range": [self.start, self.stop], "method": self.method,
                 "undecided_ranges": [[a, b] for a, b in self.undecided_ranges], "exhaustive": self.exhaustive}
 
-    def to_xarray(self) -> Any:
+    def to_xarray(self) -> xr.Dataset:
         """Dataset with dimension ``crossing``: ``value`` and ``direction`` (+1 stabilizing, -1 destabilizing)."""
         import xarray as xr
 
@@ -681,7 +703,12 @@ class CrossingResult:
             lines.append("  note: grid search, crossings closer together than the grid spacing may be missing")
         return "\n".join(lines) + "\n"
 
-    def plot(self, ax: Any = None) -> Any:
+    @overload
+    def plot(self, ax: None = None) -> Figure: ...
+    @overload
+    def plot(self, ax: Axes) -> Figure | SubFigure: ...
+
+    def plot(self, ax: Axes | None = None) -> Figure | SubFigure:
         """Largest real part along the path (the stored :attr:`profile`) with the crossings marked; returns the figure.
 
         Parameters

@@ -11,13 +11,16 @@ from __future__ import annotations
 
 import sys
 from enum import Enum
-from typing import Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 from typer.exceptions import Abort, Exit, TyperException
 
 from ..errors import BrakesquealError
 from ._options import FormatOpt, ModelOpt, NoCacheOpt, OutFormat, ParamsOpt, PresetOpt, SetOpt, space_from
+
+if TYPE_CHECKING:
+    from typer.models import CommandInfo, TyperInfo
 
 __all__ = ["app", "main"]
 
@@ -173,7 +176,8 @@ def list_(what: Annotated[ListWhat, typer.Argument(help="models or presets")],
     out = []
     for name in preset_names():
         pr = get_preset(name)
-        out.append({"name": name, "model": pr.model.name, "free": list(pr.free), "description": pr.description})
+        out.append({"name": name, "model": pr.bound_model.name, "free": list(pr.free),
+                    "description": pr.description})
     if fmt == OutFormat.json:
         sys.stdout.write(json.dumps(out, indent=2) + "\n")
     else:
@@ -213,15 +217,15 @@ def show(name: Annotated[str, typer.Argument(help="A preset or a model (built-in
             ) from None
     if fmt == OutFormat.json:
         sys.stdout.write(json.dumps({
-            "name": pr.name, "model": pr.model.name, "description": pr.description, "reference": pr.reference,
+            "name": pr.name, "model": pr.bound_model.name, "description": pr.description, "reference": pr.reference,
             **{k: {n: {"value": v if isinstance(v, str) else float(v), "unit": pr.unit(n),
                        "description": pr.describe_name(n)} for n, v in getattr(pr, k).items()}
                for k in ("free", "fixed")},
             "tied": dict(pr.tied)}, indent=2) + "\n")
         return
     sys.stdout.write(pr.describe() + "\n")
-    if pr.name == pr.model.name:
-        spec = pr.model
+    if pr.name == pr.bound_model.name:
+        spec = pr.bound_model
         sys.stdout.write(f"  components: {len(spec.pads)} pad(s) ({', '.join(p.name for p in spec.pads)})"
                          + (f", caliper(s) {', '.join(c.name for c in spec.calipers)}" if spec.calipers else "")
                          + f"; presets: {', '.join(spec.preset_names())}\n")
@@ -271,8 +275,9 @@ def _first_sentence(doc: str | None) -> str:
 
 def _apply_summaries() -> None:
     """Give every command and group a complete one-line summary (sub-commands: their docstring's first sentence)."""
-    for info in [*app.registered_commands, *app.registered_groups]:
-        name = info.name or (info.callback.__name__ if getattr(info, "callback", None) else None)
+    infos: list[CommandInfo | TyperInfo] = [*app.registered_commands, *app.registered_groups]
+    for info in infos:
+        name = info.name or (info.callback.__name__ if info.callback else None)
         if name in SUMMARIES:
             info.short_help = SUMMARIES[name]
     for group in app.registered_groups:

@@ -8,9 +8,12 @@ from __future__ import annotations
 
 import sys
 from enum import Enum
-from typing import Annotated, Any, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
+
+if TYPE_CHECKING:
+    from ..model.parameters import ParameterSpace
 
 __all__ = ["PLOT_SUFFIXES", "ContactLaw", "ModelOpt", "PresetOpt", "ParamsOpt", "SetOpt", "FormatOpt", "OutFormat",
            "NoCacheOpt", "ProgressOpt", "Modes", "ModesOpt", "space_from", "note", "refuse_set_of_axes"]
@@ -76,8 +79,8 @@ def note(message: str) -> None:
     print(f"brakesqueal: note: {message}", file=sys.stderr)
 
 
-def pads_option(space: Any, pad_slope: float | None, stick_speed: float | None,
-                pad_damping: float | None = None) -> Any:
+def pads_option(space: ParameterSpace, pad_slope: float | None, stick_speed: float | None,
+                pad_damping: float | None = None) -> ParameterSpace:
     """``space`` with the pads of ``--pad-slope``, ``--stick-speed`` and ``--pad-damping``.
 
     See :func:`brakesqueal.model.options.regularised_pads` and :func:`~brakesqueal.model.options.damped_pads`.
@@ -99,7 +102,7 @@ def pads_option(space: Any, pad_slope: float | None, stick_speed: float | None,
     return regularised_pads(space, pad_slope, stick_speed)
 
 
-def space_from(model: str | None, preset: str | None, params: str | None, sets: list[str] | None) -> Any:
+def space_from(model: str | None, preset: str | None, params: str | None, sets: list[str] | None) -> ParameterSpace:
     """The :class:`~brakesqueal.model.parameters.ParameterSpace` of the shared options (notes replaced ties)."""
     from ..model.options import resolve_space
 

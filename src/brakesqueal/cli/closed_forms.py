@@ -128,7 +128,11 @@ def live_texts() -> dict[tuple[str, str], str]:
     """
     texts = _probe()["texts"]
     assert isinstance(texts, dict)
-    return {tuple(k.split("|")): v for k, v in texts.items()}  # type: ignore[misc]
+    out: dict[tuple[str, str], str] = {}
+    for key, text in texts.items():
+        case, _, fmt = key.partition("|")
+        out[case, fmt] = text
+    return out
 
 
 def data_source() -> str:

@@ -8,11 +8,16 @@ from __future__ import annotations
 
 import sys
 from enum import Enum
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, cast
 
 import typer
 
 from ._options import ModelOpt, ParamsOpt, PresetOpt, SetOpt, space_from
+
+if TYPE_CHECKING:
+    from ..export import Target as _Target
+    from ..export.model import What as _What
+    from ..model.parameters import ParameterSpace
 
 __all__ = ["register", "describe_source"]
 
@@ -30,7 +35,7 @@ class What(str, Enum):
     linear = "linear"
 
 
-def describe_source(space: Any, model: str | None, params: str | None, sets: list[str]) -> str:
+def describe_source(space: ParameterSpace, model: str | None, params: str | None, sets: list[str]) -> str:
     """Header description of the parameter options, e.g. ``model six-dof, preset six-dof, --set mu1=0.4``.
 
     Parameters
@@ -81,7 +86,9 @@ def _export_cmd(
     sets = list(set_ or [])
     space = space_from(model, preset, params, sets)
     source = describe_source(space, model, params, sets)
-    text = export_code(to.value, what.value, space.resolve({}), name=name, source=source)  # type: ignore[arg-type]
+    # the enums' values are the literals export_code takes
+    text = export_code(cast("_Target", to.value), cast("_What", what.value), space.resolve({}), name=name,
+                       source=source)
     if path is None:
         sys.stdout.write(text)
         return

@@ -9,13 +9,18 @@ import json
 import math
 import sys
 from enum import Enum
-from typing import Annotated, Any, Optional
+from typing import TYPE_CHECKING, Annotated, Any, Optional, cast
 
 import typer
 
 from ..errors import ParameterError
 from ._options import (PLOT_SUFFIXES, ContactLaw, ModelOpt, OutFormat, PadDampingOpt, PadSlopeOpt, ParamsOpt,
                        PresetOpt, SetOpt, StickSpeedOpt, pads_option, space_from)
+
+if TYPE_CHECKING:
+    from ..model.parameters import Parameters
+    from ..simulation._integrate import EventMode
+    from ..simulation.trajectory import Trajectory
 
 __all__ = ["register"]
 
@@ -145,8 +150,8 @@ def _simulate_cmd(
         raise SystemExit(1)
 
 
-def _run(p: Any, t_end: float, method: str, rtol: float, atol: Any, events: str, sample_rate: float,
-         progress: bool, no_cache: bool, init: dict[str, Any]) -> Any:
+def _run(p: Parameters, t_end: float, method: str, rtol: float, atol: float | None, events: str, sample_rate: float,
+         progress: bool, no_cache: bool, init: dict[str, Any]) -> Trajectory:
     from ..simulation import simulate, simulation_model
     from ..interrupts import check_interrupt
 
@@ -156,12 +161,12 @@ def _run(p: Any, t_end: float, method: str, rtol: float, atol: Any, events: str,
 
     with _progress("simulate", None if progress else False) as cb:
         return simulate(
-            sim, p, t_end, method=method, rtol=rtol, atol=atol, events=events,  # type: ignore[arg-type]
+            sim, p, t_end, method=method, rtol=rtol, atol=atol, events=cast("EventMode", events),  # an _Events value
             sample_rate=sample_rate, progress=cb if progress else None, **init,
         )  # fmt: skip
 
 
-def _write(tr: Any, out: str | None, plot: str | None, wav: str | None) -> None:
+def _write(tr: Trajectory, out: str | None, plot: str | None, wav: str | None) -> None:
     """Write the outputs atomically (each OSError: one line naming the option)."""
     from ..interrupts import check_interrupt
 

@@ -13,7 +13,7 @@ import json
 import math
 import sys
 from enum import Enum
-from typing import Annotated, Any, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
@@ -21,6 +21,14 @@ from ..errors import ParameterError
 from ._options import (PLOT_SUFFIXES, ContactLaw, FormatOpt, ModelOpt, Modes, ModesOpt, OutFormat, PadDampingOpt,
                        PadSlopeOpt, ParamsOpt, PresetOpt, ProgressOpt, SetOpt, StickSpeedOpt, pads_option,
                        refuse_set_of_axes, space_from)
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from ..analysis.maps import Axis
+    from ..model.parameters import ParameterSpace
+    from ..nonlinear.models import HopfPoint
+    from ..results import CriticalSpeedResult, CrossingResult
 
 __all__ = ["register"]
 
@@ -47,11 +55,11 @@ _PlotOpt = Annotated[Optional[str], typer.Option("--plot", help="Also draw the r
 _PLOT_SUFFIXES = PLOT_SUFFIXES
 
 
-def _write_plot(fig: object, plot: str) -> None:
+def _write_plot(fig: Figure, plot: str) -> None:
     from ..outputs import atomic_write
 
     with atomic_write(plot, what="--plot") as tmp:
-        fig.savefig(tmp, dpi=300)  # type: ignore[attr-defined]
+        fig.savefig(tmp, dpi=300)
 
 
 _HopfOpt = Annotated[bool, typer.Option("--hopf", help="Add the Hopf normal form at every crossing (l1, "
@@ -73,13 +81,13 @@ def crossings(
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     space = space_from(model, preset, params, set_)
-    r = _crossings(space, axis, modes=modes.value)
+    r: CrossingResult = _crossings(space, axis, modes=modes.value)
     if plot:
-        _write_plot(r.plot(), plot)  # type: ignore[attr-defined]
+        _write_plot(r.plot(), plot)
     _write_crossings(r, space, axis, fmt, hopf)
 
 
-def _write_crossings(r: Any, space: Any, axis: Any, fmt: OutFormat, hopf: bool) -> None:
+def _write_crossings(r: CrossingResult, space: ParameterSpace, axis: Axis, fmt: OutFormat, hopf: bool) -> None:
     """Text or JSON of a crossing result; with ``hopf`` every crossing gains its normal form (as ``hopf``)."""
     if not hopf:
         sys.stdout.write(json.dumps(r.to_dict(), indent=2) + "\n" if fmt == OutFormat.json else r.text())
@@ -115,9 +123,9 @@ def critical_speed(
     name = omega_name(space)
     refuse_set_of_axes(set_, {name: "--range"})
     axis = Axis(name, lo, hi, 2, True)
-    r = critical_speeds(space, axis.start, axis.stop, modes=modes.value)
+    r: CriticalSpeedResult = critical_speeds(space, axis.start, axis.stop, modes=modes.value)
     if plot:
-        _write_plot(r.plot(), plot)  # type: ignore[attr-defined]
+        _write_plot(r.plot(), plot)
     _write_crossings(r, space, axis, fmt, hopf)
 
 
@@ -212,7 +220,7 @@ def reproduce(
         sys.stdout.write("figures and data: " + ", ".join(s["files"]) + "\n")
 
 
-def _hopf_text(points: list) -> str:  # type: ignore[type-arg]
+def _hopf_text(points: list[HopfPoint]) -> str:
     lines = []
     for hp in points:
         h = hp.hopf
@@ -251,14 +259,14 @@ def hopf(
     axis = parse_axis(along, with_num=False)
     refuse_set_of_axes(set_, {axis.name: "--along"})
     space = pads_option(space_from(model, preset, params, set_), None, None, pad_damping)
-    r = _crossings(space, axis)
+    r: CrossingResult = _crossings(space, axis)
     pts = hopf_points(space, axis, result=r)
     if fmt == OutFormat.json:
-        d = r.to_dict()  # type: ignore[attr-defined]
+        d = r.to_dict()
         d["crossings"] = [hp.to_dict() for hp in pts]
         sys.stdout.write(json.dumps(d, indent=2, default=float) + "\n")
     else:
-        sys.stdout.write(r.text() + _hopf_text(pts))  # type: ignore[attr-defined]
+        sys.stdout.write(r.text() + _hopf_text(pts))
 
 
 def cycles(
@@ -363,7 +371,7 @@ def cycles(
     sys.stdout.write("\n".join(lines) + "\n" + summary)
 
 
-def _cycles_exact_pads(axis: Any, space: Any, *, fmt: OutFormat, max_points: int, harmonics: int,
+def _cycles_exact_pads(axis: Axis, space: ParameterSpace, *, fmt: OutFormat, max_points: int, harmonics: int,
                        max_harmonics: int, contact: str, pad_slope: float | None, stick_speed: float | None,
                        pad_damping: float | None, plot: str | None, out: str | None,
                        progress: bool | None = None) -> None:

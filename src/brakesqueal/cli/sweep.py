@@ -10,9 +10,12 @@ import json
 import sys
 from enum import Enum
 from pathlib import Path
-from typing import Annotated, Any, Optional
+from typing import TYPE_CHECKING, Annotated, Any, Optional
 
 import typer
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 __all__ = ["register"]
 
@@ -76,7 +79,7 @@ def sweep(
                          f"reused{fixed}); {verdicts}\n")
 
 
-def _verdict_counts(ds: Any) -> dict[str, Any]:
+def _verdict_counts(ds: xr.Dataset) -> dict[str, Any]:
     """Stable and unstable points (by status: only decided points have a verdict) and points per status."""
     import dask
 

@@ -8,20 +8,24 @@ the server; see ``docs/explorer.md``.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from .state import MAX_MAP_POINTS, MAX_T_END, Origin, ViewState
 
 __all__ = ["MAX_MAP_POINTS", "MAX_T_END", "Origin", "ViewState", "serve", "make_server"]
 
 
-def serve(*args: object, **kwargs: object) -> None:
-    """:func:`brakesqueal.explorer.server.serve` (imports Panel on first use)."""
-    from .server import serve as _serve
+if TYPE_CHECKING:  # their signatures; at run time the wrappers below import the server module on first use
+    from .server import make_server, serve
+else:
+    def serve(*args, **kwargs):
+        """:func:`brakesqueal.explorer.server.serve` (imports Panel on first use)."""
+        from .server import serve as _serve
 
-    _serve(*args, **kwargs)  # type: ignore[arg-type]
+        _serve(*args, **kwargs)
 
+    def make_server(*args, **kwargs):
+        """:func:`brakesqueal.explorer.server.make_server` (imports Panel on first use)."""
+        from .server import make_server as _make_server
 
-def make_server(*args: object, **kwargs: object) -> object:
-    """:func:`brakesqueal.explorer.server.make_server` (imports Panel on first use)."""
-    from .server import make_server as _make_server
-
-    return _make_server(*args, **kwargs)  # type: ignore[arg-type]
+        return _make_server(*args, **kwargs)

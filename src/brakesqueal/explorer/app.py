@@ -19,9 +19,11 @@ import logging
 import math
 import threading
 import time
+from collections.abc import Callable
+from contextlib import AbstractContextManager
 from dataclasses import replace
 from functools import partial, wraps
-from typing import Any
+from typing import TYPE_CHECKING, Any, Concatenate, Final, Literal, ParamSpec, TypeVar
 
 import numpy as np
 
@@ -50,7 +52,27 @@ from .state import (
 )
 from .worker import Cancelled, LatestWorker
 
+if TYPE_CHECKING:
+    from bokeh.document import Document
+    from bokeh.events import Event as BokehEvent
+    from bokeh.layouts import Column
+    from bokeh.plotting import figure as Figure
+    from panel.viewable import Viewable
+    from param.parameterized import Event
+    from tornado.ioloop import IOLoop
+
+    from ..analysis.modes import ModeTracks
+    from ..model.parameters import ParameterSpace
+    from .state import CyclesView
+
 __all__ = ["Explorer", "build_page"]
+
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
+#: What a cached view depends on (compared with ``==``).
+_Key = tuple[Any, ...]
+#: The locus lane's result: the space, the view, and whether its path is complete.
+_Locus = tuple["ParameterSpace", LocusView, bool]
 
 log = logging.getLogger(__name__)
 
@@ -67,14 +89,14 @@ _MAP_PALETTE = ["#f3a5a5", "#a9cdf5", "#c8c8c8"]  # unstable, stable, no verdict
 #: Render level of what moves with every slider step (the current point, its markers): Bokeh repaints only
 #: the overlay layer of a plot when only overlay renderers changed, not its axes, grids and lines.  They have
 #: no legend entries (an overlay repaint erases their legend glyphs); titles and the map's legend text name them.
-_MOVING = "overlay"
+_MOVING: Final = "overlay"
 
 
 def _fmt_value(v: float) -> str:
     return "inf" if math.isinf(v) else f"{v:.6g}"
 
 
-def _label(space: Any, name: str) -> str:
+def _label(space: ParameterSpace, name: str) -> str:
     unit = space.preset.unit(name)
     return f"{name} [{unit}]" if unit else name
 
@@ -91,18 +113,25 @@ def _undebounce(*widgets: Any) -> None:
             w._debounce = WIDGET_DEBOUNCE_MS
 
 
-def _locus_key(space: Any, state: ViewState, ranges: dict[str, SliderRange]) -> tuple[Any, SliderRange]:
+def _locus_key(space: ParameterSpace, state: ViewState, ranges: dict[str, SliderRange]) -> tuple[_Key, SliderRange]:
     """What the root locus along ``state.along`` depends on (everything but the value of ``along``), its range."""
     rng = ranges[state.along] if state.along in ranges else slider_range(space, state.along)
     defs = {k: str(v) for k, v in space.definitions().items() if k != state.along}
     return (state.model, state.preset, state.along, rng, tuple(sorted(defs.items()))), rng
 
 
-def _map_key(space: Any, state: ViewState) -> tuple[Any, ...]:
+def _map_key(space: ParameterSpace, state: ViewState) -> _Key:
     """What the map depends on (everything but the values of its axes)."""
     defs = {k: str(v) for k, v in space.definitions().items()}
     return (state.model, state.preset, state.x, state.y, state.nx, state.ny,
             tuple(sorted((k, v) for k, v in defs.items() if k not in (state.x, state.y))))
+
+
+def _with_axis(state: ViewState, key: str, name: str) -> ViewState:
+    """``state`` with its axis ``key`` (``"along"``, ``"x"`` or ``"y"``) set to ``name``."""
+    if key == "along":
+        return replace(state, along=name)
+    return replace(state, x=name) if key == "x" else replace(state, y=name)
 
 
 class _WarmUp:
@@ -114,10 +143,10 @@ class _WarmUp:
     def __init__(self) -> None:
         self.started = False
         self.done = threading.Event()
-        self.key: Any = None
-        self.tracks: Any = None
+        self.key: _Key | None = None
+        self.tracks: ModeTracks | None = None
 
-    def tracks_for(self, key: Any, timeout: float = 60.0) -> Any:
+    def tracks_for(self, key: _Key, timeout: float = 60.0) -> ModeTracks | None:
         """The warmed-up modes along the path if ``key`` is the warmed-up view's, else None."""
         if not self.started:
             return None
@@ -159,7 +188,7 @@ class _AfterRest:
     Parameters
     ----------
     doc : bokeh.document.Document
-        The session's document.
+        The session's document (a served session's: without a server there is no rest to wait for).
     loop : tornado.ioloop.IOLoop
         The server's loop.
     delay_ms : int
@@ -168,7 +197,7 @@ class _AfterRest:
         Called without arguments.
     """
 
-    def __init__(self, doc: Any, loop: Any, delay_ms: int, fn: Any) -> None:
+    def __init__(self, doc: Document, loop: IOLoop, delay_ms: int, fn: Callable[[], None]) -> None:
         self.doc, self.loop, self.delay, self.fn = doc, loop, delay_ms / 1000, fn
         self.due = 0.0
         self.pending = False
@@ -211,10 +240,10 @@ class _AfterRest:
         self.fn()
 
 
-def _batched(method: Any) -> Any:
+def _batched(method: Callable[Concatenate[Explorer, _P], _R]) -> Callable[Concatenate[Explorer, _P], _R]:
     """Run an event handler of :class:`Explorer` in :meth:`Explorer._held` (its changes sent as one message)."""
     @wraps(method)
-    def run(self: Any, *args: Any, **kwargs: Any) -> Any:
+    def run(self: Explorer, *args: _P.args, **kwargs: _P.kwargs) -> _R:
         with self._held():
             return method(self, *args, **kwargs)
     return run
@@ -238,7 +267,7 @@ class Explorer:
         self.origin = origin
         self.count = 0
         self.doc = pn.state.curdoc
-        self._loop: Any = None
+        self._loop: IOLoop | None = None
         if self.doc is not None:
             from tornado.ioloop import IOLoop
 
@@ -249,7 +278,7 @@ class Explorer:
             state = origin.complete(ViewState.from_query(query, state)) if query else state
             for key in ("along", "x", "y"):  # a name the link gives is checked, not replaced by the default
                 if query.get(key) and getattr(state, key) != query[key]:
-                    origin.space_of(replace(state, **{key: query[key]}))  # the one-line message naming it
+                    origin.space_of(_with_axis(state, key, query[key]))  # the one-line message naming it
                     raise ParameterError(f"'{key}' = {query[key]!r} in the link is not a settable name here")
             if query.get("t_end"):
                 check_t_end(state.t_end)
@@ -260,14 +289,19 @@ class Explorer:
         self.state = state
         self.space = origin.space_of(state)
         self.shown: dict[str, Any] = {}
-        self._map_key: Any = None
-        self._url_rest = _AfterRest(self.doc, self._loop, URL_DELAY_MS, lambda: self._write_url_now())
-        self._info_rest = _AfterRest(self.doc, self._loop, INFO_REST_MS, lambda: self.info_lane.submit(self.state))
-        self._tracks_key: Any = None
-        self._tracks: Any = None
-        self._drawn_tracks: Any = None
-        self._cs_key: Any = None
-        self._hopf_key: Any = None
+        self._map_key: _Key | None = None
+        # rests timed on the server's loop (without a server the link and the texts follow at once)
+        self._url_rest: _AfterRest | None = None
+        self._info_rest: _AfterRest | None = None
+        if self.doc is not None and self._loop is not None:
+            self._url_rest = _AfterRest(self.doc, self._loop, URL_DELAY_MS, lambda: self._write_url_now())
+            self._info_rest = _AfterRest(self.doc, self._loop, INFO_REST_MS,
+                                         lambda: self.info_lane.submit(self.state))
+        self._tracks_key: _Key | None = None
+        self._tracks: ModeTracks | None = None
+        self._drawn_tracks: ModeTracks | None = None
+        self._cs_key: _Key | None = None
+        self._hopf_key: _Key | None = None
         self._building = False
         self._sync_shown: ViewState | None = None
         self.ranges: dict[str, SliderRange] = self._preset_ranges()
@@ -277,14 +311,17 @@ class Explorer:
         self._make_figures()
         self._rebuild_parameters()
         schedule = self._schedule
-        self.locus_lane = LatestWorker(self._compute_locus, self._show_locus, schedule, name="explorer-locus")
-        self.map_lane = LatestWorker(self._compute_map, self._show_map, schedule,
-                                     progress=self._map_progress, name="explorer-map")
-        self.info_lane = LatestWorker(self._compute_info, self._show_info, schedule, name="explorer-info")
-        self.cycles_lane = LatestWorker(self._compute_cycles, self._show_cycles, schedule,
-                                        progress=self._cycles_progress, name="explorer-cycles")
-        self.sim_lane = LatestWorker(self._compute_sim, self._show_sim, schedule,
-                                     progress=self._sim_progress, name="explorer-sim")
+        self.locus_lane: LatestWorker[ViewState, _Locus] = LatestWorker(
+            self._compute_locus, self._show_locus, schedule, name="explorer-locus")
+        self.map_lane: LatestWorker[ViewState, dict[str, Any]] = LatestWorker(
+            self._compute_map, self._show_map, schedule, progress=self._map_progress, name="explorer-map")
+        self.info_lane: LatestWorker[ViewState, dict[str, Any]] = LatestWorker(
+            self._compute_info, self._show_info, schedule, name="explorer-info")
+        self.cycles_lane: LatestWorker[ViewState, CyclesView] = LatestWorker(
+            self._compute_cycles, self._show_cycles, schedule, progress=self._cycles_progress,
+            name="explorer-cycles")
+        self.sim_lane: LatestWorker[ViewState, SimulationView] = LatestWorker(
+            self._compute_sim, self._show_sim, schedule, progress=self._sim_progress, name="explorer-sim")
         self.page = self._layout()
         self._refresh_alert()
         # The map and the texts follow the eigenvalues once the page has loaded (their work would otherwise
@@ -332,7 +369,7 @@ class Explorer:
         self._submit_info()
 
     # ------------------------------------------------------------------------------------------ plumbing
-    def _schedule(self, fn: Any) -> None:
+    def _schedule(self, fn: Callable[[], None]) -> None:
         """Run ``fn`` on the document's event loop with the document locked (callable from any thread)."""
         doc = self.doc
         if doc is None:  # no server (tests of the object): run now
@@ -343,21 +380,21 @@ class Explorer:
         # adds while the document is held can be dropped when the hold is released.
         loop = self._loop
         if loop is None:
-            self._add_tick(fn)
+            self._add_tick(doc, fn)
         else:
-            loop.add_callback(self._add_tick, fn)
+            loop.add_callback(self._add_tick, doc, fn)
 
-    def _add_tick(self, fn: Any) -> None:
+    def _add_tick(self, doc: Document, fn: Callable[[], None]) -> None:
         try:
-            self.doc.add_next_tick_callback(partial(self._held_call, fn))
+            doc.add_next_tick_callback(partial(self._held_call, fn))
         except Exception:  # the session is gone
             self.stop()
 
-    def _held_call(self, fn: Any) -> None:
+    def _held_call(self, fn: Callable[[], None]) -> None:
         with self._held():
             fn()
 
-    def _held(self) -> Any:
+    def _held(self) -> AbstractContextManager[object]:
         """Collect the document changes of one interaction and send them to the browser in one message.
 
         Unheld, every changed property is a message of its own, and the browser re-lays out the page and
@@ -450,7 +487,7 @@ class Explorer:
 
         self.sliders: dict[str, Any] = {}
         self.inputs: dict[str, Any] = {}
-        self.ranges: dict[str, SliderRange] = self._preset_ranges()
+        self.ranges = self._preset_ranges()
         rows = []
         space = self.space
         for name in space.preset.free:
@@ -492,13 +529,14 @@ class Explorer:
         self.fixed_box.objects = [pn.FlexBox(*fixed)]
 
     @_batched
-    def _on_fixed_card(self, event: Any) -> None:
+    def _on_fixed_card(self, event: Event) -> None:
         if not event.new and not self.fixed_box.objects:
             self._build_fixed()
 
     # ------------------------------------------------------------------------------------------ figures
     def _make_figures(self) -> None:
-        from bokeh.models import ColumnDataSource, LinearColorMapper, Span
+        from bokeh.models import ColumnDataSource, LinearColorMapper
+        from bokeh.models.annotations import Span
         from bokeh.plotting import figure
 
         pn = self.pn
@@ -529,7 +567,8 @@ class Explorer:
         """
         if self.fig_hist is not None:
             return
-        from bokeh.models import ColumnDataSource, Span
+        from bokeh.models import ColumnDataSource
+        from bokeh.models.annotations import Span, Title
         from bokeh.plotting import figure
 
         pn = self.pn
@@ -552,17 +591,18 @@ class Explorer:
                    tools="pan,wheel_zoom,box_zoom,reset")
         c.scatter("p", "a", source=self.src_cycles, color="color", size=5)
         c.add_layout(self.span_loss)
-        c.title.text_font_size = "9pt"
+        if isinstance(c.title, Title):  # figure() made it one
+            c.title.text_font_size = "9pt"
         self.fig_cycles = c
         self.audio = pn.pane.Audio(None, name="squeal", sample_rate=AUDIO_RATE, width=320,
                                    css_classes=["bs-audio"])
         self.dynamics_box.objects = [pn.Row(self.fig_hist, self.fig_spec), pn.Row(self.audio, self.fig_cycles)]
 
-    def _modes_figure(self, log: bool) -> Any:
+    def _modes_figure(self, log: bool) -> Column:
         from bokeh.layouts import column
         from bokeh.plotting import figure
 
-        xt = "log" if log else "linear"
+        xt: Literal["log", "linear"] = "log" if log else "linear"
         name = self.state.along
         lab = _label(self.space, name)
         a = figure(height=165, width=420, title="mode coupling", x_axis_type=xt, y_axis_label="f [Hz]",
@@ -575,9 +615,10 @@ class Explorer:
         b.add_layout(self.span_r)
         return column(a, b)
 
-    def _map_figure(self, x_log: bool, y_log: bool) -> Any:
+    def _map_figure(self, x_log: bool, y_log: bool) -> Figure:
         from bokeh.events import Tap
         from bokeh.models import CustomJSTickFormatter
+        from bokeh.models.annotations import Title
         from bokeh.plotting import figure
 
         st = self.state
@@ -585,12 +626,15 @@ class Explorer:
                    x_axis_label=_label(self.space, st.x) + (" (log)" if x_log else ""),
                    y_axis_label=_label(self.space, st.y) + (" (log)" if y_log else ""),
                    tools="tap,pan,wheel_zoom,box_zoom,reset")
-        f.image("image", x="x", y="y", dw="dw", dh="dh", source=self.src_map, color_mapper=self.map_mapper)
+        # color_mapper: a property of the Image glyph that bokeh's typed image() keywords leave out
+        f.image("image", x="x", y="y", dw="dw", dh="dh", source=self.src_map,
+                color_mapper=self.map_mapper)  # type: ignore[call-arg]
         f.line("x", "y", source=self.src_boundary, line_color="black", line_width=2, legend_label="boundary")
         f.scatter("x", "y", source=self.src_point, marker="cross", size=16, line_width=3, color="#2ca02c",
                   level=_MOVING)
         f.legend.location = "bottom_right"
-        f.title.text_font_size = "9pt"
+        if isinstance(f.title, Title):  # figure() made it one
+            f.title.text_font_size = "9pt"
         if x_log:
             f.xaxis.formatter = CustomJSTickFormatter(code=_LOG_FORMAT)
         if y_log:
@@ -601,7 +645,7 @@ class Explorer:
         self._map_logs = (x_log, y_log)
         return f
 
-    def _layout(self) -> Any:
+    def _layout(self) -> Viewable:
         pn = self.pn
         head = pn.Row(pn.pane.HTML("<h2 style='margin:4px 0'>brakesqueal explorer</h2>"), self.model_select,
                       self.preset_select, sizing_mode="stretch_width")
@@ -647,7 +691,7 @@ class Explorer:
     def _write_url(self) -> None:
         """Write the state to the URL once it has rested for :data:`URL_DELAY_MS` (one history entry per pause,
         not one per slider step: Panel's location pushes a browser-history entry per change)."""
-        if self.doc is None:
+        if self._url_rest is None:  # no server
             self._write_url_now()
             return
         self._url_rest.poke()
@@ -656,7 +700,8 @@ class Explorer:
         loc = self.pn.state.location
         if loc is not None:
             try:
-                loc.update_query(**self.state.to_query())
+                # panel annotates every keyword of update_query as a Mapping; they are the query's strings
+                loc.update_query(**self.state.to_query())  # type: ignore[arg-type]
             except Exception:  # no browser location (tests of the object)
                 log.debug("no location", exc_info=True)
 
@@ -701,8 +746,10 @@ class Explorer:
             self._building = False
 
     @_batched
-    def _on_tap(self, event: Any) -> None:
-        if event.x is None or event.y is None:
+    def _on_tap(self, event: BokehEvent) -> None:
+        from bokeh.events import Tap
+
+        if not isinstance(event, Tap) or event.x is None or event.y is None:  # (registered for Tap events)
             return
         x_log, y_log = self._map_logs
         x = 10.0 ** event.x if x_log else float(event.x)
@@ -710,7 +757,7 @@ class Explorer:
         self._move_to({self.state.x: x, self.state.y: y})
 
     @_batched
-    def _on_view(self, event: Any) -> None:
+    def _on_view(self, event: Event) -> None:
         if self._building:
             return
         st = self.state
@@ -736,34 +783,34 @@ class Explorer:
             self._rebuild_parameters()
 
     @_batched
-    def _on_model(self, event: Any) -> None:
+    def _on_model(self, event: Event) -> None:
         if self._building:
             return
         self._reset_to(ViewState(model=event.new, preset="", nx=self.state.nx, ny=self.state.ny,
                                  t_end=self.state.t_end), "model")
 
     @_batched
-    def _on_preset(self, event: Any) -> None:
+    def _on_preset(self, event: Event) -> None:
         if self._building or not event.new:
             return
         self._reset_to(ViewState(model=self.state.model, preset=event.new, nx=self.state.nx, ny=self.state.ny,
                                  t_end=self.state.t_end), "preset")
 
     @_batched
-    def _on_simulate(self, event: Any) -> None:
+    def _on_simulate(self, event: Event) -> None:
         self._ensure_dynamics()
         self.sim_text.object = "simulating …"
         self.sim_progress.value, self.sim_progress.visible = 0, True
         self.sim_lane.submit(self.state)
 
     @_batched
-    def _on_cycles(self, event: Any) -> None:
+    def _on_cycles(self, event: Event) -> None:
         self._ensure_dynamics()
         self.cycles_text.object = "continuing the limit cycles … (Cancel stops it)"
         self.cycles_progress.value, self.cycles_progress.visible = 0, True
         self.cycles_lane.submit(self.state)
 
-    def _compute_cycles(self, state: ViewState, check: Any) -> Any:
+    def _compute_cycles(self, state: ViewState, check: Callable[[float], None]) -> CyclesView:
         space = self.origin.space_of(state)
         rng = self.ranges.get(state.along) or slider_range(space, state.along)
         return cycles_view(space, state.along, rng, progress=check)  # Cancel stops the branch at its next point
@@ -771,9 +818,9 @@ class Explorer:
     def _cycles_progress(self, fraction: float) -> None:
         self.cycles_progress.value = int(100 * min(max(fraction, 0.0), 1.0))
 
-    def _show_cycles(self, state: ViewState, cv: Any, error: BaseException | None) -> None:
+    def _show_cycles(self, state: ViewState, cv: CyclesView | None, error: BaseException | None) -> None:
         self.cycles_progress.visible = False
-        if error is not None:
+        if error is not None or cv is None:  # (a delivered view comes with no error)
             msg = "cancelled" if isinstance(error, Cancelled) else str(error)
             self.cycles_text.object = f"<b>limit cycles:</b> {html.escape(msg)}"
             self.shown["cycles"] = {"state": state.to_query(), "error": msg}
@@ -794,7 +841,7 @@ class Explorer:
         self._mark()
 
     @_batched
-    def _on_cancel(self, event: Any) -> None:
+    def _on_cancel(self, event: Event) -> None:
         self.cycles_lane.cancel()
         self.sim_lane.cancel()
         self.map_lane.cancel()
@@ -827,12 +874,12 @@ class Explorer:
         Critical speeds take about 10 ms of the interpreter per point; computed on every step of a moving
         slider they would hold up the event loop that sends the next root locus.
         """
-        if self.doc is None:
+        if self._info_rest is None:  # no server
             self.info_lane.submit(self.state)
             return
         self._info_rest.poke()
 
-    def _reused_locus(self, state: ViewState) -> tuple[Any, LocusView, bool] | None:
+    def _reused_locus(self, state: ViewState) -> _Locus | None:
         """The locus of ``state`` if its path is the one kept, else None."""
         space = self.space if state is self.state else self.origin.space_of(state)
         key, rng = _locus_key(space, state, self.ranges)
@@ -842,7 +889,7 @@ class Explorer:
         return space, locus_view(space, state.along, rng, tracks=tracks), True
 
     # ------------------------------------------------------------------------------------------ lanes
-    def _compute_locus(self, state: ViewState, check: Any) -> tuple[Any, LocusView, bool]:
+    def _compute_locus(self, state: ViewState, check: Callable[[float], None]) -> _Locus:
         """The current eigenvalues, then the modes along the path (reused while only ``along`` itself moves)."""
         space = self.origin.space_of(state)
         key, rng = _locus_key(space, state, self.ranges)
@@ -870,11 +917,11 @@ class Explorer:
         return (f"<div id='bs-render' data-count='{self.count}' data-shown='{html.escape(data, quote=True)}' "
                 "style='display:none'></div>")
 
-    def _show_locus(self, state: ViewState, result: Any, error: BaseException | None) -> None:
+    def _show_locus(self, state: ViewState, result: _Locus | None, error: BaseException | None) -> None:
         if self._sync_shown is self.state and state is not self.state:
             return  # a lane's result for an older state, after the current one was shown at once
         self._follow()
-        if error is not None:
+        if error is not None or result is None:  # (a delivered result comes with no error)
             self.leading_text.object = f"<b>leading eigenvalue:</b> {html.escape(str(error))}"
             self.shown["locus"] = {"state": state.to_query(), "error": str(error)}
             self._mark()
@@ -908,7 +955,7 @@ class Explorer:
                                "tracks_state": state.to_query() if complete else previous}
         self._mark()
 
-    def _map_point(self, space: Any, state: ViewState) -> tuple[float, float]:
+    def _map_point(self, space: ParameterSpace, state: ViewState) -> tuple[float, float]:
         x_log, y_log = self._map_logs
         vx, vy = space.value(state.x), space.value(state.y)
         rx, ry = self.ranges.get(state.x), self.ranges.get(state.y)
@@ -918,7 +965,7 @@ class Explorer:
             vy = ry.high
         return (math.log10(vx) if x_log and vx > 0 else vx), (math.log10(vy) if y_log and vy > 0 else vy)
 
-    def _compute_map(self, state: ViewState, check: Any) -> dict[str, Any]:
+    def _compute_map(self, state: ViewState, check: Callable[[float], None]) -> dict[str, Any]:
         space = self.origin.space_of(state)
         ranges = {n: (self.ranges.get(n) or slider_range(space, n)) for n in (state.x, state.y)}
         out: dict[str, Any] = {}
@@ -933,7 +980,7 @@ class Explorer:
                 self._map_key = None
         return out
 
-    def _compute_info(self, state: ViewState, check: Any) -> dict[str, Any]:
+    def _compute_info(self, state: ViewState, check: Callable[[float], None]) -> dict[str, Any]:
         """Critical speeds and the Hopf point nearest the current value (each recomputed when its inputs change)."""
         space = self.origin.space_of(state)
         rng = self.ranges.get(state.along) or slider_range(space, state.along)
@@ -952,8 +999,8 @@ class Explorer:
         out["hopf"] = hopf_text(self._hopf_points, state.along, space.value(state.along), rng)
         return out
 
-    def _show_info(self, state: ViewState, out: Any, error: BaseException | None) -> None:
-        if error is not None:
+    def _show_info(self, state: ViewState, out: dict[str, Any] | None, error: BaseException | None) -> None:
+        if error is not None or out is None:  # (a delivered result comes with no error)
             self._cs_key = self._hopf_key = None
             self.hopf_text.object = f"<b>Hopf:</b> {html.escape(str(error))}"
         else:  # an unchanged text is not sent again
@@ -971,9 +1018,9 @@ class Explorer:
         self.map_progress.visible = fraction < 1.0
         self.map_progress.value = int(100 * fraction)
 
-    def _show_map(self, state: ViewState, out: Any, error: BaseException | None) -> None:
+    def _show_map(self, state: ViewState, out: dict[str, Any] | None, error: BaseException | None) -> None:
         self.map_progress.visible = False
-        if error is not None:
+        if error is not None or out is None:  # (a delivered result comes with no error)
             self._map_key = None
             if not isinstance(error, Cancelled):
                 self.map_text.object = f"<b>map:</b> {html.escape(str(error))}"
@@ -1016,15 +1063,15 @@ class Explorer:
         self.shown["map"] = {"state": state.to_query(), "points": n, "stable_fraction": frac,
                              "boundary_vertices": int(np.isfinite(mv.boundary_x).sum())}
 
-    def _compute_sim(self, state: ViewState, check: Any) -> SimulationView:
+    def _compute_sim(self, state: ViewState, check: Callable[[float], None]) -> SimulationView:
         return simulation_view(self.origin.space_of(state), state.t_end, progress=check)
 
     def _sim_progress(self, fraction: float) -> None:
         self.sim_progress.value = int(100 * min(max(fraction, 0.0), 1.0))
 
-    def _show_sim(self, state: ViewState, sv: Any, error: BaseException | None) -> None:
+    def _show_sim(self, state: ViewState, sv: SimulationView | None, error: BaseException | None) -> None:
         self.sim_progress.visible = False
-        if error is not None:
+        if error is not None or sv is None:  # (a delivered view comes with no error)
             msg = "cancelled" if isinstance(error, Cancelled) else str(error)
             self.sim_text.object = f"<b>simulation:</b> {html.escape(msg)}"
             self.shown["sim"] = {"state": state.to_query(), "error": msg}
@@ -1042,7 +1089,7 @@ class Explorer:
         self._mark()
 
 
-def build_page(origin: Origin) -> Any:
+def build_page(origin: Origin) -> Viewable:
     """The page of one session (Panel calls this once per browser tab).
 
     Parameters

@@ -5,9 +5,14 @@ from __future__ import annotations
 import ipaddress
 import socket
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, cast
 
 from ..errors import ParameterError
+
+if TYPE_CHECKING:
+    from bokeh.server.server import Server
+
+    from ..model.parameters import ParameterSpace
 
 __all__ = ["serve", "make_server", "is_loopback", "free_port", "DEFAULT_PORT"]
 
@@ -41,7 +46,8 @@ def _configure_offline() -> None:
     pn.extension(inline=False)  # registers Panel's bundled models; resources are served by this server
 
 
-def make_server(space: Any, *, port: int = DEFAULT_PORT, host: str = "127.0.0.1", show: bool = False) -> Any:
+def make_server(space: ParameterSpace, *, port: int = DEFAULT_PORT, host: str = "127.0.0.1",
+                show: bool = False) -> Server:
     """A started-on-demand Bokeh server of the explorer (call ``.start()``, ``.io_loop.start()``).
 
     Parameters
@@ -75,11 +81,13 @@ def make_server(space: Any, *, port: int = DEFAULT_PORT, host: str = "127.0.0.1"
     if not is_loopback(host):
         origins = ["*"]
     warm_up(origin)
-    return pn.serve({"/": lambda: build_page(origin)}, port=port, address=host, show=show, start=False,
-                    websocket_origin=origins, title="brakesqueal explorer", verbose=False)
+    server = pn.serve({"/": lambda: build_page(origin)}, port=port, address=host, show=show, start=False,
+                      websocket_origin=origins, title="brakesqueal explorer", verbose=False)
+    return cast("Server", server)  # not threaded: the Bokeh server itself
 
 
-def serve(space: Any, *, port: int = DEFAULT_PORT, host: str = "127.0.0.1", open_browser: bool = True) -> None:
+def serve(space: ParameterSpace, *, port: int = DEFAULT_PORT, host: str = "127.0.0.1",
+          open_browser: bool = True) -> None:
     """Serve the explorer until interrupted.
 
     Parameters

@@ -23,11 +23,20 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import ParameterError
+
+if TYPE_CHECKING:
+    from ..analysis.modes import ModeTracks
+    from ..model.components import ModelSpec
+    from ..model.parameters import ParameterSpace
+    from ..nonlinear.harmonic import HarmonicBranch
+    from ..nonlinear.models import HopfPoint, SquealBranch
+    from ..results import CriticalSpeedResult, StabilityMap
+    from ..simulation.trajectory import Trajectory
 
 __all__ = ["MAX_MAP_POINTS", "MAX_T_END", "LOCUS_POINTS", "AUDIO_RATE", "SliderRange", "ViewState",
            "slider_range", "format_eigenvalue", "leading_eigenvalue", "MapView", "map_view", "LocusView",
@@ -73,7 +82,7 @@ class SliderRange:
         return 10.0 ** position if self.log else position
 
 
-def slider_range(space: Any, name: str) -> SliderRange:
+def slider_range(space: ParameterSpace, name: str) -> SliderRange:
     """A slider range around the current value of a settable name.
 
     Positive dimensional values get a log range of two decades each way;
@@ -238,7 +247,7 @@ class ViewState:
                    nx=integer("nx", default.nx), ny=integer("ny", default.ny), t_end=t_end)
 
 
-def default_axes(space: Any) -> tuple[str, str, str]:
+def default_axes(space: ParameterSpace) -> tuple[str, str, str]:
     """Default ``(along, x, y)`` of a space: its first two free names that move the least-stable eigenvalue.
 
     A preset with two free names (``paper-fig2``: ``mu``, ``k_ip``) keeps
@@ -259,7 +268,7 @@ def default_axes(space: Any) -> tuple[str, str, str]:
     return along, x, y
 
 
-def stability_names(space: Any, names: list[str]) -> list[str]:
+def stability_names(space: ParameterSpace, names: list[str]) -> list[str]:
     """The names (in their order) whose slider range's ends move the least-stable eigenvalue or the status.
 
     One batched :func:`~brakesqueal.analysis.points.evaluate` of the two ends
@@ -306,11 +315,12 @@ class LocusView:
 
     eigenvalues: np.ndarray
     leading: complex
-    tracks: Any
+    tracks: ModeTracks | None
     message: str = ""
 
 
-def locus_view(space: Any, along: str, rng: SliderRange, num: int = LOCUS_POINTS, *, tracks: Any = None,
+def locus_view(space: ParameterSpace, along: str, rng: SliderRange, num: int = LOCUS_POINTS, *,
+               tracks: ModeTracks | None = None,
                path: bool = True) -> LocusView:
     """Linearize at the current point and track every mode along ``along`` over ``rng``.
 
@@ -418,7 +428,7 @@ class MapView:
     method: str
 
 
-def map_view(space: Any, x: str, y: str, rx: SliderRange, ry: SliderRange, nx: int, ny: int, *,
+def map_view(space: ParameterSpace, x: str, y: str, rx: SliderRange, ry: SliderRange, nx: int, ny: int, *,
              progress: Callable[[float], None] | None = None) -> MapView:
     """The stability map over ``x`` and ``y`` (the library's :func:`~brakesqueal.analysis.maps.stability_map`).
 
@@ -435,7 +445,7 @@ def map_view(space: Any, x: str, y: str, rx: SliderRange, ry: SliderRange, nx: i
         raise ParameterError(f"the map's axes must differ; both are '{x}'")
     ax = Axis(x, rx.low, rx.high, nx, rx.log)
     ay = Axis(y, ry.low, ry.high, ny, ry.log)
-    m: Any = stability_map(space, ax, ay, progress=progress)
+    m: StabilityMap = stability_map(space, ax, ay, progress=progress)
     ds = m.data
     stable = ds["stable"].transpose(y, x).values
     status = ds["status"].transpose(y, x).values
@@ -448,7 +458,7 @@ def map_view(space: Any, x: str, y: str, rx: SliderRange, ry: SliderRange, nx: i
 
 
 # ---------------------------------------------------------------------------------------------- speeds, Hopf
-def critical_speed_text(space: Any) -> str:
+def critical_speed_text(space: ParameterSpace) -> str:
     """One line: the critical speeds of the current point (:func:`~brakesqueal.analysis.crossings.critical_speeds`)."""
     from ..analysis.crossings import omega_name
     from ..api import critical_speeds
@@ -456,7 +466,7 @@ def critical_speed_text(space: Any) -> str:
 
     try:
         name = omega_name(space)
-        r: Any = critical_speeds(space)
+        r: CriticalSpeedResult = critical_speeds(space)
     except BrakesquealError as exc:
         return f"critical speed: {exc}"
     if not r.crossings:
@@ -469,7 +479,7 @@ def critical_speed_text(space: Any) -> str:
     return f"critical speed: {start}{crit}changes at " + ", ".join(parts) + certain
 
 
-def hopf_scan(space: Any, along: str, rng: SliderRange) -> list[Any] | str:
+def hopf_scan(space: ParameterSpace, along: str, rng: SliderRange) -> list[HopfPoint] | str:
     """Every Hopf point along the path (:func:`~brakesqueal.nonlinear.models.hopf_points`), or why not (a line)."""
     from ..analysis.maps import Axis
     from ..errors import BrakesquealError
@@ -481,7 +491,7 @@ def hopf_scan(space: Any, along: str, rng: SliderRange) -> list[Any] | str:
         return f"Hopf: {exc}"
 
 
-def hopf_text(points: list[Any] | str, along: str, current: float, rng: SliderRange) -> str:
+def hopf_text(points: list[HopfPoint] | str, along: str, current: float, rng: SliderRange) -> str:
     """One line: the Hopf point nearest ``current`` among :func:`hopf_scan`'s, its criticality and amplitude."""
     if isinstance(points, str):
         return points
@@ -570,7 +580,8 @@ def audio_samples(velocity: np.ndarray) -> np.ndarray:
     return np.round(v / peak * 0.9 * 32767).astype(np.int16)
 
 
-def simulation_view(space: Any, t_end: float, *, progress: Callable[[float], None] | None = None) -> SimulationView:
+def simulation_view(space: ParameterSpace, t_end: float, *,
+                    progress: Callable[[float], None] | None = None) -> SimulationView:
     """Integrate the nonlinear equations for ``t_end`` seconds (:func:`brakesqueal.simulation.simulate`).
 
     Raises
@@ -583,7 +594,7 @@ def simulation_view(space: Any, t_end: float, *, progress: Callable[[float], Non
     from ..simulation import simulate
 
     check_t_end(t_end)
-    tr: Any = simulate(None, space.resolve({}), float(t_end), sample_rate=float(AUDIO_RATE), progress=progress)
+    tr: Trajectory = simulate(None, space.resolve({}), float(t_end), sample_rate=float(AUDIO_RATE), progress=progress)
     dq = tr.dq[:, 0]
     t, x = _decimate(np.asarray(tr.t, dtype=float), np.asarray(dq, dtype=float), HISTORY_POINTS)
     if tr.t.size >= 16:
@@ -611,7 +622,7 @@ class Origin:
         From :func:`brakesqueal.model.options.resolve_space` (``--model/--preset/--params/--set``).
     """
 
-    space: Any
+    space: ParameterSpace
 
     def initial_state(self) -> ViewState:
         """The view of the command line's space (its overrides as texts, default axes)."""
@@ -628,7 +639,7 @@ class Origin:
             names.insert(0, self.space.model.name)
         return names
 
-    def spec(self, name: str) -> Any:
+    def spec(self, name: str) -> ModelSpec:
         """The model of a view.  Only built-in models and the command line's model are allowed (a link
         must not make the server read files).
 
@@ -655,7 +666,7 @@ class Origin:
             names.insert(0, self.space.label)
         return names
 
-    def space_of(self, state: ViewState) -> Any:
+    def space_of(self, state: ViewState) -> ParameterSpace:
         """The validated parameter space of a view: the same resolution as the command line's options.
 
         Raises
@@ -718,7 +729,7 @@ class CyclesView:
     judged: np.ndarray | None = None
 
 
-def cycles_view(space: Any, along: str, rng: SliderRange, *,
+def cycles_view(space: ParameterSpace, along: str, rng: SliderRange, *,
                 progress: Callable[[float], None] | None = None) -> CyclesView:
     """Continue the limit cycles along the path with the pads' true tangential dynamics.
 
@@ -758,8 +769,9 @@ def cycles_view(space: Any, along: str, rng: SliderRange, *,
     if harmonic:
         from ..nonlinear.harmonic import harmonic_branch
 
-        br: Any = harmonic_branch(space, axis, max_points=25, max_harmonics=40,  # bounded: an interactive view
-                                  progress=progress)
+        # bounded: an interactive view
+        br: HarmonicBranch | SquealBranch = harmonic_branch(space, axis, max_points=25, max_harmonics=40,
+                                                            progress=progress)
     else:
         br = squeal_branch(space, axis, progress=progress)
     s = br.summary

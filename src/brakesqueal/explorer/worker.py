@@ -13,20 +13,23 @@ from __future__ import annotations
 
 import logging
 import threading
-from functools import partial
 from collections.abc import Callable
-from typing import Any
+from functools import partial
+from typing import Generic, TypeVar, cast
 
 __all__ = ["Cancelled", "LatestWorker"]
 
 log = logging.getLogger(__name__)
+
+_J = TypeVar("_J")
+_R = TypeVar("_R")
 
 
 class Cancelled(Exception):
     """Raised inside a job whose lane was cancelled or superseded."""
 
 
-class LatestWorker:
+class LatestWorker(Generic[_J, _R]):
     """A background lane that computes only the latest submitted job.
 
     Parameters
@@ -35,7 +38,8 @@ class LatestWorker:
         ``compute(job, check) -> result`` run in the worker thread; ``check(fraction)``
         reports progress and raises :class:`Cancelled` when the job is cancelled.
     deliver : callable
-        ``deliver(job, result, error)`` run on the document's event loop.
+        ``deliver(job, result, error)`` run on the document's event loop (``result`` is ``None`` when
+        ``error`` is not).
     schedule : callable
         Runs a zero-argument callable on the document's event loop (``doc.add_next_tick_callback``).
     progress : callable, optional
@@ -44,16 +48,16 @@ class LatestWorker:
         Thread name.
     """
 
-    def __init__(self, compute: Callable[[Any, Callable[[float], None]], Any],
-                 deliver: Callable[[Any, Any, BaseException | None], None],
-                 schedule: Callable[[Callable[[], None]], Any], *,
+    def __init__(self, compute: Callable[[_J, Callable[[float], None]], _R],
+                 deliver: Callable[[_J, _R | None, BaseException | None], None],
+                 schedule: Callable[[Callable[[], None]], object], *,
                  progress: Callable[[float], None] | None = None, name: str = "explorer-worker") -> None:
         self._compute = compute
         self._deliver = deliver
         self._schedule = schedule
         self._progress = progress
         self._cv = threading.Condition()
-        self._pending: Any = None
+        self._pending: _J | None = None
         self._has_pending = False
         self._cancel = False
         self._stop = False
@@ -61,7 +65,7 @@ class LatestWorker:
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._thread.start()
 
-    def submit(self, job: Any) -> None:
+    def submit(self, job: _J) -> None:
         """Compute ``job`` next (replaces a pending job that has not started)."""
         with self._cv:
             self._pending = job
@@ -81,7 +85,7 @@ class LatestWorker:
             self._has_pending = False
             self._pending = None
         if had:  # a job that never started is reported as cancelled too
-            self._schedule(partial(self._deliver, dropped, None, Cancelled("cancelled")))
+            self._schedule(partial(self._deliver, cast("_J", dropped), None, Cancelled("cancelled")))  # it was set
 
     def stop(self) -> None:
         """End the thread after the running job (the session is gone)."""
@@ -104,10 +108,10 @@ class LatestWorker:
                     self._cv.wait()
                 if self._stop:
                     return
-                job = self._pending
+                job = cast("_J", self._pending)  # set with _has_pending
                 self._pending, self._has_pending, self._cancel = None, False, False
                 self.busy = True
-            result: Any = None
+            result: _R | None = None
             error: BaseException | None = None
             try:
                 result = self._compute(job, self._check)

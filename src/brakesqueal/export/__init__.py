@@ -13,9 +13,13 @@ command-line front end.
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Literal
 
 from .model import WHATS, ExportFunction, ExportModel, export_model
+
+if TYPE_CHECKING:
+    from ..model.components import ModelSpec
+    from ..model.parameters import Parameters
 
 __all__ = ["TARGETS", "WHATS", "ExportFunction", "ExportModel", "export_code", "export_model", "check_name"]
 
@@ -27,11 +31,11 @@ TARGETS: dict[str, str] = {"latex": ".tex", "octave": ".m", "c": ".c", "julia": 
 def export_code(
     target: Target,
     what: Literal["nonlinear", "linear"] = "nonlinear",
-    params: Any = None,
+    params: Parameters | None = None,
     *,
     name: str = "brakesqueal_model",
     source: str | None = None,
-    model: Any = None,
+    model: ModelSpec | str | None = None,
 ) -> str:
     """Source code (or a LaTeX document) of a model.
 

@@ -38,8 +38,9 @@ where the zero state is the silent motion (checked).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 from ..errors import BrakesquealError, ParameterError
 from .names import (
@@ -50,6 +51,11 @@ from .names import (
     residual_label,
     residual_unit,
 )
+
+if TYPE_CHECKING:
+    from ..model.components import ModelSpec
+    from ..model.parameters import Parameters
+    from ..symbolic.assemble import Equations
 
 __all__ = [
     "WHATS", "ExportFunction", "ExportModel", "export_model", "PARAMETER_UNITS", "STATE_UNITS",
@@ -365,7 +371,7 @@ def _matrix_labels(name: str, rows: int, cols: int) -> tuple[str, ...]:
 class _Symbols:
     """SymPy symbols of a model's entries under their local (printable) names."""
 
-    def __init__(self, eq: Any, reserved: set[str]) -> None:
+    def __init__(self, eq: Equations, reserved: set[str]) -> None:
         import sympy as sp
 
         self.x = [str(s) for s in eq.x]
@@ -374,7 +380,7 @@ class _Symbols:
         self.sym = {n: sp.Symbol(self.local[n]) for n in (*self.x, *self.p)}
         self.plain = {sp.Symbol(n): self.sym[n] for n in (*self.x, *self.p)}
 
-    def names(self, names: Any) -> tuple[str, ...]:
+    def names(self, names: Iterable[str]) -> tuple[str, ...]:
         return tuple(self.local[n] for n in names)
 
 
@@ -400,7 +406,7 @@ def _pads_coupled(G: list[Any], z: list[Any]) -> bool:
     return any(z[j] in G[i].free_symbols for i in range(len(G)) for j in range(len(z)) if i != j)
 
 
-def _nonlinear_functions(spec: Any) -> tuple[tuple[ExportFunction, ...], dict[str, Any]]:
+def _nonlinear_functions(spec: ModelSpec) -> tuple[tuple[ExportFunction, ...], dict[str, Any]]:
     import sympy as sp
 
     from ..symbolic.assemble import build_equations
@@ -465,7 +471,7 @@ def _nonlinear_functions(spec: Any) -> tuple[tuple[ExportFunction, ...], dict[st
     return tuple(fns), meta
 
 
-def _linear_functions(spec: Any) -> tuple[tuple[ExportFunction, ...], dict[str, Any]]:
+def _linear_functions(spec: ModelSpec) -> tuple[tuple[ExportFunction, ...], dict[str, Any]]:
     import sympy as sp
 
     from ..symbolic.assemble import build_equations
@@ -530,7 +536,7 @@ def _linear_functions(spec: Any) -> tuple[tuple[ExportFunction, ...], dict[str, 
 _FUNCTIONS: dict[tuple[str, str], tuple[tuple[ExportFunction, ...], dict[str, Any]]] = {}
 
 
-def _functions(spec: Any, what: str) -> tuple[tuple[ExportFunction, ...], dict[str, Any]]:
+def _functions(spec: ModelSpec, what: str) -> tuple[tuple[ExportFunction, ...], dict[str, Any]]:
     """The symbolic functions of a model, cached in-process by the model's equations."""
     from ..codegen import model_key
 
@@ -564,7 +570,7 @@ def _linear_notes(kept: tuple[str, ...]) -> tuple[str, ...]:
             "linearization.",)
 
 
-def _check_trivial(params: Any) -> None:
+def _check_trivial(params: Parameters) -> None:
     """Refuse the closed form unless the zero state is the silent motion of ``params``."""
     from ..analysis.equilibrium import silent_motion
     from ..errors import SilentMotionError
@@ -593,10 +599,10 @@ def _check_trivial(params: Any) -> None:
 
 def export_model(
     what: What = "nonlinear",
-    params: Any = None,
+    params: Parameters | None = None,
     *,
     source: str | None = None,
-    model: Any = None,
+    model: ModelSpec | str | None = None,
 ) -> ExportModel:
     """Build the language-neutral export description of any model.
 

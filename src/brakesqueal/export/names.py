@@ -43,7 +43,7 @@ all isfinite length Float64 Int Matrix Vector""".split()
 _PYTHON = """math abs pow float int range len tuple list min max all any sum print ArithmeticError
 ValueError True False None""".split()
 #: Names no exported local variable may take (keywords and library names of C, Octave, Julia and Python).
-RESERVED: frozenset[str] = frozenset(_C + _OCTAVE + _JULIA + _PYTHON + keyword.kwlist)
+RESERVED: frozenset[str] = frozenset([*_C, *_OCTAVE, *_JULIA, *_PYTHON, *keyword.kwlist])
 
 
 def is_identifier(name: str) -> bool:

@@ -127,12 +127,12 @@ def print_python(model: ExportModel, out_name: str = "brakesqueal_model") -> str
         lines.append("")
     if model.what == "nonlinear":
         lines += _helpers(model)
-    vals = ", ".join(fmt_float(v) for v in model.parameter_values)
+    defaults = ", ".join(fmt_float(v) for v in model.parameter_values)
     source = model.parameter_source.replace("\\", "\\\\").replace('"""', "'''")
     lines += [
         "",
         "def parameters():",
         f'    """The parameter set {source}."""',
-        f"    return ({vals},)",
+        f"    return ({defaults},)",
     ]
     return "\n".join(lines) + "\n"

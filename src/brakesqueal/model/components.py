@@ -60,11 +60,12 @@ from .friction import FieldDef
 
 if TYPE_CHECKING:
     from ..symbolic.assemble import Assembly
+    from .friction import LawDef
     from .parameters import Preset
     from .roles import ParameterRoles
 
-__all__ = ["Value", "FrictionLaw", "Disk", "Pad", "Caliper", "ModelSpec", "MAX_PADS", "MAX_COORDINATES", "Kind",
-           "COMPONENTS", "param", "attribute", "components"]
+__all__ = ["Value", "FrictionLaw", "Disk", "Pad", "Caliper", "ModelSpec", "Component", "MAX_PADS", "MAX_COORDINATES",
+           "Kind", "COMPONENTS", "param", "attribute", "components"]
 
 Value = Union[float, str]
 FACES = ("upper", "lower")
@@ -139,10 +140,12 @@ def attribute(schema: Mapping[str, Any], default: Any = dataclasses.MISSING, *,
     default, default_factory : optional
         As for :func:`dataclasses.field` (neither: a required key).
     """
-    return field(default=default, default_factory=default_factory, metadata={"schema": dict(schema)})  # type: ignore[call-overload]
+    # field()'s overloads take a default or a default_factory, not both arguments (one of them is MISSING here)
+    return field(default=default, default_factory=default_factory,  # type: ignore[call-overload]
+                 metadata={"schema": dict(schema)})
 
 
-def _check_fields(obj: Any, component: str) -> None:
+def _check_fields(obj: Component, component: str) -> None:
     """Check a component's fields by their definitions: parameters, names, choices and lists (``component``: label)."""
     for f in dataclasses.fields(obj):
         v, fd, schema = getattr(obj, f.name), f.metadata.get("role"), f.metadata.get("schema", {})
@@ -214,7 +217,7 @@ class FrictionLaw:
             raise AttributeError(name)
         return dict(object.__getattribute__(self, "fields")).get(name)
 
-    def __setattr__(self, name: str, value: Any) -> None:
+    def __setattr__(self, name: str, value: object) -> None:
         raise AttributeError("FrictionLaw is immutable")
 
     def __eq__(self, other: object) -> bool:
@@ -232,12 +235,12 @@ class FrictionLaw:
         return (_friction_law, (self.law, self.mu, dict(self.fields)))
 
     @property
-    def __dict__(self) -> dict[str, Any]:  # type: ignore[override]
+    def __dict__(self) -> dict[str, Any]:  # type: ignore[override]  # a property: the class has __slots__
         """``law``, ``mu`` and the fields (for ``vars()``)."""
         return {"law": self.law, **self.values()}
 
     @property
-    def definition(self) -> Any:
+    def definition(self) -> LawDef:
         """The :class:`~brakesqueal.model.friction.LawDef` of this law."""
         from .friction import LAWS
 
@@ -575,7 +578,7 @@ class Caliper:
         _check_fields(self, f"caliper '{self.name}'")
 
     # physics hooks (docs/extending.md): ctx is a brakesqueal.symbolic.assemble.Assembly
-    def _dofs(self) -> list[tuple[str, Any, Any]]:
+    def _dofs(self) -> list[tuple[str, Value, Value]]:
         return [(state_name(pre, self.name), k, d) for dof, pre, k, d in
                 (("normal", "wc", self.k_n, self.d_n), ("tangential", "uc", self.k_t, self.d_t)) if dof in self.dofs]
 
@@ -598,6 +601,9 @@ class Caliper:
             V += half * v(k) * ctx.Q[n] ** 2
         return {"T2": T2, "V_support": V}
 
+
+#: A component of a model (:func:`components`).
+Component = Union[Disk, Pad, Caliper]
 
 #: Largest number of pads a model may have (assembly cost grows quickly with it).
 MAX_PADS = 24
@@ -694,7 +700,7 @@ for _kind in COMPONENTS.values():
     _document(_kind)
 
 
-def components(spec: ModelSpec) -> Iterator[tuple[Kind, Any]]:
+def components(spec: ModelSpec) -> Iterator[tuple[Kind, Component]]:
     """Every component of a model as ``(kind, component)``, in :data:`COMPONENTS` order (``spec``: a ModelSpec)."""
     for kind in COMPONENTS.values():
         held = getattr(spec, kind.table)

@@ -43,7 +43,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from types import MappingProxyType
+from types import MappingProxyType, ModuleType
 from typing import Any
 
 __all__ = ["FieldDef", "LawDef", "LAWS", "SPEED_SCALE", "register_law"]
@@ -100,7 +100,7 @@ class LawDef:
 
     name: str
     fields: Mapping[str, FieldDef]
-    formula: Callable[[Any, Any, Mapping[str, Any]], Any]
+    formula: Callable[[ModuleType, Any, Mapping[str, Any]], Any]  # (sympy, v, fields) -> mu(v), SymPy expressions
     rate_dependent: bool
     text: str = ""
 

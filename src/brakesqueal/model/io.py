@@ -45,9 +45,9 @@ from dataclasses import MISSING
 from typing import Any, Mapping
 
 from ..errors import ParameterError
-from .components import COMPONENTS, FrictionLaw, Kind, ModelSpec
+from .components import COMPONENTS, Component, FrictionLaw, Kind, ModelSpec
 from .expressions import evaluate
-from .parameters import Preset, Value
+from .parameters import Parameters, Preset, Value
 
 __all__ = ["spec_from_dict", "spec_to_dict", "load_model", "model_to_toml", "read_toml", "load_parameter_file",
            "parameters_to_toml", "MAX_FILE_BYTES", "read_toml_text"]
@@ -146,7 +146,8 @@ def _fields(kind: Kind, data: Mapping[str, Any], where: str) -> dict[str, Any]:
         if f.default_factory is FrictionLaw:
             if not isinstance(v, dict):
                 raise ParameterError(f"{where}: {f.name} must be a table like {{ law = 'coulomb', mu = 'mu1' }}")
-            v = FrictionLaw(**{k: (math.inf if x == "inf" else x) for k, x in v.items()})  # type: ignore[arg-type]
+            table: dict[str, Any] = {k: (math.inf if x == "inf" else x) for k, x in v.items()}  # checked by the law
+            v = FrictionLaw(**table)
         elif schema.get("type") == "array":
             if not isinstance(v, (list, tuple)):
                 example = ", ".join(f'"{x}"' for x in schema.get("items", {}).get("enum", ()))
@@ -284,7 +285,7 @@ def spec_to_dict(spec: ModelSpec, *, presets: bool = True) -> dict[str, Any]:
         ``"inf"`` and tuples as lists (plain JSON/TOML types).
     """
 
-    def comp(obj: Any) -> dict[str, Any]:
+    def comp(obj: Component) -> dict[str, Any]:
         out = {}
         for f in dataclasses.fields(obj):
             v = getattr(obj, f.name)
@@ -437,7 +438,7 @@ def load_parameter_file(path: str) -> tuple[str | None, str | None, dict[str, Va
     return model, preset, dict(table)
 
 
-def parameters_to_toml(params: Any) -> str:
+def parameters_to_toml(params: Parameters) -> str:
     """A complete parameter file for ``params`` (a :class:`~.parameters.Parameters`) that reads back exactly.
 
     Floats are written with ``repr`` (exact round trip); ``inf`` as ``"inf"``.

@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING
 
 from ..errors import ParameterError
-from .parameters import ParameterSpace, Parameters, parse_sets
+from .parameters import ParameterSpace, Parameters, Value, parse_sets
+
+if TYPE_CHECKING:
+    from .components import ModelSpec
 
 __all__ = ["resolve_space", "resolve_parameters", "regularised_pads", "damped_pads", "stick_slip_everywhere",
            "DEFAULT_PRESET", "MAX_PAD_SLOPE", "MAX_STICK_SPEED", "MAX_PAD_DAMPING"]
@@ -16,8 +19,8 @@ __all__ = ["resolve_space", "resolve_parameters", "regularised_pads", "damped_pa
 DEFAULT_PRESET = "paper-fig2"
 
 
-def resolve_space(model: Any = None, preset: str | None = None, params: str | None = None,
-                  sets: Sequence[str] | dict[str, Any] = ()) -> ParameterSpace:
+def resolve_space(model: ModelSpec | str | None = None, preset: str | None = None, params: str | None = None,
+                  sets: Sequence[str] | dict[str, Value] = ()) -> ParameterSpace:
     """Combine the model, preset, parameter-file and ``--set`` options into one parameter space.
 
     Parameters
@@ -58,7 +61,7 @@ def resolve_space(model: Any = None, preset: str | None = None, params: str | No
     from .library import get_model, get_preset, resolve_model
 
     overrides = dict(sets) if isinstance(sets, dict) else parse_sets(list(sets))
-    entries: dict[str, Any] = {}
+    entries: dict[str, Value] = {}
     f_model = f_preset = None
     source = None
     if params is not None:
@@ -95,8 +98,8 @@ def resolve_space(model: Any = None, preset: str | None = None, params: str | No
     return space
 
 
-def resolve_parameters(model: Any = None, preset: str | None = None, params: str | None = None,
-                       sets: Sequence[str] | dict[str, Any] = ()) -> Parameters:
+def resolve_parameters(model: ModelSpec | str | None = None, preset: str | None = None, params: str | None = None,
+                       sets: Sequence[str] | dict[str, Value] = ()) -> Parameters:
     """The validated parameter set of :func:`resolve_space` at its current point.
 
     Parameters
@@ -119,7 +122,7 @@ MAX_STICK_SPEED = 1.0
 MAX_PAD_DAMPING = 1e6
 
 
-def _in_range(option: str, value: Any, high: float, unit: str) -> float:
+def _in_range(option: str, value: float, high: float, unit: str) -> float:
     """``value`` as a float in ``(0, high]``, else a ParameterError naming ``option``."""
     try:
         x = float(value)
@@ -131,7 +134,7 @@ def _in_range(option: str, value: Any, high: float, unit: str) -> float:
     return x
 
 
-def stick_slip_everywhere(spec: Any) -> bool:
+def stick_slip_everywhere(spec: ModelSpec) -> bool:
     """Whether every pad of ``spec`` has regularised stick-slip (the law ``stick``).
 
     Only then is a sliding reversal ordinary motion for the simulation (``events="stop"`` stops at contact
@@ -150,7 +153,7 @@ def stick_slip_everywhere(spec: Any) -> bool:
     return bool(spec.pads) and all(pad.friction.law == "stick" for pad in spec.pads)
 
 
-def regularised_pads(space: Any, slope: float, stick_speed: float | None = None) -> Any:
+def regularised_pads(space: ParameterSpace, slope: float, stick_speed: float | None = None) -> ParameterSpace:
     """``space`` with the pads' tangential rates made regular: Coulomb friction replaced by ``mu + slope v``.
 
     Every massless pad with Coulomb friction and a finite tangential stiffness gets the rising law ``mu(v) =
@@ -209,7 +212,7 @@ def regularised_pads(space: Any, slope: float, stick_speed: float | None = None)
     return type(space)(space.preset.bind(new), dict(space.values))
 
 
-def damped_pads(space: Any, d_ip: float) -> Any:
+def damped_pads(space: ParameterSpace, d_ip: float) -> ParameterSpace:
     """``space`` with a tangential damper ``d_ip`` beside the spring of every massless pad (not in the paper).
 
     A massless pad with a finite tangential stiffness then balances ``k_ip (l - u_m) + d_ip (ldot - u_mdot) =

@@ -25,12 +25,17 @@ import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
-from typing import Any, Union
+from typing import TYPE_CHECKING, Any, Union, cast, overload
 
 import numpy as np
 
 from ..errors import ParameterError
 from .expressions import RESERVED_NAMES, dependency_order, evaluate, evaluate_array, names_in, to_sympy
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from .components import ModelSpec
 
 __all__ = ["Value", "Parameters", "Preset", "ParameterSpace", "as_model_spec", "compliance"]
 
@@ -44,7 +49,7 @@ def _fmt(value: float) -> str:
     return repr(value)
 
 
-def _number(value: Any, what: str, name: str | None = None) -> float:
+def _number(value: object, what: str, name: str | None = None) -> float:
     """A float from a number or a constant expression (``"16*pi"``, ``"inf"``); errors name ``name``."""
     if isinstance(value, str):
         try:
@@ -60,14 +65,20 @@ def _number(value: Any, what: str, name: str | None = None) -> float:
     return v
 
 
-def compliance(value: Any) -> Any:
+@overload
+def compliance(value: float) -> float: ...
+@overload
+def compliance(value: np.ndarray) -> np.ndarray: ...  # (a 0-d array gives a float)
+
+
+def compliance(value: ArrayLike) -> float | np.ndarray:
     """``1/k`` for a stiffness, ``0`` for a rigid support (``k = inf``); works on arrays."""
     with np.errstate(divide="ignore"):
         out = np.where(np.isinf(value), 0.0, 1.0 / np.asarray(value, dtype=float))
     return float(out) if np.ndim(out) == 0 else out
 
 
-def as_model_spec(model: Any) -> Any:
+def as_model_spec(model: ModelSpec | str) -> ModelSpec:
     """The :class:`~brakesqueal.model.components.ModelSpec` named by ``model``.
 
     Parameters
@@ -119,10 +130,10 @@ class Parameters(Mapping[str, float]):
     """
 
     __slots__ = ("_model", "_values")
-    _model: Any
+    _model: ModelSpec
     _values: Mapping[str, float]
 
-    def __init__(self, model: Any, values: Mapping[str, Value], *, source: str | None = None) -> None:
+    def __init__(self, model: ModelSpec | str, values: Mapping[str, Value], *, source: str | None = None) -> None:
         from .roles import problems
 
         spec = as_model_spec(model)
@@ -166,7 +177,7 @@ class Parameters(Mapping[str, float]):
         except KeyError:
             raise AttributeError(f"model '{self._model.name}' has no parameter '{name}'") from None
 
-    def __setattr__(self, name: str, value: Any) -> None:
+    def __setattr__(self, name: str, value: object) -> None:
         raise AttributeError("Parameters are immutable; use replace()")
 
     def __repr__(self) -> str:
@@ -185,7 +196,7 @@ class Parameters(Mapping[str, float]):
 
     # ---------------------------------------------------------------- queries
     @property
-    def model(self) -> Any:
+    def model(self) -> ModelSpec:
         """The :class:`~brakesqueal.model.components.ModelSpec`."""
         return self._model
 
@@ -248,16 +259,16 @@ class Preset:
     free: Mapping[str, Value]
     tied: Mapping[str, str]
     auxiliary: Mapping[str, str] = field(default_factory=dict)
-    model: Any = field(default=None, repr=False, compare=False)
+    model: ModelSpec | None = field(default=None, repr=False, compare=False)
 
-    __hash__ = None  # type: ignore[assignment]
+    __hash__ = None  # type: ignore[assignment]  # unhashable (it holds mappings): the data-model idiom
 
     def __post_init__(self) -> None:
         for attribute in ("fixed", "free", "tied", "auxiliary"):
             object.__setattr__(self, attribute, MappingProxyType(dict(getattr(self, attribute))))
 
     # ---------------------------------------------------------------- definition
-    def check(self, spec: Any) -> None:
+    def check(self, spec: ModelSpec) -> None:
         """Check the definition against a model; raise ParameterError naming the preset."""
         where = f"preset '{self.name}'"
         every = [*self.fixed, *self.free, *self.tied]
@@ -290,15 +301,21 @@ class Preset:
             raise ParameterError(f"{where}: auxiliary name '{unused[0]}' is not used", parameter=unused[0])
         dependency_order(self.tied, what=where)
 
-    def bind(self, spec: Any) -> Preset:
+    def bind(self, spec: ModelSpec) -> Preset:
         """This preset attached to ``spec`` (checked)."""
         self.check(spec)
         return replace(self, model=spec)
 
-    def _spec(self) -> Any:
+    def _spec(self) -> ModelSpec:
         if self.model is None:
             raise ParameterError(f"preset '{self.name}' is not attached to a model (use ModelSpec.get_preset)")
         return self.model
+
+    @property
+    def bound_model(self) -> ModelSpec:
+        """The model of a bound preset (:meth:`bind`, :meth:`ModelSpec.get_preset
+        <brakesqueal.model.components.ModelSpec.get_preset>`); ParameterError for an unbound one."""
+        return self._spec()
 
     # ---------------------------------------------------------------- use
     def settable_names(self) -> tuple[str, ...]:
@@ -425,7 +442,7 @@ class ParameterSpace:
     # ---------------------------------------------------------------- construction
     @classmethod
     def from_preset(cls, name: str = "paper-fig2", overrides: Mapping[str, Value] | None = None,
-                    *, model: Any = None) -> ParameterSpace:
+                    *, model: ModelSpec | str | None = None) -> ParameterSpace:
         """A preset (of ``model``, or any built-in preset) with validated overrides."""
         from .library import get_preset
 
@@ -444,9 +461,10 @@ class ParameterSpace:
 
     # ---------------------------------------------------------------- queries
     @property
-    def model(self) -> Any:
+    def model(self) -> ModelSpec:
         """The model."""
-        return self.preset.model
+        # a space's preset is bound (ModelSpec.get_preset / Preset.bind): its model is set
+        return cast("ModelSpec", self.preset.model)
 
     @property
     def label(self) -> str:
@@ -510,7 +528,7 @@ class ParameterSpace:
         return isinstance(other, ParameterSpace) and self.key() == other.key()
 
     # ---------------------------------------------------------------- vectorized / symbolic
-    def arrays(self, axes: Mapping[str, Any]) -> dict[str, np.ndarray]:
+    def arrays(self, axes: Mapping[str, ArrayLike]) -> dict[str, np.ndarray]:
         """Every model parameter evaluated on broadcastable axis arrays (ties applied element-wise).
 
         Parameters
@@ -536,7 +554,7 @@ class ParameterSpace:
             env[n] = evaluate_array(self.tied[n], env, what=f"tied parameter '{n}'")
         return {n: np.broadcast_to(np.asarray(env[n], dtype=float), shape) for n in self.model.parameters}
 
-    def valid(self, arrays: Mapping[str, Any]) -> np.ndarray:
+    def valid(self, arrays: Mapping[str, ArrayLike]) -> np.ndarray:
         """Element-wise validity of :meth:`arrays` output (the array form of the scalar checks)."""
         from .roles import valid_mask
 

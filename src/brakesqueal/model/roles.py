@@ -35,11 +35,18 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
 from .friction import FieldDef
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from .components import Kind, ModelSpec, Value
+
+_T = TypeVar("_T")
 
 __all__ = ["Role", "ROLES", "MAX_MAGNITUDE", "MIN_MAGNITUDE", "ParameterRoles", "parameter_roles", "problems",
            "valid_mask", "format_interval", "role_message"]
@@ -105,7 +112,7 @@ def _from_def(key: str, f: FieldDef) -> Role:
 
 
 @lru_cache(maxsize=8)
-def _derive(kinds: tuple[Any, ...]) -> Mapping[str, Role]:
+def _derive(kinds: tuple[Kind, ...]) -> Mapping[str, Role]:
     from .components import FrictionLaw
     from .friction import LAWS, MU_FIELD
 
@@ -166,10 +173,10 @@ class ParameterRoles:
 
     uses: Mapping[str, tuple[tuple[Role, str], ...]]
     fixed: tuple[tuple[Role, str, float], ...]
-    thickness: tuple[Any, Any]
-    pad_radii: tuple[tuple[str, Any], ...]
-    disk_radius: Any
-    caliper_dofs: tuple[tuple[str, str, Any], ...]
+    thickness: tuple[Value, Value]
+    pad_radii: tuple[tuple[str, Value], ...]
+    disk_radius: Value
+    caliper_dofs: tuple[tuple[str, str, Value], ...]
 
     def unit(self, name: str) -> str:
         """SI unit of a parameter (``""`` if dimensionless or unknown)."""
@@ -210,21 +217,21 @@ class ParameterRoles:
         return bool(roles) and all(r.allows_inf for r, _ in roles)
 
 
-def _component_role(role: Role, f: dataclasses.Field[Any], comp: Any) -> Role:
+def _component_role(role: Role, f: dataclasses.Field[Any], comp: object) -> Role:
     """The role of field ``f`` in component ``comp``: without ``inf`` where its ``finite_if`` rule says so."""
     rule = f.metadata.get("finite_if")
     why = rule(comp) if rule is not None and role.allows_inf else None
     return dataclasses.replace(role, high_open=True, finite=why) if why else role
 
 
-def parameter_roles(spec: Any) -> ParameterRoles:
+def parameter_roles(spec: ModelSpec) -> ParameterRoles:
     """Collect the roles of the named parameters of ``spec`` (a :class:`~.components.ModelSpec`)."""
     from .components import COMPONENTS, FrictionLaw, components
 
     uses: dict[str, list[tuple[Role, str]]] = {}
     fixed: list[tuple[Role, str, float]] = []
-    used: list[tuple[Role, Any, str]] = []
-    unused: list[tuple[Role, Any, str]] = []  # fields that do not enter the equations: their roles come last
+    used: list[tuple[Role, Value | None, str]] = []
+    unused: list[tuple[Role, Value | None, str]] = []  # fields that do not enter the equations: their roles come last
     table = _table()
     for kind, comp in components(spec):
         owner = kind.owner(comp)
@@ -287,7 +294,7 @@ def role_message(role: Role, owner: str, subject: str, v: float) -> str | None:
     return f"{subject} ({what}) must be in {role.interval()}{unit}{why}; got {v!r}"
 
 
-def _value_message(name: str, value: Any, roles: ParameterRoles) -> str | None:
+def _value_message(name: str, value: object, roles: ParameterRoles) -> str | None:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
         return f"The parameter '{name}' must be a real number; got {value!r} ({type(value).__name__})"
     v = float(value)
@@ -300,7 +307,7 @@ def _value_message(name: str, value: Any, roles: ParameterRoles) -> str | None:
     return None
 
 
-def _thickness_message(hu: Any, hl: Any, a: float, b: float) -> str:
+def _thickness_message(hu: Value, hl: Value, a: float, b: float) -> str:
     """The disk thickness ``h_upper + h_lower <= 0``: name the parameters, or the literal field and its range."""
     if isinstance(hu, str) and isinstance(hl, str):
         return (f"The parameters '{hu}' and '{hl}' must satisfy {hu} + {hl} > 0 (disk thickness, eq. 58); "
@@ -313,11 +320,11 @@ def _thickness_message(hu: Any, hl: Any, a: float, b: float) -> str:
             f"be positive (eq. 58) and {other} = {partner}")
 
 
-def _lookup(v: Any, values: Mapping[str, Any]) -> Any:
+def _lookup(v: Value, values: Mapping[str, _T]) -> _T | float:
     return values[v] if isinstance(v, str) else v
 
 
-def problems(roles: ParameterRoles, values: Mapping[str, Any]) -> list[tuple[str, str]]:
+def problems(roles: ParameterRoles, values: Mapping[str, float]) -> list[tuple[str, str]]:
     """Every violated bound or joint constraint, as ``(parameter name, one-line message)``.
 
     Parameters
@@ -359,7 +366,7 @@ def problems(roles: ParameterRoles, values: Mapping[str, Any]) -> list[tuple[str
     return out
 
 
-def valid_mask(roles: ParameterRoles, arrays: Mapping[str, Any]) -> Any:
+def valid_mask(roles: ParameterRoles, arrays: Mapping[str, ArrayLike]) -> np.ndarray:
     """Element-wise validity of broadcastable parameter arrays (the array form of :func:`problems`).
 
     Parameters

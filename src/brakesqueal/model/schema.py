@@ -36,7 +36,11 @@ import math
 import pathlib
 import sys
 from importlib import resources
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .components import Kind
+    from .friction import LawDef
 
 __all__ = ["SCHEMA_FILE", "SCHEMA_ID", "schema", "schema_path", "build_schema"]
 
@@ -77,7 +81,7 @@ def schema() -> dict[str, Any]:
 
 
 # ---------------------------------------------------------------------------------------------- generation
-def _value(role_key: str, owner: str, extra: str = "", default: Any = dataclasses.MISSING) -> dict[str, Any]:
+def _value(role_key: str, owner: str, extra: str = "", default: object = dataclasses.MISSING) -> dict[str, Any]:
     """A field that is a number in its role's interval or a parameter name (or ``inf`` where allowed)."""
     from .io import _plain
     from .roles import MAX_MAGNITUDE, ROLES
@@ -106,7 +110,7 @@ def _value(role_key: str, owner: str, extra: str = "", default: Any = dataclasse
     return out
 
 
-def _component(kind: Any) -> dict[str, Any]:
+def _component(kind: Kind) -> dict[str, Any]:
     """The schema of one component of a kind (:data:`.components.COMPONENTS`), from its dataclass fields."""
     props: dict[str, Any] = {}
     fields = dataclasses.fields(kind.cls)
@@ -123,7 +127,7 @@ def _component(kind: Any) -> dict[str, Any]:
     return out | ({"allOf": list(kind.rules)} if kind.rules else {})
 
 
-def _listed(kind: Any) -> dict[str, Any]:
+def _listed(kind: Kind) -> dict[str, Any]:
     """The model file's key of a kind: a table, or a list of tables."""
     ref = {"$ref": f"#/$defs/{kind.key}"}
     if not kind.many:
@@ -134,7 +138,7 @@ def _listed(kind: Any) -> dict[str, Any]:
     return {"type": "array", **count, "items": ref, **default, "description": kind.doc}
 
 
-def _law_text(law: Any) -> str:
+def _law_text(law: LawDef) -> str:
     fields = ", ".join(["mu", *law.fields])
     formula = law.text
     return f"{law.name}: {formula} (fields: {fields})" if formula else f"{law.name} (fields: {fields})"

@@ -22,12 +22,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..analysis.verdict import Grid, Points, compact
 from ..model.parameters import ParameterSpace, Value
+
+if TYPE_CHECKING:
+    from ..codegen.engine import Engine
+    from .study import Study
 
 __all__ = ["ChunkSpec", "build_space", "compute_chunk", "engine_of"]
 
@@ -57,7 +61,7 @@ class ChunkSpec:
     model: str | None = None
 
     @classmethod
-    def from_study(cls, study: Any) -> ChunkSpec:
+    def from_study(cls, study: Study) -> ChunkSpec:
         if study.kind == "grid":
             refs = tuple(a.ref for a in study.axes)
             signs = tuple(1 if np.all(a.values > 0) else -1 if np.all(a.values < 0) else 0 for a in study.axes)
@@ -120,7 +124,7 @@ def build_space(preset: str | None, values: tuple[tuple[str, Value], ...],
             space = ParameterSpace.from_parameters(Parameters(get_model("paper"), vals, source="[parameters]"))
         space.resolve({})
         return space
-    target = base.model if base is not None else get_model("paper")
+    target = base.bound_model if base is not None else get_model("paper")
     defs: dict[str, Value] = {**base.fixed, **base.free} if base else {}
     defs.update(vals)
     ties = dict(base.tied) if base else {}
@@ -142,7 +146,7 @@ def build_space(preset: str | None, values: tuple[tuple[str, Value], ...],
     return space
 
 
-def engine_of(space: ParameterSpace) -> Any:
+def engine_of(space: ParameterSpace) -> Engine:
     """The engine of a study's model in this worker process (built once per model; a chunk is an entry point)."""
     from ..codegen import build
 

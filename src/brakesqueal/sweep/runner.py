@@ -16,10 +16,11 @@ import math
 import re
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import asdict, dataclass, field
+from functools import partial
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO, Union, cast
 
 import numpy as np
 
@@ -30,13 +31,21 @@ from .lock import StoreLock, lock_holder
 from .store import (StoreError, _NotWritable, check_location, check_skeleton, check_writable,
                     inspect_store, open_group, prepare_store, read_manifest, study_attrs, variable_attrs,
                     verified_chunks, write_chunk)
-from .study import Study, load_study
+from .study import Study, StudySource, load_study
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from dask.typing import Key
+    from distributed import Client, Future, LocalCluster
 
 __all__ = ["sweep", "run_sweep", "sweep_status", "open_sweep", "SweepRun", "SweepStatus", "default_store",
            "local_cluster", "check_scheduler_address"]
 
 #: Largest result (bytes) of a study computed in memory (no store).
 _MAX_IN_MEMORY = 2 * 10**9
+
+#: What ``progress=`` takes: a bar on stderr (``True``) or a stream, a callback of the completed fraction, or nothing.
+Progress = Union[bool, TextIO, Callable[[float], None]]
 
 _WORKER_ENV = {"OMP_WAIT_POLICY": "passive", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
                "MKL_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1"}
@@ -62,10 +71,10 @@ def _coords(study: Study, chunk: int) -> dict[str, np.ndarray]:
 class _Progress:
     """Reports the completed fraction of a study's chunks to a callback (or draws a text bar on a stream)."""
 
-    def __init__(self, study: Study, todo: list[int], done: int, sink: Any) -> None:
+    def __init__(self, study: Study, todo: list[int], done: int, sink: TextIO | Callable[[float], None] | None) -> None:
         self.total, self.done = study.n_chunks, done
-        self.callback = sink if callable(sink) and not hasattr(sink, "write") else None
-        self.stream = sink if self.callback is None else None
+        self.callback: Callable[[float], None] | None = sink if callable(sink) and not hasattr(sink, "write") else None
+        self.stream = cast("TextIO | None", sink if self.callback is None else None)  # what is not a callback
         self.points_left = sum(study.chunk_points(c) for c in todo)
         self.points_done, self.t0 = 0, time.perf_counter()
         self._draw()
@@ -104,7 +113,7 @@ _SCHEMES = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
 _HOST = re.compile(r"^(\[[0-9A-Fa-f:.%a-zA-Z]+\]|[A-Za-z0-9_]([A-Za-z0-9_.-]*[A-Za-z0-9_])?)$")
 
 
-def check_scheduler_address(address: Any) -> str:
+def check_scheduler_address(address: object) -> str:
     """Validate a Dask scheduler address without connecting; return it (``HOST:PORT`` gets ``tcp://``).
 
     Parameters
@@ -189,7 +198,7 @@ def _probe_scheduler(address: str, timeout: float) -> None:
     raise ParameterError(f"cannot reach the Dask scheduler at '{address}' within {timeout:g} s: {why}")
 
 
-def _check_executor(workers: Any, scheduler: Any, client: Any) -> str | None:
+def _check_executor(workers: object, scheduler: object, client: object) -> str | None:
     """Validate the executor options before anything else happens; return the scheduler address."""
     if sum(x is not None for x in (workers, scheduler, client)) > 1:
         raise ParameterError("give at most one of --workers, --scheduler (or client=)")
@@ -199,7 +208,8 @@ def _check_executor(workers: Any, scheduler: Any, client: Any) -> str | None:
 
 
 @contextlib.contextmanager
-def _client(workers: int | None, scheduler: str | None, client: Any, timeout: float) -> Iterator[Any]:
+def _client(workers: int | None, scheduler: str | None, client: Client | None,
+            timeout: float) -> Iterator[Client | None]:
     """``None`` (in-process) or a ``distributed.Client``."""
     scheduler = _check_executor(workers, scheduler, client)
     if client is not None:
@@ -234,7 +244,7 @@ def _client(workers: int | None, scheduler: str | None, client: Any, timeout: fl
     yield None
 
 
-def local_cluster(workers: int) -> Any:
+def local_cluster(workers: int) -> LocalCluster:
     """A ``LocalCluster`` of single-threaded worker processes set up for the compiled kernels.
 
     Two defaults of distributed are changed for these workers (measured on the
@@ -253,7 +263,8 @@ def local_cluster(workers: int) -> Any:
                             silence_logs=logging.ERROR, env=_WORKER_ENV)
 
 
-def _results(study: Study, spec: ChunkSpec, todo: list[int], client: Any) -> Iterator[tuple[int, dict[str, Any]]]:
+def _results(study: Study, spec: ChunkSpec, todo: list[int],
+             client: Client | None) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
     """Compute the chunks ``todo``; yields ``(chunk, result)`` as they finish."""
     if not todo:
         return
@@ -268,9 +279,9 @@ def _results(study: Study, spec: ChunkSpec, todo: list[int], client: Any) -> Ite
 
     limit = 2 * max(1, sum(client.nthreads().values())) + 1
     pending = iter(todo)
-    owner: dict[str, int] = {}
+    owner: dict[Key, int] = {}
 
-    def submit() -> Any:
+    def submit() -> Future | None:
         c = next(pending, None)
         if c is None:
             return None
@@ -308,16 +319,16 @@ class SweepRun:
         Damage of the store's metadata or coordinates that was found and rewritten.
     """
 
-    dataset: Any
+    dataset: xr.Dataset
     store: str | None
     computed: int
     reused: int
     repaired: list[str] = field(default_factory=list)
 
 
-def sweep(study: Any, *, store: str | Path | None = None, workers: int | None = None, scheduler: str | None = None,
-          client: Any = None, overwrite: bool = False, progress: bool | TextIO = False,
-          scheduler_timeout: float = 5.0) -> Any:
+def sweep(study: StudySource, *, store: str | Path | None = None, workers: int | None = None,
+          scheduler: str | None = None, client: Client | None = None, overwrite: bool = False,
+          progress: Progress = False, scheduler_timeout: float = 5.0) -> xr.Dataset:
     """Run a parameter study and return its results as an :class:`xarray.Dataset`.
 
     Parameters
@@ -361,9 +372,9 @@ def sweep(study: Any, *, store: str | Path | None = None, workers: int | None = 
                      progress=progress, scheduler_timeout=scheduler_timeout).dataset
 
 
-def run_sweep(study: Any, *, store: str | Path | None = None, workers: int | None = None,
-              scheduler: str | None = None, client: Any = None, overwrite: bool = False,
-              progress: bool | TextIO = False, scheduler_timeout: float = 5.0) -> SweepRun:
+def run_sweep(study: StudySource, *, store: str | Path | None = None, workers: int | None = None,
+              scheduler: str | None = None, client: Client | None = None, overwrite: bool = False,
+              progress: Progress = False, scheduler_timeout: float = 5.0) -> SweepRun:
     """Run a parameter study as :func:`sweep` does, and report what was computed, reused and repaired.
 
     The order is: the study and the executor options are validated; the store
@@ -442,8 +453,8 @@ def _read_only(st: Study, path: Path, exc: StoreError, overwrite: bool) -> Sweep
     raise exc
 
 
-def _in_memory(st: Study, spec: ChunkSpec, workers: Any, scheduler: Any, client: Any, stream: Any,
-               timeout: float) -> Any:
+def _in_memory(st: Study, spec: ChunkSpec, workers: int | None, scheduler: str | None, client: Client | None,
+               stream: TextIO | Callable[[float], None] | None, timeout: float) -> xr.Dataset:
     import xarray as xr
 
     from ..analysis.quantities import quantity
@@ -474,7 +485,7 @@ def _in_memory(st: Study, spec: ChunkSpec, workers: Any, scheduler: Any, client:
     return ds
 
 
-def open_sweep(store: str | Path, *, verify: bool = True) -> Any:
+def open_sweep(store: str | Path, *, verify: bool = True) -> xr.Dataset:
     """Open a study's Zarr store as a lazily loaded :class:`xarray.Dataset`.
 
     Parameters
@@ -604,7 +615,7 @@ def _ranges(ids: list[int], limit: int = 20) -> str:
     return ", ".join(out[:limit]) + (", ..." if len(out) > limit else "")
 
 
-def sweep_status(study: Any, *, store: str | Path | None = None) -> SweepStatus:
+def sweep_status(study: StudySource, *, store: str | Path | None = None) -> SweepStatus:
     """Completed (verified by checksum), corrupt and missing chunks of a study's store (read-only).
 
     Parameters
@@ -633,13 +644,13 @@ def sweep_status(study: Any, *, store: str | Path | None = None) -> SweepStatus:
     path = path.resolve()
     dims = dict(zip(st.dims, st.shape))
     holder = lock_holder(path)
-    base = dict(store=str(path), study_hash=st.hash(), dims=dims, chunk_shape=list(st.chunks), n_chunks=st.n_chunks,
-                in_use=holder.describe() if holder else None)
+    status = partial(SweepStatus, store=str(path), study_hash=st.hash(), dims=dims, chunk_shape=list(st.chunks),
+                     n_chunks=st.n_chunks, in_use=holder.describe() if holder else None)
     if not path.exists() or (path.is_dir() and not any(path.iterdir())):
-        return SweepStatus(exists=False, missing=list(range(st.n_chunks)), **base)
+        return status(exists=False, missing=list(range(st.n_chunks)))
     check = inspect_store(path, st)
     g = open_group(path, check.manifest, read_only=True)
     good, bad = verified_chunks(g, path, st)
-    return SweepStatus(exists=True, completed=sorted(good), corrupt=sorted(bad),
-                       missing=[c for c in range(st.n_chunks) if c not in good],
-                       version=check.manifest.get("brakesqueal_version"), damaged=check.problems, **base)
+    return status(exists=True, completed=sorted(good), corrupt=sorted(bad),
+                  missing=[c for c in range(st.n_chunks) if c not in good],
+                  version=check.manifest.get("brakesqueal_version"), damaged=check.problems)

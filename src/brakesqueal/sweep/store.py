@@ -47,13 +47,19 @@ import warnings
 from contextlib import suppress
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from ..errors import BrakesquealError, ParameterError
 from ..labels import unit
 from ..status import PointStatus
+
+if TYPE_CHECKING:
+    import zarr
+    from zarr.codecs import ZstdCodec
+
+    from .study import Study
 
 __all__ = ["StoreError", "MARKERS", "MANIFEST", "study_attrs", "variable_attrs", "coordinates", "create_store",
            "prepare_store", "inspect_store", "check_skeleton", "read_manifest", "open_group", "write_chunk",
@@ -80,11 +86,11 @@ def checksum(a: np.ndarray) -> str:
     return hashlib.blake2b(np.ascontiguousarray(a).tobytes(), digest_size=16).hexdigest()
 
 
-def _variables(study: Any) -> list[str]:
+def _variables(study: Study) -> list[str]:
     return list(study.variables())
 
 
-def _compressor() -> Any:
+def _compressor() -> ZstdCodec:
     from zarr.codecs import ZstdCodec
 
     return ZstdCodec(level=1, checksum=True)
@@ -184,7 +190,7 @@ def _zstore(root: Path, *, read_only: bool = False, metadata: dict[str, str] | N
 
 
 # ---------------------------------------------------------------- attributes and coordinates
-def study_attrs(study: Any) -> dict[str, Any]:
+def study_attrs(study: Study) -> dict[str, Any]:
     """Provenance attributes stored with the results (study text and hash, package version, ...)."""
     from .. import __version__
 
@@ -207,20 +213,20 @@ def study_attrs(study: Any) -> dict[str, Any]:
     }
 
 
-def variable_attrs(study: Any) -> dict[str, dict[str, Any]]:
+def variable_attrs(study: Study) -> dict[str, dict[str, Any]]:
     """Attributes of every data variable."""
     from ..analysis.quantities import attributes
 
     extra = {"coordinates": " ".join(study.sample_names)} if study.kind == "samples" else {}
     engine = study.engine()
-    out = {}
+    out: dict[str, dict[str, Any]] = {}
     for q in _variables(study):
         a = attributes(q, engine)
         out[q] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in a.items()} | extra
     return out
 
 
-def coordinates(study: Any) -> dict[str, np.ndarray]:
+def coordinates(study: Study) -> dict[str, np.ndarray]:
     """The coordinate arrays of a study's store (recomputed from the study): name -> values."""
     if study.kind == "grid":
         return {ax.name: ax.values for ax in study.axes}
@@ -228,7 +234,8 @@ def coordinates(study: Any) -> dict[str, np.ndarray]:
 
 
 # ---------------------------------------------------------------- creation
-def _build_skeleton(root: Path, study: Any, attrs: dict[str, Any], *, write_coordinates: bool = True) -> dict[str, Any]:
+def _build_skeleton(root: Path, study: Study, attrs: dict[str, Any], *,
+                    write_coordinates: bool = True) -> dict[str, Any]:
     """Create the store skeleton at ``root`` (must not exist); return its creation record (also written last)."""
     import zarr
 
@@ -292,7 +299,7 @@ def _siblings(path: Path, kind: str) -> list[Path]:
         return []
 
 
-def create_store(path: Path, study: Any) -> dict[str, Any]:
+def create_store(path: Path, study: Study) -> dict[str, Any]:
     """Create the store atomically (build in a hidden sibling directory, then rename); return its record.
 
     ``path`` must not exist or be an empty directory.  Raises
@@ -312,7 +319,7 @@ def create_store(path: Path, study: Any) -> dict[str, Any]:
     return manifest
 
 
-def _expected_manifest(study: Any, created: str | None, version: str | None) -> dict[str, Any]:
+def _expected_manifest(study: Study, created: str | None, version: str | None) -> dict[str, Any]:
     """The creation record a store of ``study`` has (built in a temporary directory, without coordinates)."""
     attrs = study_attrs(study)
     if created:
@@ -372,14 +379,14 @@ class StoreCheck:
         return bool(self.problems)
 
 
-def _different(path: Path, study: Any, h: Any, source: Any) -> ParameterError:
+def _different(path: Path, study: Study, h: object, source: object) -> ParameterError:
     return ParameterError(
         f"store '{path}' holds results of a different study (key 'study_hash' = {str(h)[:12]}..., "
         f"this study {study.hash()[:12]}..., written from '{source or '?'}'); "
         "pass --overwrite to replace it or choose another store")
 
 
-def inspect_store(path: Path, study: Any) -> StoreCheck:
+def inspect_store(path: Path, study: Study) -> StoreCheck:
     """Identify the study of an existing store and check its metadata and coordinates (read-only).
 
     Raises
@@ -446,7 +453,7 @@ def check_skeleton(path: Path, manifest: dict[str, Any]) -> StoreCheck:
     g = open_group(path, manifest, read_only=True)
     for name, want_sum in manifest["coordinates"].items():
         try:
-            ok = checksum(np.asarray(g[name][...])) == want_sum
+            ok = checksum(np.asarray(_array(g, name)[...])) == want_sum
         except Exception:  # noqa: BLE001 - missing / truncated / corrupt chunk files raise codec-specific errors
             ok = False
         if not ok:
@@ -467,7 +474,12 @@ def _read_json_text(text: str) -> Any:
         return None
 
 
-def open_group(path: Path, manifest: dict[str, Any], *, read_only: bool = False) -> Any:
+def _array(g: zarr.Group, name: str) -> zarr.Array:
+    """The coordinate or data variable ``name`` of a store's group (every node but the markers is an array)."""
+    return cast("zarr.Array", g[name])
+
+
+def open_group(path: Path, manifest: dict[str, Any], *, read_only: bool = False) -> zarr.Group:
     """The store's Zarr group, with every node's metadata taken from the creation record ``manifest``."""
     import zarr
 
@@ -475,7 +487,7 @@ def open_group(path: Path, manifest: dict[str, Any], *, read_only: bool = False)
                            mode="r" if read_only else "r+", zarr_format=3)
 
 
-def _repair(path: Path, study: Any, check: StoreCheck) -> None:
+def _repair(path: Path, study: Study, check: StoreCheck) -> None:
     """Rewrite the creation record, damaged metadata and coordinates (they follow from the study)."""
     m = check.manifest
     try:
@@ -489,7 +501,7 @@ def _repair(path: Path, study: Any, check: StoreCheck) -> None:
             g = open_group(path, m)
             coords = coordinates(study)
             for name in check.coords:
-                g[name][...] = coords[name]
+                _array(g, name)[...] = coords[name]
     except OSError as exc:
         raise io_error(exc, "repairing the metadata", path) from None
 
@@ -509,7 +521,7 @@ def _remove_partials(path: Path) -> None:
                     os.unlink(os.path.join(d, f))
 
 
-def prepare_store(path: Path, study: Any, *, overwrite: bool) -> tuple[Any, list[str]]:
+def prepare_store(path: Path, study: Study, *, overwrite: bool) -> tuple[zarr.Group, list[str]]:
     """Create, or verify and repair, the store of ``study`` at ``path`` (the caller holds the lock).
 
     Returns
@@ -598,7 +610,7 @@ def check_writable(path: Path) -> None:
 
 
 # ---------------------------------------------------------------- chunks
-def write_chunk(g: Any, path: Path, study: Any, chunk: int, result: dict[str, np.ndarray]) -> None:
+def write_chunk(g: zarr.Group, path: Path, study: Study, chunk: int, result: dict[str, np.ndarray]) -> None:
     """Write one chunk's data, then its completion marker (each file atomically).
 
     Raises
@@ -613,7 +625,7 @@ def write_chunk(g: Any, path: Path, study: Any, chunk: int, result: dict[str, np
     try:
         for name in _variables(study):
             data = result[name]
-            g[name][region] = data
+            _array(g, name)[region] = data
             sums[name] = checksum(data)
         marker = {"chunk": chunk, "region": [[s.start, s.stop] for s in region], "checksums": sums}
         d = path / MARKERS
@@ -641,18 +653,19 @@ def completed_chunks(path: Path) -> dict[int, dict[str, Any] | None]:
     return out
 
 
-def verified_chunks(g: Any, path: Path, study: Any) -> tuple[set[int], set[int]]:
+def verified_chunks(g: zarr.Group, path: Path, study: Study) -> tuple[set[int], set[int]]:
     """Verify every marker against the data: ``(good, bad)`` chunk ids (markers are never removed)."""
-    good, bad = set(), set()
+    good: set[int] = set()
+    bad: set[int] = set()
     names = _variables(study)
     for chunk, m in sorted(completed_chunks(path).items()):
         if not 0 <= chunk < study.n_chunks:
             continue
         region = study.region(chunk)
         ok = m is not None and m.get("region") == [[s.start, s.stop] for s in region]
-        if ok:
+        if ok and m is not None:
             try:
-                ok = all(checksum(np.asarray(g[n][region])) == m["checksums"].get(n) for n in names)
+                ok = all(checksum(np.asarray(_array(g, n)[region])) == m["checksums"].get(n) for n in names)
             except Exception:  # noqa: BLE001 - truncated / corrupt chunk files raise codec-specific errors
                 ok = False
         (good if ok else bad).add(chunk)

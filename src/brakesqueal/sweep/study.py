@@ -34,15 +34,19 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeGuard, Union
 
 import numpy as np
 
 from ..errors import ParameterError
 from ..model.parameters import Value
 
-__all__ = ["Study", "GridAxis", "SampleRange", "load_study", "QUANTITIES", "DEFAULT_QUANTITIES", "MAX_AXIS_POINTS",
-           "MAX_POINTS", "MAX_CHUNKS", "MAX_CHUNK_POINTS"]
+if TYPE_CHECKING:
+    from ..codegen.engine import Engine
+    from ..model.parameters import ParameterSpace
+
+__all__ = ["Study", "StudySource", "GridAxis", "SampleRange", "load_study", "QUANTITIES", "DEFAULT_QUANTITIES",
+           "MAX_AXIS_POINTS", "MAX_POINTS", "MAX_CHUNKS", "MAX_CHUNK_POINTS"]
 
 #: Quantities a study may compute per point (``stable`` and ``status`` are always computed).
 #: The quantities of the built-in list a study may ask for (any registered quantity is allowed:
@@ -66,7 +70,7 @@ MAX_CHUNKS = 10**6
 MAX_CHUNK_POINTS = (1 << 26, 1 << 22)
 
 
-def _is_num(v: object) -> bool:
+def _is_num(v: object) -> TypeGuard[float]:
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
@@ -77,7 +81,7 @@ class GridAxis:
     name: str
     values: np.ndarray = field(repr=False, compare=False)
     scale: str  # "linear", "log" or "values"
-    spec: tuple[Any, ...]  # (start, stop, num) or the values, for the hash
+    spec: tuple[float, ...]  # (start, stop, num) or the values, for the hash
     ref: float  # magnitude used to scale polynomials in this axis (same for every chunk)
 
     @property
@@ -236,13 +240,13 @@ class Study:
             self.__dict__["_hash"] = hashlib.sha256(json.dumps(self.canonical(), sort_keys=True).encode()).hexdigest()
         return self.__dict__["_hash"]
 
-    def space(self) -> Any:
+    def space(self) -> ParameterSpace:
         """The :class:`~brakesqueal.model.parameters.ParameterSpace` of the study (cached per process)."""
         from .compute import build_space
 
         return build_space(self.preset, tuple(self.values.items()), tuple(self.tied.items()), self.model)
 
-    def engine(self) -> Any:
+    def engine(self) -> Engine:
         """The engine of the study's model (a study file is an entry point: its model is built where it is read)."""
         from ..codegen import build
 
@@ -255,6 +259,10 @@ class Study:
         return [*ALWAYS, *[q for q in REGISTERED if q in self.quantities and q not in ALWAYS]]
 
 
+#: What :func:`load_study` reads: a loaded study, a TOML study file or its content as a dict.
+StudySource = Union[Study, str, Path, Mapping[str, Any]]
+
+
 # ---------------------------------------------------------------- parsing helpers
 class _Ctx:
     def __init__(self, source: str) -> None:
@@ -263,7 +271,7 @@ class _Ctx:
     def err(self, key: str, msg: str) -> ParameterError:
         return ParameterError(f"study file '{self.source}': key '{key}': {msg}")
 
-    def table(self, data: Any, key: str, allowed: tuple[str, ...] | None = None) -> dict[str, Any]:
+    def table(self, data: object, key: str, allowed: tuple[str, ...] | None = None) -> dict[str, Any]:
         if not isinstance(data, dict):
             raise self.err(key, f"must be a table; got {data!r}")
         if allowed is not None:
@@ -273,7 +281,7 @@ class _Ctx:
                                    "unknown key; allowed keys: " + ", ".join(allowed))
         return data
 
-    def number(self, v: Any, key: str) -> float:
+    def number(self, v: object, key: str) -> float:
         from ..model.expressions import evaluate
 
         if isinstance(v, str):
@@ -289,7 +297,7 @@ class _Ctx:
             raise self.err(key, f"must be finite; got {v!r}")
         return x
 
-    def integer(self, v: Any, key: str, low: int) -> int:
+    def integer(self, v: object, key: str, low: int) -> int:
         if not isinstance(v, int) or isinstance(v, bool):
             raise self.err(key, f"must be an integer; got {v!r}")
         if v < low:
@@ -297,7 +305,7 @@ class _Ctx:
         return v
 
 
-def _parse_range(ctx: _Ctx, key: str, v: Any, with_num: bool) -> tuple[float, float, int, bool]:
+def _parse_range(ctx: _Ctx, key: str, v: object, with_num: bool) -> tuple[float, float, int, bool]:
     """A range entry: ``"START:STOP:N[:log]"`` or ``{start, stop, num, scale}``."""
     if isinstance(v, str):
         from ..analysis.maps import parse_axis
@@ -331,7 +339,7 @@ def _parse_range(ctx: _Ctx, key: str, v: Any, with_num: bool) -> tuple[float, fl
     return start, stop, num, scale == "log"
 
 
-def _grid_axis(ctx: _Ctx, name: str, v: Any) -> GridAxis:
+def _grid_axis(ctx: _Ctx, name: str, v: object) -> GridAxis:
     from ..analysis.maps import Axis
 
     key = f"axes.{name}"
@@ -407,7 +415,7 @@ def _read(path: str) -> tuple[str, dict[str, Any]]:
     return read_toml_text(path, "study file")
 
 
-def load_study(study: Any) -> Study:
+def load_study(study: StudySource) -> Study:
     """Read and validate a study.
 
     Parameters
@@ -437,7 +445,7 @@ def load_study(study: Any) -> Study:
 
 
 def _preset_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str | None, dict[str, Value],
-                                                                        dict[str, Any], Any, str | None]:
+                                                                        dict[str, Any], ParameterSpace, str | None]:
     """The preset / parameter-file / [parameters] / [tied] part of a study: (preset, values, tied, space, model)."""
     from ..model.io import load_parameter_file, spec_to_dict
     from ..model.library import get_model, get_preset, resolve_model
@@ -514,7 +522,7 @@ def _offending_key(exc: ParameterError, values: Mapping[str, Any], tied: Mapping
     return "parameters"
 
 
-def _model_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str, dict[str, Value], Any]:
+def _model_space(ctx: _Ctx, data: dict[str, Any], base: Path) -> tuple[str, dict[str, Value], ParameterSpace]:
     """The ``model = ...`` part of a study: (canonical model JSON, parameter overrides, space)."""
     from ..model.io import spec_to_dict
     from ..model.library import resolve_model
@@ -551,10 +559,11 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
     name = data.get("name", Path(source).stem if source != "<dict>" else "study")
     if not isinstance(name, str):
         raise ctx.err("name", f"must be a string; got {name!r}")
-    model_json = None
+    model_json: str | None = None
+    tied_tab: dict[str, Any] = {}
     if "model" in data:
         model_json, values, space = _model_space(ctx, data, base)
-        preset_name, tied_tab = None, {}
+        preset_name = None
     else:
         preset_name, values, tied_tab, space, model_json = _preset_space(ctx, data, base)
 

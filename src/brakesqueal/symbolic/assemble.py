@@ -25,9 +25,10 @@ simulation is decided there (:mod:`brakesqueal.analysis.linear`).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Container, Mapping
 from dataclasses import dataclass
-from typing import Any, cast
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
 
 from ..model.components import components
 from .backend import Backend, get_backend
@@ -36,11 +37,14 @@ from .contact import PadContact, angle_cos_sin, friction_coefficient, pad_contac
 from .euler import angular_momentum_rate, euler_matrices, support_moment
 from .kinematics import CardanKinematics, cardan_kinematics
 
+if TYPE_CHECKING:
+    from ..model.components import Component, FrictionLaw, ModelSpec
+
 __all__ = ["Equations", "Assembly", "ENERGY_TERMS", "PHASES", "build_equations", "energy_terms",
            "compliance_name"]
 
 
-def compliance_name(name: str, taken: Any = ()) -> str:
+def compliance_name(name: str, taken: Container[str] = ()) -> str:
     """Name of the compliance ``1/k`` of a stiffness parameter: ``k_ip1 -> c_ip1``, else ``c__<name>``."""
     cand = "c" + name[1:] if name.startswith("k_") else f"c__{name}"
     return cand if cand not in taken else f"c__{name}"
@@ -86,7 +90,7 @@ class Equations:
         ``"symengine"`` or ``"sympy"``.
     """
 
-    spec: Any
+    spec: ModelSpec
     coords: tuple[str, ...]
     algebraic: tuple[str, ...]
     R: Any
@@ -103,7 +107,7 @@ class Equations:
     reduced: ReducedEquations | None
     kinematics: CardanKinematics | None
     constraint_qdot: Any
-    backend: str
+    backend: Backend
 
     @property
     def x(self) -> list[Any]:
@@ -131,7 +135,7 @@ class Equations:
 class _Values:
     """Component field → symbolic value (names → symbols, stiffness names → 1/compliance)."""
 
-    def __init__(self, sm: Any, spec: Any) -> None:
+    def __init__(self, sm: ModuleType, spec: ModelSpec) -> None:
         self.sm = sm
         self.kip = spec.stiffness_names()
         names = list(spec.parameters)
@@ -207,8 +211,8 @@ class Assembly:
         The disk's matrices of eq. (45) (set by :meth:`euler_rows` on the Kronecker route).
     """
 
-    def __init__(self, sm: Any, spec: Any, coords: list[str], algebraic: list[str], *, kronecker: bool = True,
-                 keep_q3: bool = False, engagement: Any = None) -> None:
+    def __init__(self, sm: ModuleType, spec: ModelSpec, coords: list[str], algebraic: list[str], *,
+                 kronecker: bool = True, keep_q3: bool = False, engagement: Mapping[str, Any] | None = None) -> None:
         self.sm = sm
         self.spec = spec
         self.val = _Values(sm, spec)
@@ -236,7 +240,7 @@ class Assembly:
     @classmethod
     def of(cls, eq: Equations) -> Assembly:
         """The context of assembled equations (for the ``energy`` hooks): symbols, disk kinematics, pad contacts."""
-        ctx = cls(get_backend(cast(Backend, eq.backend)), eq.spec, list(eq.coords), list(eq.algebraic))
+        ctx = cls(get_backend(eq.backend), eq.spec, list(eq.coords), list(eq.algebraic))
         ctx.Q, ctx.dQ, ctx.ddQ = (dict(zip(eq.coords, x)) for x in (eq.Q, eq.dQ, eq.ddQ))
         ctx.L, ctx.dL = dict(zip(eq.algebraic, eq.L)), dict(zip(eq.algebraic, eq.dL))
         ctx.kinematics, ctx.qdot, ctx.reduced = eq.kinematics, eq.constraint_qdot, eq.reduced
@@ -261,7 +265,7 @@ class Assembly:
         """Exact ``cos``/``sin`` of an angle in degrees (:func:`.contact.angle_cos_sin`)."""
         return angle_cos_sin(self.sm, deg)
 
-    def friction(self, law: Any, v: Any) -> Any:
+    def friction(self, law: FrictionLaw, v: Any) -> Any:
         """``mu(v)`` of a :class:`~brakesqueal.model.components.FrictionLaw` (its fields through :attr:`val`)."""
         return friction_coefficient(self.sm, law, v, self.val)
 
@@ -311,8 +315,8 @@ class Assembly:
         return _psi_without_kronecker(sm, kin, I3, con, dq_m, ddq_m, k_t, d_t, self.moment)
 
 
-def build_equations(spec: Any, backend: Backend = "symengine", *, kronecker: bool = True,
-                    keep_q3: bool = False, engagement: Any = None) -> Equations:
+def build_equations(spec: ModelSpec, backend: Backend = "symengine", *, kronecker: bool = True,
+                    keep_q3: bool = False, engagement: Mapping[str, Any] | None = None) -> Equations:
     """Assemble the nonlinear equations of a model from its components' physics hooks.
 
     The driver of :class:`Assembly`: every component names its coordinates and pad deformations, then
@@ -401,13 +405,13 @@ def energy_terms(eq: Equations) -> dict[str, Any]:
     return total
 
 
-def _hook(comp: Any, name: str, default: Callable[..., Any]) -> Callable[..., Any]:
+def _hook(comp: Component, name: str, default: Callable[..., Any]) -> Callable[..., Any]:
     """A component's physics hook, or ``default`` when its class defines none (a kind with data only)."""
     return getattr(comp, name, None) or default
 
 
-def _psi_without_kronecker(sm: Any, kin: Any, I3: Any, con: Any, dq_m: Any, ddq_m: Any, k_t: Any, d_t: Any,
-                           moment: Any) -> Any:
+def _psi_without_kronecker(sm: ModuleType, kin: CardanKinematics, I3: Any, con: SpinConstraint, dq_m: Any,
+                           ddq_m: Any, k_t: Any, d_t: Any, moment: Any) -> Any:
     """Chain-rule route: derivative of the angular momentum along the motion, then the constraint."""
     dq3, ddq3 = sm.Symbol("dq3"), sm.Symbol("ddq3")
     q1, q2 = kin.q[0], kin.q[1]

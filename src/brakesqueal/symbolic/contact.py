@@ -40,9 +40,12 @@ import math
 from dataclasses import dataclass
 from fractions import Fraction
 from types import ModuleType
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 from .kinematics import tilde
+
+if TYPE_CHECKING:
+    from ..model.components import FrictionLaw
 
 __all__ = ["PadContact", "pad_contact", "friction_coefficient", "angle_cos_sin"]
 
@@ -107,7 +110,7 @@ def angle_cos_sin(sm: ModuleType, deg: float) -> tuple[Any, Any]:
     return sm.cos(a), sm.sin(a)
 
 
-def friction_coefficient(sm: ModuleType, law: Any, v: Any, val: Callable[[Any], Any]) -> Any:
+def friction_coefficient(sm: ModuleType, law: FrictionLaw, v: Any, val: Callable[[Any], Any]) -> Any:
     """``mu(v)`` of a :class:`~brakesqueal.model.components.FrictionLaw` (``val`` maps fields to symbols).
 
     The formula is the law's own (:data:`brakesqueal.model.friction.LAWS`).

@@ -20,10 +20,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal, cast
 
 from ..errors import ParameterError
 from .backend import get_backend
+
+if TYPE_CHECKING:
+    from ..model.components import ModelSpec
+    from .assemble import Equations
+    from .model import SymbolicEquations
 
 
 def _unknown_case(case: object) -> ParameterError:
@@ -89,12 +94,12 @@ def simplify_entry(e: Any) -> Any:
     return sp.factor_terms(sp.cancel(masked)).xreplace({d: x for x, d in mask.items()})
 
 
-def _equations(eq: Any) -> Any:
+def _equations(eq: Equations | SymbolicEquations) -> Equations:
     """The general :class:`~.assemble.Equations` behind ``eq`` (also accepts the paper view of :mod:`.model`)."""
-    return getattr(eq, "equations", eq)
+    return cast("Equations", getattr(eq, "equations", eq))
 
 
-def jacobian_blocks(eq: Any) -> dict[str, Any]:
+def jacobian_blocks(eq: Equations | SymbolicEquations) -> dict[str, Any]:
     """Exact symbolic Jacobians of ``R`` and ``G`` by variable group.
 
     Parameters
@@ -112,7 +117,7 @@ def jacobian_blocks(eq: Any) -> dict[str, Any]:
         ``psi_q, ..., g_dl`` of :data:`BLOCKS` are present too.
     """
     e = _equations(eq)
-    sm = get_backend(e.backend)  # type: ignore[arg-type]
+    sm = get_backend(e.backend)
     out: dict[str, Any] = {}
     groups = {"Q": e.Q, "dQ": e.dQ, "ddQ": e.ddQ, "L": e.L, "dL": e.dL}
     for res_name, res in (("R", e.R), ("G", e.G)):
@@ -126,7 +131,7 @@ def jacobian_blocks(eq: Any) -> dict[str, Any]:
     return out
 
 
-def trivial_blocks(eq: Any) -> dict[str, Any]:
+def trivial_blocks(eq: Equations | SymbolicEquations) -> dict[str, Any]:
     """The blocks of :func:`jacobian_blocks` at the zero state (the trivial silent motion).
 
     Parameters
@@ -279,7 +284,7 @@ def closed_form(case: Case = "general") -> ClosedForm:
     return ClosedForm(case=case, M=conv(M), D=conv(D), K=conv(K), assumptions=_ASSUMPTIONS[case], symbols=S)
 
 
-def model_closed_form(spec: Any) -> ClosedForm:
+def model_closed_form(spec: ModelSpec) -> ClosedForm:
     """Symbolic ``M, D, K`` of any model about the zero state (the silent motion when it is trivial).
 
     Numeric component fields enter as numbers, named ones as positive SymPy
@@ -310,8 +315,8 @@ def model_closed_form(spec: Any) -> ClosedForm:
     real = {n for n in (spec.disk.h_upper, spec.disk.h_lower) if isinstance(n, str)}
     S = {n: (sp.Symbol(n, real=True) if n in real else sp.Symbol(n, positive=True)) for n in spec.parameters}
     back = {}
-    for n, pn in zip(spec.parameters, eq.param_names):
-        back[sp.Symbol(pn)] = 1 / S[n] if pn != n else S[n]
+    for name, pn in zip(spec.parameters, eq.param_names):
+        back[sp.Symbol(pn)] = 1 / S[name] if pn != name else S[name]
 
     def conv(m: Any) -> Any:
         return sp.Matrix(sp.sympify(m)).xreplace(back).applyfunc(simplify_entry)

@@ -34,6 +34,7 @@ from fractions import Fraction
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from ..model.components import ModelSpec
     from ..model.parameters import ParameterSpace
 
 __all__ = [
@@ -100,7 +101,7 @@ class ModelForm:
         return dict(zip(self.names, self.symbols))
 
 
-def _zero_state(spec: Any, names: tuple[str, ...], comp: tuple[bool, ...], S: dict[str, Any]
+def _zero_state(spec: ModelSpec, names: tuple[str, ...], comp: tuple[bool, ...], S: dict[str, Any]
                 ) -> tuple[tuple[Any, ...], bool]:
     """Non-zero zero-state residuals in the model's symbols, and whether every pad provably touches and slides."""
     import sympy as sp
@@ -124,7 +125,7 @@ def _zero_state(spec: Any, names: tuple[str, ...], comp: tuple[bool, ...], S: di
     return residuals, True
 
 
-def build_model_form(spec: Any, key: str, param_names: tuple[str, ...], n: int, rate_free: tuple[bool, ...]
+def build_model_form(spec: ModelSpec, key: str, param_names: tuple[str, ...], n: int, rate_free: tuple[bool, ...]
                      ) -> ModelForm | None:
     """The closed form of a model for the generated kernels, or ``None`` where it does not apply.
 
@@ -187,7 +188,7 @@ def build_model_form(spec: Any, key: str, param_names: tuple[str, ...], n: int, 
 
 
 # ---------------------------------------------------------------- rate blocks
-def rate_block_exprs(spec: Any) -> tuple[int, int, list[Any], list[Any]]:
+def rate_block_exprs(spec: ModelSpec) -> tuple[int, int, list[Any], list[Any]]:
     """The zero-state rate blocks ``R_dL``, ``G_dL``, ``G_ddQ`` of a model, simplified (SymPy).
 
     At the zero state a massless pad's rate terms are differences of terms
@@ -677,7 +678,7 @@ def exact_omega_source(form: ModelForm) -> str:
 
 
 # ---------------------------------------------------------------- n-DOF: the exact characteristic polynomial
-def nd_form(spec: Any, rate_free: tuple[bool, ...]) -> tuple[Any, ...] | None:
+def nd_form(spec: ModelSpec, rate_free: tuple[bool, ...]) -> tuple[Any, ...] | None:
     """Symbolic zero-state ``M, D, K`` and residuals of a rate-free model whose pads provably touch and slide."""
     from .linearize import model_closed_form
 
