@@ -127,25 +127,6 @@ def test_write_map_file_of_an_ndof_model(tmp_path):
     np.testing.assert_array_equal(np.asarray(data["stable"].values, dtype=bool), d["stable"].values)
 
 
-def test_charpoly_point_verdicts_against_lapack():
-    """Scattered points (e.g. a boundary's vertices) by the characteristic polynomial, against LAPACK."""
-    from brakesqueal.analysis.kernels import charpoly_point_verdicts
-
-    space = resolve_space("eight-dof")
-    table = build(space.model).charpoly_table(space, "k_cn", "k_c")
-    # scattered points against LAPACK
-    rng = np.random.default_rng(3)
-    ov = np.exp(rng.uniform(np.log(5e6), np.log(5e8), 60))
-    iv = np.exp(rng.uniform(np.log(1e8), np.log(1e10), 60))
-    codes, mr, _ = charpoly_point_verdicts(table, ov, iv)
-    ev = np.array([_lapack(space, "k_cn", "k_c", ov[k:k + 1], iv[k:k + 1])[0, 0] for k in range(ov.size)])
-    top = ev[np.arange(ov.size), np.argmax(ev.real, axis=1)]
-    done = codes != UNDECIDED
-    assert done.mean() > 0.9
-    np.testing.assert_array_equal(codes[done] == STABLE, top.real[done] < 0)
-    np.testing.assert_array_less(np.abs(mr - top.real)[done], 1e-9 * np.abs(top[done]))
-
-
 def test_charpoly_route_refused_quickly_for_transcendental_entries(tmp_path):
     """A Stribeck law puts exp(-Omega r / v_s) into the pencil: not rational in an Omega axis.
 

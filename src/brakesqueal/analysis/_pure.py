@@ -19,21 +19,13 @@ import importlib.util
 import types
 from typing import Any
 
+from ..codegen.stability import plain_module
+
 __all__ = ["SMALL", "twin", "call"]
 
 #: Largest batch run as plain Python.
 SMALL = 4
 _TWIN: list[types.ModuleType] = []
-
-
-class _NoJit:
-    """Stands in for ``numba`` in the twin: ``njit`` returns the function unchanged."""
-
-    @staticmethod
-    def njit(*args: Any, **kwargs: Any) -> Any:
-        if args and callable(args[0]):
-            return args[0]
-        return lambda f: f
 
 
 def twin() -> types.ModuleType:
@@ -43,11 +35,7 @@ def twin() -> types.ModuleType:
         assert spec is not None and spec.loader is not None and spec.origin is not None
         src = spec.loader.get_source(spec.name)  # type: ignore[attr-defined]
         assert src is not None and "\nimport numba\n" in src and src.rstrip().endswith("_guard()")
-        src = src.replace("\nimport numba\n", "\n", 1).rstrip()[: -len("_guard()")]
-        mod = types.ModuleType("brakesqueal.analysis._compiled_twin")
-        mod.__dict__.update(numba=_NoJit, __package__="brakesqueal.analysis")
-        exec(compile(src, spec.origin, "exec"), mod.__dict__)  # noqa: S102 (the package's own source)
-        _TWIN.append(mod)
+        _TWIN.append(plain_module(src.rstrip()[: -len("_guard()")], spec.origin, "brakesqueal.analysis"))
     return _TWIN[0]
 
 

@@ -80,8 +80,8 @@ def _gcd(a: Sequence[Any], b: Sequence[Any]) -> Poly:
     return a
 
 
-def _divide(a: Poly, b: Poly) -> tuple[Poly, bool]:
-    """Primitive quotient ``a / b`` over the rationals and whether the division is exact."""
+def _divide(a: Sequence[Any], b: Sequence[Any]) -> tuple[list[Fraction], list[Fraction]]:
+    """Quotient and remainder of ``a / b`` over the rationals (not normalized)."""
     r = [Fraction(x) for x in a]
     q = [Fraction(0)] * max(len(a) - len(b) + 1, 1)
     while r and _deg(r) >= _deg(b):
@@ -90,7 +90,12 @@ def _divide(a: Poly, b: Poly) -> tuple[Poly, bool]:
         for i, y in enumerate(b):
             r[i + shift] -= c * y
         r = _trim(r)
-    return _primitive(q), not r
+    return _trim(q), r
+
+
+def _exact(a: Sequence[Any], b: Sequence[Any]) -> Poly:
+    """Primitive ``a / b`` where ``b`` divides ``a``."""
+    return _primitive(_divide(a, b)[0])
 
 
 def _derivative(p: Sequence[Any]) -> list[Any]:
@@ -102,33 +107,20 @@ def _sub(a: Sequence[Any], b: Sequence[Any]) -> list[Any]:
     return _trim([(a[i] if i < len(a) else 0) - (b[i] if i < len(b) else 0) for i in range(n)])
 
 
-def _quotient(a: Sequence[Any], b: Sequence[Any]) -> list[Fraction]:
-    """Exact quotient ``a / b`` over the rationals (not normalized: Yun's steps need consistent scaling)."""
-    r = [Fraction(x) for x in a]
-    q = [Fraction(0)] * max(len(a) - len(b) + 1, 1)
-    while r and _deg(r) >= _deg(b):
-        c, shift = r[-1] / b[-1], _deg(r) - _deg(b)
-        q[shift] = c
-        for i, y in enumerate(b):
-            r[i + shift] -= c * y
-        r = _trim(r)
-    return _trim(q)
-
-
 def _squarefree(p: Poly) -> list[tuple[Poly, int]]:
     """Yun's square-free decomposition ``p = c prod f_k^k`` (the ``f_k`` of degree >= 1, with ``k``)."""
     dp = _derivative(p)
     a = _gcd(p, dp)
-    b = _quotient([Fraction(x) for x in p], a)
-    c = _quotient([Fraction(x) for x in dp], a)
+    b = _divide(p, a)[0]
+    c = _divide(dp, a)[0]
     d = _sub(c, [Fraction(x) for x in _derivative(b)])
     out, k = [], 1
     while _deg(b) >= 1:
         f = _gcd(b, d)
         if _deg(f) >= 1:
             out.append((f, k))
-        b = _quotient(b, f)
-        c = _quotient(d, f)
+        b = _divide(b, f)[0]
+        c = _divide(d, f)[0]
         d = _sub(c, _derivative(b))
         k += 1
     return out
@@ -145,10 +137,10 @@ def _basis(parts: list[Poly]) -> list[Poly]:
                 new.append(b)
                 continue
             new.append(h)
-            q = _divide(b, h)[0]
+            q = _exact(b, h)
             if _deg(q) >= 1:
                 new.append(q)
-            g = _divide(g, h)[0]
+            g = _exact(g, h)
         if _deg(g) >= 1:
             new.append(g)
         basis = new
@@ -346,6 +338,6 @@ def isolate_real_roots(polys: Sequence[Sequence[Any]], lo: Any, hi: Any, *, eps_
         items.sort(key=lambda t: (t[0], t[1]))
     out = []
     for a_, b_, j in items:
-        owners = {i: k for i, fs in factors.items() for f, k in fs if _divide(f, basis[j])[1]}
+        owners = {i: k for i, fs in factors.items() for f, k in fs if not _divide(f, basis[j])[1]}
         out.append((a_, b_, owners))
     return out

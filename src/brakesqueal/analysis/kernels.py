@@ -23,7 +23,7 @@ and axes) by the model's :class:`~brakesqueal.codegen.engine.Engine` from its
 closed form (:mod:`brakesqueal.symbolic.stability_forms`) and kept in the on-disk
 cache; this module only *runs* them:
 
-* :func:`kernel_eigen`, :func:`classify_numpy`, :func:`run_classify` — the
+* :func:`kernel_eigen`, :func:`run_classify` — the
   grid kernels' verdicts and roots (:meth:`Engine.grid_kernel
   <brakesqueal.codegen.engine.Engine.grid_kernel>`: the exact numerators of the
   quartic as polynomials in one *inner* axis, rows evaluated in
@@ -55,9 +55,9 @@ if TYPE_CHECKING:
 
 __all__ = [
     "quartic_coefficients", "hurwitz_h3", "hurwitz_stable", "GridKernel", "MapKernel", "CharpolyTable",
-    "classify_numpy", "real_roots", "trivial_entries", "omega_entries", "omega_coefficients", "omega_subranges",
+    "real_roots", "trivial_entries", "omega_entries", "omega_subranges",
     "inner_exponent", "kernel_segments", "run_classify", "kernel_scaling", "kernel_eigen", "charpoly_verdicts",
-    "charpoly_point_verdicts", "CHARPOLY_ACCURACY", "CHARPOLY_ROUTE", "CHARPOLY_BLOCK",
+    "CHARPOLY_ACCURACY", "CHARPOLY_ROUTE", "CHARPOLY_BLOCK",
 ]
 
 _U = 2.0 ** -53
@@ -188,109 +188,6 @@ def kernel_eigen(kern: GridKernel | MapKernel, C: np.ndarray, t: np.ndarray, lam
     return mr, fr, ok
 
 
-def _np_bounds(C: np.ndarray, EC: np.ndarray, degrees: tuple[int, ...], T: np.ndarray | float
-               ) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """Error bounds ``E_k`` and magnitude bounds ``B_k`` of the ``a_k`` for ``|t| <= T`` (broadcast to rows × T)."""
-    offs = np.concatenate([[0], np.cumsum([d + 1 for d in degrees])])
-    E, B = [], []
-    for i, d in enumerate(degrees):
-        g = (2 * d + 4) * _U * 1.0001
-        c = C[:, offs[i]:offs[i + 1], None]
-        b = EC[:, offs[i]:offs[i + 1], None] + g * np.abs(c)
-        e = b[:, d]
-        m = np.abs(c[:, d])
-        for k in range(d - 1, -1, -1):
-            e = e * T + b[:, k]
-            m = m * T + np.abs(c[:, k])
-        E.append(e * 1.0000000001 + 1e-300)
-        B.append(m * 1.0000000001 + E[-1])
-    return E, B
-
-
-def _np_values(C: np.ndarray, degrees: tuple[int, ...], t: np.ndarray) -> list[np.ndarray]:
-    offs = np.concatenate([[0], np.cumsum([d + 1 for d in degrees])])
-    a = []
-    for i, d in enumerate(degrees):
-        v = np.broadcast_to(C[:, offs[i] + d, None], (C.shape[0], t.size)).copy()
-        for k in range(d - 1, -1, -1):
-            v *= t
-            v += C[:, offs[i] + k, None]
-        a.append(v)
-    return a
-
-
-def _np_test(a: list[np.ndarray], E: list[np.ndarray], eh: np.ndarray) -> np.ndarray:
-    a0, a1, a2, a3, a4 = a
-    E0, E1, E2, E3, E4 = E
-    s = np.where(a4 > 0, 1.0, -1.0)
-    d0, d1, d2, d3 = s * a0, s * a1, s * a2, s * a3
-    h = d1 * (d3 * d2 - np.abs(a4) * d1) - d3 * d3 * d0
-    sg = np.abs(a4) > E4
-    st = sg & (d0 > E0) & (d1 > E1) & (d2 > E2) & (d3 > E3) & (h > eh)
-    ng = sg & ((d0 < -E0) | (d1 < -E1) | (d2 < -E2) | (d3 < -E3) | (h < -eh))
-    return np.where(st, 1, np.where(ng, 0, 2)).astype(np.uint8)
-
-
-def _eh(A: list[np.ndarray], E: list[np.ndarray], a: list[np.ndarray] | None = None) -> np.ndarray:
-    """Error bound of ``s H3`` from bounds ``E_k`` and magnitudes ``A_k`` (``|a_k| <= A_k - E_k``)."""
-    A0, A1, A2, A3, A4 = A
-    E0, E1, E2, E3, E4 = E
-    v1, v3, v4 = (A1 - E1, A3 - E3, A4 - E4) if a is None else (np.abs(a[1]), np.abs(a[3]), np.abs(a[4]))
-    return (E1 * A3 * A2 + v1 * E3 * A2 + v1 * v3 * E2 + E4 * A1 * A1 + v4 * E1 * (A1 + v1)
-            + E3 * (A3 + v3) * A0 + v3 * v3 * E0 + 1.2e-15 * (A1 * A3 * A2 + A4 * A1 * A1 + A3 * A3 * A0)) * 1.0000001 \
-        + 1e-300
-
-
-def classify_numpy(kernel: MapKernel | GridKernel, C: np.ndarray, EC: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """NumPy (no compiler) version of the compiled classifier on the same row tables (codes 0/1/2).
-
-    Same two passes: bounds per segment of :func:`kernel_segments`, then the
-    points left uncertain with their own bounds.
-    """
-    degrees = kernel.degrees
-    t = np.asarray(t, dtype=float)
-    out = np.empty((C.shape[0], t.size), dtype=np.uint8)
-    seg, Tseg = kernel_segments(t)
-    with np.errstate(all="ignore"):
-        for q in range(seg.size - 1):
-            ts = t[seg[q]:seg[q + 1]]
-            E, B = _np_bounds(C, EC, degrees, float(Tseg[q]))
-            eh = _eh(B, E)
-            a0, a1, a2, a3, a4 = _np_values(C, degrees, ts)
-            s = np.copysign(1.0, a4)
-            for x in (a0, a1, a2, a3):
-                x *= s
-            np.abs(a4, out=a4)
-            h = a3 * a2
-            h -= a4 * a1
-            h *= a1
-            h -= a3 * a3 * a0
-            f = 1.0 - 4.5e-16  # fl(d r) > 1 implies d > E (see the compiled kernel)
-            m = h * (f / eh)
-            for x, e in zip((a0, a1, a2, a3), E[:4]):
-                np.minimum(m, x * (f / e), out=m)
-            sg = a4 > E[4]
-            out[:, seg[q]:seg[q + 1]] = 2 - (sg & (m > 1.0)) - 2 * (sg & (m < -1.0))
-        rr, cc = np.nonzero(out == 2)
-        if rr.size:
-            tt = t[cc]
-            Cp, ECp = C[rr], EC[rr]
-            offs = np.concatenate([[0], np.cumsum([d + 1 for d in degrees])])
-            a, E = [], []
-            for i, d in enumerate(degrees):
-                g = (2 * d + 4) * _U * 1.0001
-                v = Cp[:, offs[i] + d].copy()
-                e = ECp[:, offs[i] + d] + g * np.abs(Cp[:, offs[i] + d])
-                for k in range(d - 1, -1, -1):
-                    v = v * tt + Cp[:, offs[i] + k]
-                    e = e * np.abs(tt) + ECp[:, offs[i] + k] + g * np.abs(Cp[:, offs[i] + k])
-                a.append(v)
-                E.append(e * 1.0000000001 + 1e-300)
-            A = [np.abs(x) + e for x, e in zip(a, E)]
-            out[rr, cc] = _np_test(a, E, _eh(A, E, a))
-    return out
-
-
 # ---------------------------------------------------------------- real roots (compiled, floating point)
 
 
@@ -365,17 +262,6 @@ def omega_entries(engine: Engine, P: np.ndarray) -> tuple[np.ndarray, np.ndarray
     with np.errstate(all="ignore"):
         mod.entries_batch(P, V, R)
     return V.reshape(-1, 12, 4), R.reshape(-1, 12, 4)
-
-
-def omega_coefficients(engine: Engine, p: np.ndarray) -> np.ndarray:
-    """Laurent coefficients in Ω of the 12 entries of ``Mbar, Dbar, Kbar`` at parameter vector ``p``.
-
-    Returns
-    -------
-    ndarray, shape (12, 4)
-        ``entry = Σ_k out[e, k] Ω^(k-1)``.
-    """
-    return omega_entries(engine, np.atleast_2d(p))[0][0]
 
 
 def omega_subranges(lo: float, hi: float, decades: float = 6.0) -> np.ndarray:
@@ -456,22 +342,4 @@ def charpoly_verdicts(table: CharpolyTable, outer_values: np.ndarray, inner_valu
                              CHARPOLY_BLOCK)
     else:
         charpoly_grid(table.Q, table.RQ, xo, yi, ok, bool(eigen), CHARPOLY_ACCURACY, codes, mr, fr)
-    return codes, mr, fr
-
-
-def charpoly_point_verdicts(table: CharpolyTable, outer_values: np.ndarray, inner_values: np.ndarray, *,
-                            eigen: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`charpoly_verdicts` at scattered points ``(outer_values[k], inner_values[k])`` (1-D arrays).
-
-    Each point warm-starts from the previous one (e.g. the vertices of a
-    boundary curve); the verdicts are certified the same way.
-    """
-    from ._compiled import charpoly_points
-
-    xs, ys = np.broadcast_arrays(np.asarray(outer_values, dtype=float), np.asarray(inner_values, dtype=float))
-    xs, ys = np.ascontiguousarray(xs.ravel()), np.ascontiguousarray(ys.ravel())
-    codes = np.empty(xs.size, dtype=np.uint8)
-    mr = np.empty(xs.size)
-    fr = np.empty(xs.size)
-    charpoly_points(table.Q, table.RQ, xs, ys, bool(eigen), CHARPOLY_ACCURACY, codes, mr, fr)
     return codes, mr, fr

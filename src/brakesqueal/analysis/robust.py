@@ -22,14 +22,10 @@ ascending coefficients):
 * :func:`routh_exact` — the same test in exact rational arithmetic
   (:class:`fractions.Fraction`); decides every polynomial not exactly on the
   stability boundary.
-* :func:`horner_bound` — interval Horner evaluation (value and rigorous bound).
 * :func:`isolate_real_roots` — exact real-root isolation (plain Python
   integers, :mod:`._roots`: Descartes' rule of signs with bisection on a
   gcd-free basis) of several polynomials on any interval, e.g.
   ``(1e-100, 1e100)``, with disjoint isolating intervals.
-* :func:`isolate_real_roots_float` — compiled certified isolation (Descartes'
-  rule of signs with interval coefficients) for float polynomials with error
-  radii; returns brackets or ``None`` when it cannot certify.
 
 Matrices (any ``n``):
 
@@ -69,7 +65,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "UNSTABLE", "STABLE", "UNDECIDED", "STATUS_UNDECIDED", "INPUT_REL", "routh_verdicts", "routh_exact",
-    "horner_bound", "isolate_real_roots", "isolate_real_roots_float", "quartic_interval", "eigen_verdicts",
+    "isolate_real_roots", "quartic_interval", "eigen_verdicts",
     "mp_roots_summary", "roots_summary", "exact_trivial_entries", "balance", "state_verdicts", "descriptor_verdicts",
     "extended_descriptor_verdict", "EXTENDED_VERDICT_MAX_SIZE", "mp_balanced", "extended_analysis", "extended_eigen",
     "state_analysis", "state_matrices", "descriptor_states",
@@ -164,58 +160,12 @@ def routh_exact(coeffs: Sequence[Any]) -> int:
     return STABLE if row1[0] > 0 else UNSTABLE
 
 
-def horner_bound(coeffs: np.ndarray, radii: np.ndarray | None, x: float) -> tuple[float, float]:
-    """Value of ``Σ coeffs[k] x^k`` and a rigorous bound of its error (coefficient radii plus rounding)."""
-    from ._compiled import horner_interval
-
-    c = np.ascontiguousarray(coeffs, dtype=float)
-    r = np.zeros_like(c) if radii is None else np.ascontiguousarray(radii, dtype=float)
-    v, rv = horner_interval(c, r, c.size - 1, float(x))
-    return float(v), float(rv)
-
-
 def _to_fraction(x: Any) -> Fraction:
     if isinstance(x, Fraction):
         return x
     if hasattr(x, "p") and hasattr(x, "q"):
         return Fraction(int(x.p), int(x.q))
     return Fraction(x)
-
-
-def isolate_real_roots_float(coeffs: np.ndarray, radii: np.ndarray | None, lo: float, hi: float,
-                             max_roots: int = 64) -> np.ndarray | None:
-    """Certified isolation (compiled Descartes bisection) of the real roots of an interval polynomial.
-
-    Parameters
-    ----------
-    coeffs, radii : ndarray
-        Ascending coefficients and their absolute error bounds.
-    lo, hi : float
-        Open interval searched (finite; choose a well-scaled variable: the
-        coefficients times ``max(|lo|, |hi|)^k`` must stay finite).
-    max_roots : int
-        Capacity.
-
-    Returns
-    -------
-    ndarray, shape (k, 3), or None
-        Brackets ``[a, b]`` (columns 0, 1) with certified opposite signs at
-        the ends and exactly one simple root inside (for every polynomial
-        within the radii), ascending, and a floating-point estimate of the
-        root inside the bracket (column 2); ``None`` if it cannot certify
-        (clustered or multiple roots, a root at ``lo`` or ``hi``).
-    """
-    from ._compiled import isolate_roots
-
-    c = np.ascontiguousarray(coeffs, dtype=float)
-    r = np.zeros_like(c) if radii is None else np.ascontiguousarray(radii, dtype=float)
-    d = c.size - 1
-    out = np.empty((max_roots, 3))
-    w = np.empty(d + 1)
-    rw = np.empty(d + 1)
-    stack = np.empty((512, 2))
-    n = isolate_roots(c, r, d, float(lo), float(hi), out, w, rw, stack)
-    return None if n < 0 else out[:n].copy()
 
 
 # ---------------------------------------------------------------- matrices

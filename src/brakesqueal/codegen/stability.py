@@ -503,14 +503,17 @@ class _NoJit:
 _PLAIN: dict[str, Any] = {}
 
 
-def plain_module(source: str, label: str) -> Any:
-    """A generated numba module executed as plain Python (memoized by its source)."""
+def plain_module(source: str, label: str, package: str | None = None) -> Any:
+    """A numba module's source executed as plain Python (memoized by its source; ``numba.njit`` a no-op).
+
+    ``label`` names it in tracebacks; ``package`` anchors its relative imports.
+    """
     import types
 
     digest = hashlib.sha256(source.encode()).hexdigest()
     if digest not in _PLAIN:
         mod = types.ModuleType(label)
-        mod.__dict__["numba"] = _NoJit
+        mod.__dict__.update(numba=_NoJit, __package__=package)
         text = re.sub(r"(?m)^import numba\n", "", source, count=1)
         exec(compile(text, label, "exec"), mod.__dict__)  # noqa: S102 (the package's own generated source)
         _PLAIN[digest] = mod

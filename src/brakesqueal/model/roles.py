@@ -112,7 +112,7 @@ def _from_def(key: str, f: FieldDef) -> Role:
 
 
 @lru_cache(maxsize=8)
-def _derive(kinds: tuple[Kind, ...]) -> Mapping[str, Role]:
+def _derive(kinds: tuple[Kind, ...], laws: tuple[str, ...]) -> Mapping[str, Role]:
     from .components import FrictionLaw
     from .friction import LAWS, MU_FIELD
 
@@ -123,15 +123,16 @@ def _derive(kinds: tuple[Kind, ...]) -> Mapping[str, Role]:
                 out[f"{kind.key}.{f.name}"] = _from_def(f"{kind.key}.{f.name}", f.metadata["role"])
             elif f.default_factory is FrictionLaw:
                 out.setdefault("friction.mu", _from_def("friction.mu", MU_FIELD))
-    for law in LAWS.values():
+    for law in (LAWS[name] for name in laws):
         out |= {f"friction.{name}": _from_def(f"friction.{name}", f) for name, f in law.fields.items()}
     return MappingProxyType(out)
 
 
 def _table() -> Mapping[str, Role]:
     from .components import COMPONENTS
+    from .friction import LAWS
 
-    return _derive(tuple(COMPONENTS.values()))
+    return _derive(tuple(COMPONENTS.values()), tuple(LAWS))  # kinds and laws registered later count too
 
 
 class _Roles(Mapping[str, Role]):

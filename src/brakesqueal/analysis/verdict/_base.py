@@ -302,6 +302,16 @@ class LinearGroup:
         A = np.concatenate([np.concatenate([Z, I], 2), np.concatenate([-self.K, -self.D], 2)], 1)
         return E, A
 
+    def states_matrices(self) -> tuple[np.ndarray, np.ndarray]:
+        """First-order state matrices of the systems (``E^-1 A`` of descriptor groups) and which are usable."""
+        from ..robust import descriptor_states, state_matrices
+
+        if self.E is None:
+            assert self.M is not None and self.D is not None and self.K is not None
+            return state_matrices(self.M, self.D, self.K)
+        assert self.A is not None
+        return descriptor_states(self.E, self.A)
+
     def subset(self, sel: np.ndarray) -> LinearGroup:
         """The group's systems at positions ``sel`` (a boolean mask or indices into :attr:`idx`)."""
         def take(X: np.ndarray | None) -> np.ndarray | None:
@@ -321,18 +331,25 @@ class Result:
         :data:`STABLE`, :data:`UNSTABLE` or :data:`UNDECIDED`.
     max_real, frequency : ndarray
         The least-stable eigenvalue's real part [1/s] and frequency [Hz] (NaN where not computed).
-    bound : ndarray or None
+    bound : ndarray
         An error bound of ``max_real`` where the route certified the verdict through it (NaN otherwise: e.g.
-        a Routh test).
-    carrier : ndarray of int or None
-        The label index of the mode carrying the verdict (-1: not determined by the route).
+        a Routh test; the default).
+    carrier : ndarray of int
+        The label index of the mode carrying the verdict (-1: not determined by the route; the default).
     """
 
     code: np.ndarray
     max_real: np.ndarray
     frequency: np.ndarray
-    bound: np.ndarray | None = None
-    carrier: np.ndarray | None = None
+    bound: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    carrier: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+
+    def __post_init__(self) -> None:
+        n = self.code.size
+        if self.bound.size != n:
+            self.bound = np.full(n, np.nan)
+        if self.carrier.size != n:
+            self.carrier = np.full(n, -1, dtype=np.int64)
 
     @classmethod
     def empty(cls, size: int) -> Result:
@@ -367,6 +384,16 @@ class Route:
 
     def __repr__(self) -> str:
         return f"<route {self.name}>"
+
+
+class ClosedFormRoute(Route):
+    """A route of the closed form (2-DOF models): it takes the points with a trivial silent motion."""
+
+    def applies(self, ctx: Context) -> bool:
+        return ctx.points is not None and ctx.engine is not None and ctx.engine.caps.closed_form
+
+    def take(self, ctx: Context, pending: np.ndarray) -> np.ndarray:
+        return pending[ctx.trivial[pending]]
 
 
 @dataclass
@@ -458,9 +485,9 @@ class Context:
     """
 
     def __init__(self, engine: Engine | None, space: ParameterSpace | None, points: Points | None, size: int, *,
-                 eigen: bool, modes: str, carriers: str = "all") -> None:
+                 eigen: bool, modes: str, carriers_wanted: str = "all") -> None:
         self.engine = engine
-        self.carriers_wanted = carriers
+        self.carriers_wanted = carriers_wanted
         self.space = space
         self.points = points
         self.eigen = eigen

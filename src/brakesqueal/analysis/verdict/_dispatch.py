@@ -133,7 +133,7 @@ def decide(engine: Engine, space: ParameterSpace, points: Points, *, eigen: bool
         Arrays of ``points.shape``.
     """
     _check_modes(modes)
-    ctx = Context(engine, space, points, points.size, eigen=eigen, modes=modes, carriers=carriers)
+    ctx = Context(engine, space, points, points.size, eigen=eigen, modes=modes, carriers_wanted=carriers)
     ctx.closed = bool(engine.closed_route(space, points.names)) if engine.caps.closed_form else False
     operating_points(ctx)
     return _choose(ctx).reshape(points.shape)
@@ -205,10 +205,8 @@ def _choose(ctx: Context) -> Verdicts:
         ctx.code[done] = res.code[ok]
         ctx.max_real[done] = res.max_real[ok]
         ctx.frequency[done] = res.frequency[ok]
-        if res.bound is not None:
-            ctx.bound[done] = res.bound[ok]
-        if res.carrier is not None:
-            ctx.carrier[done] = res.carrier[ok]
+        ctx.bound[done] = res.bound[ok]
+        ctx.carrier[done] = res.carrier[ok]
         ctx.method[done] = k
         # what an undecided point's routes computed is kept for information (the first value found)
         info = idx[~ok & alive]
@@ -236,14 +234,8 @@ def _carriers(ctx: Context) -> None:
         return
     if ctx.carriers_wanted != "all":
         return
-    from ..robust import descriptor_states, state_matrices
-
     for g in linear_groups(ctx, todo):
-        if g.E is None:
-            assert g.M is not None and g.D is not None and g.K is not None
-            S, good = state_matrices(g.M, g.D, g.K)
-        else:
-            S, good = descriptor_states(g.E, g.A)  # type: ignore[arg-type]
+        S, good = g.states_matrices()
         sel = np.flatnonzero(good)
         if sel.size == 0:
             continue

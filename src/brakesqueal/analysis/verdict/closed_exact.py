@@ -17,22 +17,16 @@ from __future__ import annotations
 import numpy as np
 
 from ..robust import _exact_point
-from ._base import UNDECIDED, Context, Result, Route
+from ._base import UNDECIDED, ClosedFormRoute, Context, Result
 
 __all__ = ["ClosedExact"]
 
 
-class ClosedExact(Route):
+class ClosedExact(ClosedFormRoute):
     """See the module docstring."""
 
     name = "closed-exact"
     description = "closed form: exact rational evaluation, exact Routh-Hurwitz test"
-
-    def applies(self, ctx: Context) -> bool:
-        return ctx.points is not None and ctx.engine is not None and ctx.engine.caps.closed_form
-
-    def take(self, ctx: Context, pending: np.ndarray) -> np.ndarray:
-        return pending[ctx.trivial[pending]]
 
     def run(self, ctx: Context, idx: np.ndarray) -> Result:
         assert ctx.points is not None and ctx.engine is not None

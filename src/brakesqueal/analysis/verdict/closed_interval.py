@@ -16,22 +16,16 @@ import numpy as np
 
 from ..kernels import trivial_entries
 from ..robust import quartic_interval, roots_summary, routh_verdicts
-from ._base import Context, Result, Route
+from ._base import ClosedFormRoute, Context, Result
 
 __all__ = ["ClosedInterval"]
 
 
-class ClosedInterval(Route):
+class ClosedInterval(ClosedFormRoute):
     """See the module docstring."""
 
     name = "closed-interval"
     description = "closed form: bounded entries, interval quartic, certified Routh-Hurwitz test"
-
-    def applies(self, ctx: Context) -> bool:
-        return ctx.points is not None and ctx.engine is not None and ctx.engine.caps.closed_form
-
-    def take(self, ctx: Context, pending: np.ndarray) -> np.ndarray:
-        return pending[ctx.trivial[pending]]
 
     def run(self, ctx: Context, idx: np.ndarray) -> Result:
         assert ctx.points is not None and ctx.engine is not None

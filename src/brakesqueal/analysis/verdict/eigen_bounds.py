@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..robust import descriptor_states, state_analysis, state_matrices
+from ..robust import state_analysis
 from ._base import Context, LinearGroup, Result, Route
 from ._linear import linear_groups
 
@@ -51,15 +51,9 @@ class EigenBounds(Route):
 
     def run(self, ctx: Context, idx: np.ndarray) -> Result:
         res = Result.empty(idx.size)
-        res.bound = np.full(idx.size, np.nan)
-        res.carrier = np.full(idx.size, -1, dtype=np.int64)
         pos = {int(i): j for j, i in enumerate(idx)}
         for g in linear_groups(ctx, idx):
-            if g.E is None:
-                assert g.M is not None and g.D is not None and g.K is not None
-                S, good = state_matrices(g.M, g.D, g.K)
-            else:
-                S, good = descriptor_states(g.E, g.A)  # type: ignore[arg-type]
+            S, good = g.states_matrices()
             sel = np.flatnonzero(good)
             if sel.size == 0:
                 continue

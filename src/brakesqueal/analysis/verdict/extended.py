@@ -34,8 +34,6 @@ class Extended(Route):
 
     def run(self, ctx: Context, idx: np.ndarray) -> Result:
         res = Result.empty(idx.size)
-        res.bound = np.full(idx.size, np.nan)
-        res.carrier = np.full(idx.size, -1, dtype=np.int64)
         pos = {int(i): j for j, i in enumerate(idx)}
         for g in linear_groups(ctx, idx):
             E, A = g.descriptor()
