@@ -655,6 +655,9 @@ class CrossingResult:
         ``(values, max_real)`` along the path, computed with the result
         (NaN where no verdict was established); drawn by :meth:`plot`.  Not
         part of :meth:`to_dict`, the repr or comparisons.
+    carrier_at_start : str, optional
+        The mode carrying the verdict at ``start`` (e.g. ``"disk"``, ``"pad 1 tangential rate"``; ``""``:
+        not determined, the default).
     """
 
     parameter: str
@@ -668,6 +671,7 @@ class CrossingResult:
     undecided_ranges: tuple[tuple[float, float], ...] = ()
     exhaustive: bool = True
     profile: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False, compare=False)
+    carrier_at_start: str = ""
 
     @property
     def complete(self) -> bool:
@@ -679,7 +683,8 @@ class CrossingResult:
         return {"parameter": self.parameter, "stable_at_start": self.stable_at_start,
                 "crossings": [{"value": v, "direction": d} for v, d in self.crossings],
                 "range": [self.start, self.stop], "method": self.method,
-                "undecided_ranges": [[a, b] for a, b in self.undecided_ranges], "exhaustive": self.exhaustive}
+                "undecided_ranges": [[a, b] for a, b in self.undecided_ranges], "exhaustive": self.exhaustive,
+                "carrier_at_start": self.carrier_at_start or None}
 
     def to_xarray(self) -> xr.Dataset:
         """Dataset with dimension ``crossing``: ``value`` and ``direction`` (+1 stabilizing, -1 destabilizing)."""
@@ -695,6 +700,9 @@ class CrossingResult:
         """Human-readable summary."""
         lines = [f"{self.parameter} in [{self.start:g}, {self.stop:g}]: "
                  f"{'stable' if self.stable_at_start else 'unstable'} at start ({self.method})"]
+        if not self.stable_at_start and self.carrier_at_start.endswith("tangential rate"):
+            lines.append(f"  unstable at start through {self.carrier_at_start}: a non-oscillatory mode of the massless "
+                         "pad alone, not a disk vibration (modes='disk', --modes disk, judges the disk modes alone)")
         lines += [f"  {self.parameter} = {v:.12g}: {d}" for v, d in self.crossings] or (
             ["  no stability change"] if self.complete else ["  no stability change found"])
         lines += [f"  UNDECIDED for {self.parameter} in [{a:.6g}, {b:.6g}] (crossings there may be missing)"

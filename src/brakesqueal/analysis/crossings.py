@@ -289,8 +289,8 @@ _DECIDED = (int(PointStatus.OK), int(PointStatus.OK_NONTRIVIAL))
 
 
 def _numeric(engine: Engine, space: ParameterSpace, axis: Axis, n: int = NUMERIC_GRID, modes: str = "all"
-             ) -> tuple[bool, list[tuple[float, str]], list[tuple[float, float]], tuple[np.ndarray, np.ndarray]]:
-    """Certified per-point verdicts on a grid, sign changes bracketed, Brent on max Re λ."""
+             ) -> tuple[bool, list[tuple[float, str]], list[tuple[float, float]], tuple[np.ndarray, np.ndarray], str]:
+    """Certified per-point verdicts on a grid, sign changes bracketed, Brent on max Re λ; the carrier at the start."""
     from scipy.optimize import brentq
 
     from .points import evaluate, evaluate_point
@@ -323,7 +323,9 @@ def _numeric(engine: Engine, space: ParameterSpace, axis: Axis, n: int = NUMERIC
                 undecided.append((a, b))
         out.append((float(x), "stabilizing" if st[k1] else "destabilizing"))
     prof = (grid, np.where(ok, mr, np.nan))
-    return bool(st[0]), out, _merge_ranges(undecided), prof
+    c0 = int(r.carrier.reshape(-1)[0])
+    carrier = r.carriers[c0] if 0 <= c0 < len(r.carriers) else ""
+    return bool(st[0]), out, _merge_ranges(undecided), prof, carrier
 
 
 def _valid_fn(space: Any, name: str) -> Any:
@@ -395,18 +397,20 @@ def crossings(engine: Engine, space: ParameterSpace, axis: Axis, *, modes: str =
     space.check_axis(axis.name)
     _check_some_valid(space, axis)
     table = engine.univariate(space, axis.name)
+    carrier = ""
     if table is not None:  # a closed form: no pad keeps a rate state, every mode is judged either way
         start, found, undecided = exact_crossings(table, axis.start, axis.stop, axis.log, _valid_fn(space, axis.name))
         method, exhaustive = "exact (isolated real roots of the Hurwitz polynomials of the closed form)", True
         prof = _profile(engine, space, axis)
     else:
-        start, found, undecided, prof = _numeric(engine, space, axis, modes=modes)
+        start, found, undecided, prof, carrier = _numeric(engine, space, axis, modes=modes)
         method = (f"numeric (certified per-point verdicts on a {NUMERIC_GRID}-point grid + Brent on max Re lambda; "
                   "grid search)")
         exhaustive = False
     return CrossingResult(parameter=axis.name, start=axis.start, stop=axis.stop, log=axis.log,
                           stable_at_start=start, crossings=tuple(found), method=method, space=space,
-                          undecided_ranges=tuple(undecided), exhaustive=exhaustive, profile=prof)
+                          undecided_ranges=tuple(undecided), exhaustive=exhaustive, profile=prof,
+                          carrier_at_start=carrier)
 
 
 def _check_some_valid(space: ParameterSpace, axis: Axis) -> None:
@@ -532,7 +536,8 @@ def critical_speeds(engine: Engine, space: ParameterSpace, lo: float = 1.0, hi: 
     r = crossings(engine, space, axis, modes=modes)
     return CriticalSpeedResult(parameter=name, start=lo, stop=hi, log=True, stable_at_start=r.stable_at_start,
                                crossings=r.crossings, method=r.method, space=space,
-                               undecided_ranges=r.undecided_ranges, exhaustive=r.exhaustive, profile=r.profile)
+                               undecided_ranges=r.undecided_ranges, exhaustive=r.exhaustive, profile=r.profile,
+                               carrier_at_start=r.carrier_at_start)
 
 
 def critical_speeds_many(engine: Engine, space: ParameterSpace, changes: dict[str, np.ndarray], lo: float = 1.0,
