@@ -473,7 +473,7 @@ def hopf_scan(space: Any, along: str, rng: SliderRange) -> list[Any] | str:
     """Every Hopf point along the path (:func:`~brakesqueal.nonlinear.models.hopf_points`), or why not (a line)."""
     from ..analysis.maps import Axis
     from ..errors import BrakesquealError
-    from ..nonlinear.models import hopf_points
+    from ..api_nonlinear import hopf_points
 
     try:
         return list(hopf_points(space, Axis(along, rng.low, rng.high, 2, rng.log)))
@@ -580,10 +580,10 @@ def simulation_view(space: Any, t_end: float, *, progress: Callable[[float], Non
     SilentMotionError
         If the silent motion does not exist.
     """
-    from ..simulation import simulate
+    from ..api_nonlinear import simulate
 
     check_t_end(t_end)
-    tr: Any = simulate(None, space.resolve({}), float(t_end), sample_rate=float(AUDIO_RATE), progress=progress)
+    tr: Any = simulate(space.resolve({}), float(t_end), sample_rate=float(AUDIO_RATE), progress=progress)
     dq = tr.dq[:, 0]
     t, x = _decimate(np.asarray(tr.t, dtype=float), np.asarray(dq, dtype=float), HISTORY_POINTS)
     if tr.t.size >= 16:
@@ -751,17 +751,13 @@ def cycles_view(space: Any, along: str, rng: SliderRange, *,
         No Hopf point with a cycle prediction on the path, or ``progress`` not callable.
     """
     from ..analysis.maps import Axis
-    from ..nonlinear.models import cycle_route, squeal_branch
+    from ..api_nonlinear import limit_cycles
+    from ..nonlinear.models import cycle_route
 
     axis = Axis(along, rng.low, rng.high, 2, rng.log)
     harmonic = cycle_route(space, axis) == "harmonic balance"
-    if harmonic:
-        from ..nonlinear.harmonic import harmonic_branch
-
-        br: Any = harmonic_branch(space, axis, max_points=25, max_harmonics=40,  # bounded: an interactive view
-                                  progress=progress)
-    else:
-        br = squeal_branch(space, axis, progress=progress)
+    bounded = {"max_points": 25, "max_harmonics": 40} if harmonic else {}  # bounded: an interactive view
+    br: Any = limit_cycles(space, axis, progress=progress, **bounded)
     s = br.summary
     rows = list(s.table) if s is not None else []
     p = np.array([float(r["p"]) for r in rows])

@@ -35,7 +35,7 @@ import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -43,19 +43,28 @@ from ..errors import BrakesquealError
 from .hopf import HopfResult, first_lyapunov
 from .system import PiecewiseSystem, SmoothSystem, Transition
 
+if TYPE_CHECKING:
+    from ..analysis.maps import Axis
+    from ..codegen.engine import Engine
+    from ..model.parameters import Parameters, ParameterSpace
+    from ..results import CrossingResult
+    from ..simulation import SimulationModel
+
 __all__ = ["model_system", "model_piecewise_system", "hopf_points", "HopfPoint",
            "squeal_branch", "SquealBranch", "SquealSummary", "squeal_summary",
-           "PAD_TREATMENTS", "soft_quasi_static_pads", "cycle_route", "limit_cycles"]
+           "PAD_TREATMENTS", "soft_quasi_static_pads", "cycle_route", "cycle_space", "limit_cycles"]
 
 #: Pad treatments a limit-cycle computation can be asked for (:func:`cycle_route`).
 PAD_TREATMENTS: tuple[str, ...] = ("auto", "exact", "quasi-static")
 
 
-def model_system(space: Any, name: str, *, use_cache: bool = True) -> SmoothSystem:
+def model_system(engine: Engine, space: ParameterSpace, name: str, *, use_cache: bool = True) -> SmoothSystem:
     """A model as a :class:`~.system.SmoothSystem` in the settable parameter ``name`` of ``space``.
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine (built by the caller, e.g. :func:`brakesqueal.engine`).
     space : ParameterSpace
         The model, preset and overrides; tied names follow ``name``.
     name : str
@@ -71,14 +80,14 @@ def model_system(space: Any, name: str, *, use_cache: bool = True) -> SmoothSyst
     Raises
     ------
     ParameterError
-        ``name`` is not settable in ``space``.
+        ``name`` is not settable in ``space``, or ``space`` is not of the engine's model.
     """
     from ..simulation import simulation_model
 
     if name not in space.settable():
         space.resolve({name: 1.0})  # raises the one message for unknown or tied names
-    params0 = space.resolve({})
-    sim = simulation_model(params0.model, use_cache=use_cache)
+    sim = simulation_model(engine, use_cache=use_cache)
+    sim.parameters(space.resolve({}))  # the space is of the engine's model
     cache: dict[float, tuple[Any, Any]] = {}
 
     def fields(p: float) -> tuple[Any, Any]:
@@ -102,11 +111,13 @@ def model_system(space: Any, name: str, *, use_cache: bool = True) -> SmoothSyst
     # shooting and continuation integrate with the compiled flow and the generated exact Jacobian
     from .compiled import model_flow
 
-    object.__setattr__(system, "default_flow", lambda: model_flow(space, name, system=system, use_cache=use_cache))
+    object.__setattr__(system, "default_flow",
+                       lambda: model_flow(engine, space, name, system=system, use_cache=use_cache))
     return system
 
 
-def model_piecewise_system(space: Any, name: str, *, use_cache: bool = True) -> PiecewiseSystem:
+def model_piecewise_system(engine: Engine, space: ParameterSpace, name: str, *,
+                           use_cache: bool = True) -> PiecewiseSystem:
     """A model with unilateral contact as a :class:`~.system.PiecewiseSystem` in the parameter ``name``.
 
     Mode ``m`` (a bit mask: bit ``j`` set when pad ``j`` is lifted off; mode 0
@@ -121,6 +132,8 @@ def model_piecewise_system(space: Any, name: str, *, use_cache: bool = True) -> 
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine (built by the caller).
     space : ParameterSpace
         The model, preset and overrides (pads with coulomb friction, with
         their own degrees of freedom, or with a tangential damper ``d_ip``;
@@ -143,7 +156,7 @@ def model_piecewise_system(space: Any, name: str, *, use_cache: bool = True) -> 
     """
     from ..errors import ParameterError
 
-    smooth = model_system(space, name, use_cache=use_cache)
+    smooth = model_system(engine, space, name, use_cache=use_cache)
     sim = smooth.simulation_model  # type: ignore[attr-defined]
     if undamped := sim.undamped(space.resolve({})):
         raise ParameterError(f"unilateral contact needs a tangential damper d_ip > 0 on every pad whose rate is a "
@@ -283,7 +296,7 @@ class HopfPoint:
         return d
 
 
-def soft_quasi_static_pads(space: Any, axis: Any = None) -> tuple[str, ...]:
+def soft_quasi_static_pads(space: ParameterSpace, axis: Axis | None = None) -> tuple[str, ...]:
     """Pads whose tangential rate the simulation drops (``ldot := 0``) although their ``k_ip`` is finite.
 
     These are the massless pads with Coulomb friction, no tangential damper and a finite ``k_ip``
@@ -311,7 +324,8 @@ def soft_quasi_static_pads(space: Any, axis: Any = None) -> tuple[str, ...]:
     return tuple(p.name for p in params.model.pads if p.name in soft)
 
 
-def cycle_route(space: Any, axis: Any = None, *, contact: str = "bilateral", pads: str = "auto") -> str:
+def cycle_route(space: ParameterSpace, axis: Axis | None = None, *, contact: str = "bilateral",
+                pads: str = "auto") -> str:
     """The route that computes limit cycles of a model with the pads' true tangential dynamics.
 
     Parameters
@@ -372,15 +386,58 @@ def cycle_route(space: Any, axis: Any = None, *, contact: str = "bilateral", pad
         "--pads quasi-static (ldot := 0, exact to first order at the onset)", parameter="pads")
 
 
+def cycle_space(space: ParameterSpace, *, pads: str = "auto", pad_slope: float | None = None,
+                stick_speed: float | None = None) -> ParameterSpace:
+    """The parameter space a limit-cycle computation runs on: ``space``, or with ``pad_slope`` its massless
+    Coulomb pads regularised (:func:`~brakesqueal.model.options.regularised_pads`: a rising law that keeps the
+    pads' rates, error O(pad_slope); with ``stick_speed`` the law ``stick``).
+
+    A regularised space is another model: its engine is built by the caller from the returned space
+    (:func:`brakesqueal.limit_cycles` and :func:`brakesqueal.squeal_branch` do both).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    pads : {"auto", "exact", "quasi-static"}
+        The requested pad treatment (:func:`cycle_route`): ``pad_slope`` needs ``"auto"``.
+    pad_slope, stick_speed : float, optional
+        As for :func:`~brakesqueal.model.options.regularised_pads`.
+
+    Returns
+    -------
+    ParameterSpace
+
+    Raises
+    ------
+    ParameterError
+        ``pad_slope`` with ``pads`` other than ``"auto"``, ``stick_speed`` without ``pad_slope``, or a value
+        out of range (naming the option).
+    """
+    from ..errors import ParameterError
+
+    if pad_slope is None and stick_speed is None:
+        return space
+    if pads != "auto":
+        raise ParameterError(f"The option 'pad_slope' (a rising law that keeps the pads' rates, shooting) "
+                             f"cannot be combined with pads = {pads!r}", parameter="pads")
+    if pad_slope is None:
+        raise ParameterError("stick_speed regularises the pads of pad_slope; give pad_slope too",
+                             parameter="stick_speed")
+    from ..model.options import regularised_pads
+
+    return regularised_pads(space, pad_slope, stick_speed)
+
+
 #: Options of :func:`limit_cycles` each route takes (beyond ``max_points`` and ``progress``).
 _ROUTE_OPTIONS: dict[str, frozenset[str]] = {
-    "shooting": frozenset({"use_cache", "tol", "ds", "ds_max", "pad_slope", "stick_speed", "flow_method"}),
+    "shooting": frozenset({"use_cache", "tol", "ds", "ds_max", "flow_method"}),
     "harmonic balance": frozenset({"use_cache", "tol", "ds", "ds_max", "harmonics", "max_harmonics",
                                    "harmonic_tol", "start_offset", "stability", "stop_at_contact_loss"}),
 }
 
 
-def limit_cycles(space: Any, axis: Any, *, contact: str = "bilateral", pads: str = "auto",
+def limit_cycles(engine: Engine, space: ParameterSpace, axis: Axis, *, contact: str = "bilateral", pads: str = "auto",
                  max_points: int | None = None, progress: Callable[[float], None] | None = None,
                  **options: Any) -> Any:
     """Limit cycles from the first Hopf point on a path, by the route ``brakesqueal cycles`` takes.
@@ -390,16 +447,17 @@ def limit_cycles(space: Any, axis: Any, *, contact: str = "bilateral", pads: str
 
     Parameters
     ----------
+    engine : Engine
+        The engine of ``space``'s model (built by the caller; :func:`brakesqueal.limit_cycles` builds it).
     space : ParameterSpace
         The model, preset and overrides (after any pad option such as
-        :func:`~brakesqueal.model.options.damped_pads`).
+        :func:`~brakesqueal.model.options.damped_pads` or :func:`cycle_space`).
     axis : Axis
         The path: the first Hopf point with a cycle prediction in it is continued within it.
     contact : {"bilateral", "unilateral"}
         As in :func:`squeal_branch` (unilateral: shooting only).
     pads : {"auto", "exact", "quasi-static"}
-        As in :func:`cycle_route`.  ``options["pad_slope"]`` (a rising law that keeps the rates) takes the
-        shooting route and does not combine with ``"exact"`` or ``"quasi-static"``.
+        As in :func:`cycle_route`.
     max_points : int, optional
         Largest number of branch points (default: the route's own, 60 for shooting, 40 for harmonic
         balance).
@@ -408,7 +466,7 @@ def limit_cycles(space: Any, axis: Any, *, contact: str = "bilateral", pads: str
         the branch and propagates.
     **options
         Options of the route taken: shooting (:func:`squeal_branch`): ``use_cache``, ``tol``, ``ds``,
-        ``ds_max``, ``pad_slope``, ``stick_speed``, ``flow_method``; harmonic balance
+        ``ds_max``, ``flow_method``; harmonic balance
         (:func:`~.harmonic.harmonic_branch`): ``use_cache``, ``tol``, ``ds``, ``ds_max``, ``harmonics``,
         ``max_harmonics``, ``harmonic_tol``, ``start_offset``, ``stability``, ``stop_at_contact_loss``.
 
@@ -427,14 +485,11 @@ def limit_cycles(space: Any, axis: Any, *, contact: str = "bilateral", pads: str
     """
     from ..errors import ParameterError
 
-    slope = options.get("pad_slope")
-    if slope is not None or options.get("stick_speed") is not None:
-        if pads != "auto":
-            raise ParameterError(f"The option 'pad_slope' (a rising law that keeps the pads' rates, shooting) "
-                                 f"cannot be combined with pads = {pads!r}", parameter="pads")
-        route = cycle_route(space, axis, contact=contact, pads="quasi-static")  # checks contact; "shooting"
-    else:
-        route = cycle_route(space, axis, contact=contact, pads=pads)
+    for opt in ("pad_slope", "stick_speed"):
+        if opt in options:
+            raise ParameterError(f"The option {opt!r} changes the model: regularise the space with cycle_space() and "
+                                 "pass the engine of its model (brakesqueal.limit_cycles does both)", parameter=opt)
+    route = cycle_route(space, axis, contact=contact, pads=pads)
     bad = sorted(set(options) - _ROUTE_OPTIONS[route])
     if bad:
         other = "harmonic balance" if route == "shooting" else "shooting"
@@ -448,8 +503,8 @@ def limit_cycles(space: Any, axis: Any, *, contact: str = "bilateral", pads: str
     if route == "harmonic balance":
         from .harmonic import harmonic_branch
 
-        return harmonic_branch(space, axis, progress=progress, **kw)
-    return squeal_branch(space, axis, contact=contact, progress=progress, **kw)
+        return harmonic_branch(engine, space, axis, progress=progress, **kw)
+    return squeal_branch(engine, space, axis, contact=contact, progress=progress, **kw)
 
 
 def _hopf_dict(h: HopfResult) -> dict[str, Any]:
@@ -467,11 +522,14 @@ def _hopf_dict(h: HopfResult) -> dict[str, Any]:
     }
 
 
-def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = None) -> list[HopfPoint]:
+def hopf_points(engine: Engine, space: ParameterSpace, axis: Axis, *, use_cache: bool = True,
+                result: CrossingResult | None = None) -> list[HopfPoint]:
     """Every stability crossing along a path with its first Lyapunov coefficient and cycle prediction.
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine (built by the caller).
     space : ParameterSpace
         The model, preset and overrides (any model).
     axis : Axis
@@ -494,14 +552,14 @@ def hopf_points(space: Any, axis: Any, *, use_cache: bool = True, result: Any = 
     from ..simulation.trajectory import soft_quasi_static_pads as soft_at
     from .implicit import exact_lyapunov
 
-    system = model_system(space, axis.name, use_cache=use_cache)
+    system = model_system(engine, space, axis.name, use_cache=use_cache)
     sim = system.simulation_model  # type: ignore[attr-defined]
-    r = crossings(sim.engine, space, axis) if result is None else result
+    r = crossings(engine, space, axis) if result is None else result
     treatment = dict(zip(sim.pad_unknowns, sim.pad_kinds))
     out = []
     for value, direction in r.crossings:  # type: ignore[attr-defined]
         try:
-            ex = exact_lyapunov(space, axis.name, float(value), use_cache=use_cache)
+            ex = exact_lyapunov(engine, space, axis.name, float(value), use_cache=use_cache)
         except (BrakesquealError, np.linalg.LinAlgError) as exc:
             out.append(HopfPoint(axis.name, float(value), direction, None, treatment,
                                  f"no Hopf normal form: {exc}"))
@@ -546,7 +604,7 @@ def _periodic_min(values: np.ndarray) -> np.ndarray:
     return np.where(curv > 0, np.minimum(fine, y0), y0)
 
 
-def _contact_indicators(sim: Any, params: Any, samples: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _contact_indicators(sim: SimulationModel, params: Parameters, samples: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per pad, the smallest normal force [N] and the smallest sliding margin over one period of samples.
 
     The sliding margin is the sliding velocity's component along the silent motion's sliding velocity (it
@@ -558,7 +616,7 @@ def _contact_indicators(sim: Any, params: Any, samples: np.ndarray) -> tuple[np.
     return _periodic_min(cq[:, :, 0]), _periodic_min(slide)
 
 
-def predicted_contact_loss(space: Any, name: str, hopf: Any) -> float | None:
+def predicted_contact_loss(engine: Engine, space: ParameterSpace, name: str, hopf: HopfResult | None) -> float | None:
     r"""Where the Hopf point's small-amplitude prediction says a pad first loses contact.
 
     On the cycle $x = x_0 + 2 r\,\mathrm{Re}(q e^{i\theta}) + O(r^2)$ the smallest normal force falls
@@ -569,6 +627,8 @@ def predicted_contact_loss(space: Any, name: str, hopf: Any) -> float | None:
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine.
     space : ParameterSpace
         The model, preset and overrides.
     name : str
@@ -583,8 +643,9 @@ def predicted_contact_loss(space: Any, name: str, hopf: Any) -> float | None:
     """
     if hopf is None or not hopf.side:
         return None
-    system = model_system(space, name)
-    sim = system.simulation_model  # type: ignore[attr-defined]
+    from ..simulation import simulation_model
+
+    sim = simulation_model(engine)
     p0 = float(hopf.p0)
     d = 1e-9 * max(1.0, abs(p0))
     drops = []
@@ -912,15 +973,17 @@ def _shooting_flow(pw: PiecewiseSystem, h: Any, flow_method: str | None) -> tupl
     return flow, info
 
 
-def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: bool = True,
-                  tol: float = 1e-8, contact: str = "bilateral", ds: float | None = None,
-                  ds_max: float = 0.05, pad_slope: float | None = None,
-                  stick_speed: float | None = None, flow_method: str | None = None,
+def squeal_branch(engine: Engine, space: ParameterSpace, axis: Axis, *, max_points: int = 60,
+                  use_cache: bool = True, tol: float = 1e-8, contact: str = "bilateral", ds: float | None = None,
+                  ds_max: float = 0.05, flow_method: str | None = None,
                   progress: Callable[[float], None] | None = None) -> SquealBranch:
     """Continue the limit cycles from the first Hopf point on a path and find where a pad loses contact.
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine (built by the caller; :func:`brakesqueal.squeal_branch` builds it, and
+        regularises the pads with ``pad_slope``, :func:`cycle_space`).
     space : ParameterSpace
         The model, preset and overrides.
     axis : Axis
@@ -943,15 +1006,6 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
         parameter scale is twenty times the distance from the onset to the contact loss predicted by the
         Hopf point (:func:`predicted_contact_loss`), not the width of the range, so the steps near the
         onset do not depend on the requested range.
-    pad_slope : float, optional
-        Continue with the pads' tangential rates kept, regularised by a slightly rising friction law
-        (:func:`~brakesqueal.model.options.regularised_pads`; error O(pad_slope)).  Default: massless Coulomb
-        pads are quasi-static in the branch (exact only to first order at the onset;
-        :attr:`HopfPoint.simulated`).
-    stick_speed : float, optional
-        With ``pad_slope``: regularise stick-slip too (the law ``stick``, a sticking pad creeps at speeds of
-        order ``stick_speed``; error O(stick_speed)).  Sliding reversals are then ordinary motion: they are
-        still reported per point (``sliding_reversal``) but do not end the model's validity.
     flow_method : {None, "DOP853", "Radau", "BDF"}
         The integrator of a unilateral branch's shooting (:class:`~.flow.ScipyFlow`; a bilateral branch
         always uses the compiled DOP853).  ``None`` (default): DOP853 at ``rtol = 1e-11``; when the
@@ -999,16 +1053,10 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
     if flow_method is not None and contact != "unilateral":
         raise ParameterError("The option 'flow_method' applies to contact='unilateral' (a bilateral branch is "
                              "shot with the compiled DOP853)")
-    if pad_slope is not None:
-        from ..model.options import regularised_pads
-
-        space = regularised_pads(space, pad_slope, stick_speed)
-    elif stick_speed is not None:
-        raise ParameterError("stick_speed regularises the pads of pad_slope; give pad_slope too")
     from ..model.options import stick_slip_everywhere
 
-    stick = stick_slip_everywhere(space.resolve({}).model)  # the simulation's rule
-    pts = [hp for hp in hopf_points(space, axis, use_cache=use_cache)
+    stick = stick_slip_everywhere(space.resolve({}).model)  # the simulation's rule (regularised stick-slip)
+    pts = [hp for hp in hopf_points(engine, space, axis, use_cache=use_cache)
            if hp.branch_start is not None and hp.branch_start.side]
     if not pts:
         raise ParameterError(f"no Hopf point with a limit-cycle prediction for {axis.name} in "
@@ -1016,23 +1064,23 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
     hp = pts[0]
     h = hp.branch_start
     assert h is not None
-    predicted = predicted_contact_loss(space, axis.name, h)
+    predicted = predicted_contact_loss(engine, space, axis.name, h)
     p_scale = 20 * abs(predicted - h.p0) if predicted is not None else None
     tracker = _Progress(progress, max_points)  # relays the continuation's fractions and keeps the last
     opts: dict[str, Any] = {"max_points": max_points, "tol": tol, "p_scale": p_scale, "ds_max": ds_max,
                             "ds": min(0.02, ds_max) if ds is None else ds, "progress": tracker.report}
-    system = model_system(space, axis.name, use_cache=use_cache)
+    system = model_system(engine, space, axis.name, use_cache=use_cache)
     sim = system.simulation_model  # type: ignore[attr-defined]
     flow_info: dict[str, Any] = {}
     if contact == "unilateral":
-        pw = model_piecewise_system(space, axis.name, use_cache=use_cache)
+        pw = model_piecewise_system(engine, space, axis.name, use_cache=use_cache)
         flow, flow_info = _shooting_flow(pw, h, flow_method)
         br = continue_cycles(pw, h, (axis.start, axis.stop), flow=flow, **opts)
     else:
         br = continue_cycles(system, h, (axis.start, axis.stop), **opts)
-    ds = br.data
-    p = ds["p"].values
-    orbits = ds["orbit"].values
+    data = br.data
+    p = data["p"].values
+    orbits = data["orbit"].values
     npad = len(sim.pads)
     fmin = np.full((p.size, npad), np.nan)
     fmax = np.full((p.size, npad), np.nan)
@@ -1082,33 +1130,33 @@ def squeal_branch(space: Any, axis: Any, *, max_points: int = 60, use_cache: boo
     import xarray as xr
 
     pad_c = {"pad": list(sim.pads)}
-    ds["F_n_min"] = xr.DataArray(fmin, dims=("point", "pad"), coords=pad_c,
+    data["F_n_min"] = xr.DataArray(fmin, dims=("point", "pad"), coords=pad_c,
                                  attrs={"units": "N", "long_name": "smallest normal force over one period "
                                                                    "(bilateral: negative where a pad lifts off)"})
-    ds["F_n_max"] = xr.DataArray(fmax, dims=("point", "pad"), coords=pad_c,
+    data["F_n_max"] = xr.DataArray(fmax, dims=("point", "pad"), coords=pad_c,
                                  attrs={"units": "N", "long_name": "largest acting normal force over one period"})
-    ds["duty_cycle"] = xr.DataArray(duty, dims=("point", "pad"), coords=pad_c,
+    data["duty_cycle"] = xr.DataArray(duty, dims=("point", "pad"), coords=pad_c,
                                     attrs={"long_name": "fraction of the period the pad is pressed (NaN: the "
                                                         "bilateral branch is not valid there)"})
-    tilt = [c for c in ("q1", "q2") if c in [str(v) for v in ds["coord"].values]]
-    amp = ds["amplitude"].sel(coord=tilt).max("coord").values if tilt else np.full(p.size, np.nan)
-    ds["tilt_amplitude"] = xr.DataArray(amp, dims=("point",), attrs={"units": "rad", "long_name":
+    tilt = [c for c in ("q1", "q2") if c in [str(v) for v in data["coord"].values]]
+    amp = data["amplitude"].sel(coord=tilt).max("coord").values if tilt else np.full(p.size, np.nan)
+    data["tilt_amplitude"] = xr.DataArray(amp, dims=("point",), attrs={"units": "rad", "long_name":
                                         "largest first-harmonic amplitude of the disk tilt"})
-    ds["sliding_reversal"] = xr.DataArray(reversal, dims=("point",), attrs={"long_name": "a pressed pad's sliding "
+    data["sliding_reversal"] = xr.DataArray(reversal, dims=("point",), attrs={"long_name": "a pressed pad's sliding "
                                           "velocity reverses on the cycle " + ("(regularised stick-slip)" if stick
                                                                                else "(outside the model's validity)")})
-    ds["in_contact"] = xr.DataArray(worst > 0, dims=("point",),
+    data["in_contact"] = xr.DataArray(worst > 0, dims=("point",),
                                     attrs={"long_name": "every pad pressed over the whole period (bilateral "
                                                         "equations valid)"})
-    ds.attrs["contact_loss"] = np.nan if loss is None else loss
-    ds.attrs["contact_loss_predicted"] = np.nan if predicted is None else predicted
-    ds.attrs["validity_end"] = np.nan if end is None else end
-    ds.attrs["contact"] = contact
-    ds.attrs.update(flow_info)
-    ds.attrs["stick_slip"] = "regularised" if stick else "none"
+    data.attrs["contact_loss"] = np.nan if loss is None else loss
+    data.attrs["contact_loss_predicted"] = np.nan if predicted is None else predicted
+    data.attrs["validity_end"] = np.nan if end is None else end
+    data.attrs["contact"] = contact
+    data.attrs.update(flow_info)
+    data.attrs["stick_slip"] = "regularised" if stick else "none"
     out = SquealBranch(hp, br, loss, tuple(sim.pads), contact)
     summ = squeal_summary(out)
-    ds.attrs["summary"] = json.dumps(summ.to_dict(), default=float)
+    data.attrs["summary"] = json.dumps(summ.to_dict(), default=float)
     tracker.done()
     return SquealBranch(hp, br, loss, tuple(sim.pads), contact, summ)
 
