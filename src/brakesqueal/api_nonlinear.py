@@ -23,7 +23,8 @@ if TYPE_CHECKING:
     from .nonlinear.compiled import CompiledFlow
     from .nonlinear.harmonic import HarmonicBranch
     from .nonlinear.implicit import PadHopf
-    from .nonlinear.models import HopfPoint, SquealBranch
+    from .nonlinear.models import HopfPoint
+    from .nonlinear.squeal import SquealBranch
     from .nonlinear.system import PiecewiseSystem, SmoothSystem
     from .results import CrossingResult
     from .simulation import SimulationModel, Trajectory
@@ -184,7 +185,7 @@ def squeal_branch(space: ParameterSpace, axis: Axis, *, pad_slope: float | None 
     SquealBranch
     """
     from .nonlinear.models import cycle_space
-    from .nonlinear.models import squeal_branch as _squeal_branch
+    from .nonlinear.squeal import squeal_branch as _squeal_branch
 
     space = cycle_space(space, pad_slope=pad_slope, stick_speed=stick_speed)
     return _squeal_branch(_engine(space, use_cache), space, axis, use_cache=use_cache, **options)

@@ -15,7 +15,8 @@ from brakesqueal.errors import ParameterError
 from brakesqueal.model.parameters import ParameterSpace
 from brakesqueal.nonlinear.harmonic import HarmonicBranch
 from brakesqueal import harmonic_branch
-from brakesqueal.nonlinear.models import SquealBranch, cycle_route
+from brakesqueal.nonlinear.models import cycle_route
+from brakesqueal.nonlinear.squeal import SquealBranch
 
 #: paper-fig3 at mu1 = mu2 = 0.5 (onset ~35.6 rigid / 35.74 with k_ip = 1e8; contact loss near 36.04 / 36.19)
 from brakesqueal import limit_cycles, squeal_branch

@@ -20,7 +20,7 @@ import pytest
 from brakesqueal import Axis
 from brakesqueal.model import ParameterSpace
 from brakesqueal.nonlinear import find_periodic_orbit
-from brakesqueal.nonlinear.models import _duty_cycle
+from brakesqueal.nonlinear.squeal import _duty_cycle
 from brakesqueal import hopf_points, model_piecewise_system, model_system
 from brakesqueal import simulate
 

@@ -233,7 +233,7 @@ class HarmonicBranch:
         (the first orbit with a verdict after the turn is stable; right at the fold an exponent crosses 0 and the
         orbits have no verdict), here only if the branch is valid up to there.
         """
-        from .models import SquealSummary
+        from .squeal import SquealSummary
 
         h = self.hopf.hopf
         pts = self.points
