@@ -4,9 +4,9 @@ SciPy's ``DOP853`` (Hairer, Nørsett & Wanner, *Solving ODEs I*, sec. II.10;
 ``scipy.integrate._ivp.rk.DOP853``): its coefficients, its combined 5th/3rd-order
 error norm, its step-size control and its 7th-order dense output, ported to
 numba.  Two drivers include this text: the simulation's
-(:mod:`.simulation_dop853`: dense output, events, unilateral contact) and the
-flow's (:mod:`.flow_dop853`: variational equations, samples hit by shortened
-steps).  Each defines ``_stage_rhs(ctx, y, out)``, the vector field at ``y``
+(:mod:`.simulation_dop853`: 7th-order dense output with the table ``_DD``,
+events, unilateral contact) and the flow's (:mod:`.flow_dop853`: variational
+equations, samples hit by shortened steps).  Each defines ``_stage_rhs(ctx, y, out)``, the vector field at ``y``
 with its context ``ctx`` (a tuple: work arrays, parameters, first-class
 functions), so the right-hand side is compiled into the step.
 
@@ -92,43 +92,3 @@ def dop853_factor(err, rejected):
     if not err < math.inf:
         return _MIN_FACTOR
     return max(_MIN_FACTOR, _SAFETY * err ** _EXPO)
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def dop853_dense(ctx, y, ynew, h, K, F, ystage):
-    """The dense output of an accepted step (3 extra stages K[13..15]; F (7, n) for :func:`dense_eval`);
-    K[0] = f(y), K[12] = f(ynew)."""
-    n = y.shape[0]
-    for s in range(13, 16):
-        for j in range(n):
-            acc = 0.0
-            for q in range(s):
-                acc += K[q, j] * _DA[s, q]
-            ystage[j] = y[j] + h * acc
-        _stage_rhs(ctx, ystage, K[s])
-    for j in range(n):
-        dy = ynew[j] - y[j]
-        F[0, j] = dy
-        F[1, j] = h * K[0, j] - dy
-        F[2, j] = 2.0 * dy - h * (K[_NS, j] + K[0, j])
-        for r in range(4):
-            acc = 0.0
-            for q in range(16):
-                acc += _DD[r, q] * K[q, j]
-            F[3 + r, j] = h * acc
-
-
-@njit(cache=True, error_model="numpy")
-def dense_eval(F, y_old, x, out):
-    """SciPy's Dop853DenseOutput at normalized time x in [0, 1] of the step from y_old."""
-    n = y_old.shape[0]
-    nf = F.shape[0]
-    for j in range(n):
-        acc = 0.0
-        for k in range(nf):
-            acc += F[nf - 1 - k, j]
-            if k % 2 == 0:
-                acc *= x
-            else:
-                acc *= 1.0 - x
-        out[j] = acc + y_old[j]

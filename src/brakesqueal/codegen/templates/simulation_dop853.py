@@ -38,10 +38,6 @@ def event_values_u(y, l, dl, p, vr0, cb, eng, out):  # template simulation_pads
     raise NotImplementedError
 
 
-def dense_eval(F, y_old, x, out):  # template dop853
-    raise NotImplementedError
-
-
 def dop853_step(ctx, y, h, rtol, atol, K, ynew, ystage):  # template dop853
     raise NotImplementedError
 
@@ -50,11 +46,27 @@ def dop853_factor(err, rejected):  # template dop853
     raise NotImplementedError
 
 
-def dop853_dense(ctx, y, ynew, h, K, F, ystage):  # template dop853
-    raise NotImplementedError
+_DA = np.zeros((16, 16))  # template dop853
+_DD = np.zeros((7, 16))  # template dop853
 
 
 # ---- template body ----
+
+
+@njit(cache=True, error_model="numpy")
+def dense_eval(F, y_old, x, out):
+    """SciPy's Dop853DenseOutput at normalized time x in [0, 1] of the step from y_old."""
+    n = y_old.shape[0]
+    nf = F.shape[0]
+    for j in range(n):
+        acc = 0.0
+        for k in range(nf):
+            acc += F[nf - 1 - k, j]
+            if k % 2 == 0:
+                acc *= x
+            else:
+                acc *= 1.0 - x
+        out[j] = acc + y_old[j]
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -209,9 +221,25 @@ def dop853(y, f, l, dl, ev_old, ev_prev, p, ztol, vr0, t, t1, h_abs, rtol, atol,
         # dense output of this step (3 extra stages)
         need_dense = (i_out < t_out.shape[0] and t_out[i_out] <= t_new) or event_mode > 0 \
             or te0 + i_est * dte <= t_new
-        if need_dense:
-            dop853_dense(ctx, y, ynew, h, K, F, ystage)
+        if need_dense:  # 3 more stages and the coefficients of the 7th-order interpolant (SciPy's Dop853DenseOutput)
+            for s in range(13, 16):
+                for j in range(n):
+                    acc = 0.0
+                    for q in range(s):
+                        acc += K[q, j] * _DA[s, q]
+                    ystage[j] = y[j] + h * acc
+                rhs_u(ystage, lnew, dlnew, p, ztol, g, mw, eng, Dw, K[s])
             stats[0] += 3
+            for j in range(n):
+                dy = ynew[j] - y[j]
+                F[0, j] = dy
+                F[1, j] = h * f[j] - dy
+                F[2, j] = 2.0 * dy - h * (K[12, j] + f[j])
+                for r in range(4):
+                    acc = 0.0
+                    for q in range(16):
+                        acc += _DD[r, q] * K[q, j]
+                    F[3 + r, j] = h * acc
         t_stop = t_new
         stop = False
         switch = -1
