@@ -285,7 +285,8 @@ def exact_lyapunov(space: ParameterSpace, name: str, p0: float, *, omega: float 
     return _exact_lyapunov(_engine(space, use_cache), space, name, p0, omega=omega, use_cache=use_cache)
 
 
-def model_flow(space: ParameterSpace, name: str, *, use_cache: bool = True, rtol: float = 1e-11) -> CompiledFlow:
+def model_flow(space: ParameterSpace, name: str, *, system: SmoothSystem | None = None, use_cache: bool = True,
+               rtol: float = 1e-11) -> CompiledFlow:
     """The compiled flow of a model with its exact Jacobian (:func:`brakesqueal.nonlinear.compiled.model_flow`).
 
     Parameters
@@ -294,6 +295,8 @@ def model_flow(space: ParameterSpace, name: str, *, use_cache: bool = True, rtol
         The model, preset and overrides.
     name : str
         The continuation parameter.
+    system : SmoothSystem, optional
+        The system the flow belongs to (default :func:`model_system` ``(space, name)``).
     use_cache : bool, optional
         Use the on-disk code cache.
     rtol : float, optional
@@ -305,4 +308,4 @@ def model_flow(space: ParameterSpace, name: str, *, use_cache: bool = True, rtol
     """
     from .nonlinear.compiled import model_flow as _model_flow
 
-    return _model_flow(_engine(space, use_cache), space, name, use_cache=use_cache, rtol=rtol)
+    return _model_flow(_engine(space, use_cache), space, name, system=system, use_cache=use_cache, rtol=rtol)
