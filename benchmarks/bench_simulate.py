@@ -84,7 +84,7 @@ def builder_rhs(params: Any) -> tuple[Callable[[float, np.ndarray], np.ndarray],
     cm = compile_model(params.model)
     n, m = cm.n, cm.m
     p = list(map(float, params.vector()))
-    sm = silent_motion(params, model=cm)
+    sm = silent_motion(params)
     L = np.array(sm.l0, dtype=float)
     zeros = [0.0] * n
 
