@@ -331,12 +331,9 @@ def bench_paper_model(*, points: int = 200, old_points: int = 20, brute_points: 
     """
     import math as _m
 
-    from brakesqueal import Axis
+    from brakesqueal import Axis, hopf_points, model_flow, model_system, simulate
     from brakesqueal.model import ParameterSpace
     from brakesqueal.nonlinear import ScipyFlow, continue_cycles, first_lyapunov
-    from brakesqueal.nonlinear.compiled import model_flow
-    from brakesqueal.nonlinear.models import hopf_points, model_system
-    from brakesqueal.simulation import simulate
 
     space = ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5, "k_ip": _m.inf})
     hp = hopf_points(space, Axis("Omega", 30.0, 40.0))[0]
@@ -346,7 +343,7 @@ def bench_paper_model(*, points: int = 200, old_points: int = 20, brute_points: 
     first_lyapunov(system, y0, hp.value, refine=False)
     t_l1 = best_time(lambda: first_lyapunov(system, y0, hp.value, refine=False), repeat=5)
     # soft pads (k_ip = 1e6): the normal form of the implicit equations, pads' rates kept (refinement included)
-    from brakesqueal.nonlinear.implicit import exact_lyapunov
+    from brakesqueal import exact_lyapunov
 
     soft = ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5, "k_ip": 1e6})
     p_soft = exact_lyapunov(soft, "Omega", 80.0).hopf.p0
@@ -377,7 +374,7 @@ def bench_paper_model(*, points: int = 200, old_points: int = 20, brute_points: 
         sigma = float(modes.eigenvalues[0].real) if modes is not None else 1.0
         t_end = min(10.0 / max(sigma, 1e-9), 20.0)
         sim_s += t_end
-        tr = simulate(None, params, t_end, events="off", sample_rate=200_000.0)
+        tr = simulate(params, t_end, events="off", sample_rate=200_000.0)
         n_last = int(0.002 * 200_000)
         a_sim = 0.5 * float(np.ptp(tr.y[-n_last:, 0]))
         a_br = 0.5 * float(np.ptp(d["orbit"].values[i][:, 0]))
@@ -430,10 +427,8 @@ def bench_exact_pads_branch(*, points: int = 200) -> list[BenchResult]:
     -------
     list of BenchResult
     """
-    from brakesqueal import Axis
+    from brakesqueal import Axis, harmonic_branch, squeal_branch
     from brakesqueal.model import ParameterSpace
-    from brakesqueal.nonlinear.harmonic import harmonic_branch
-    from brakesqueal.nonlinear.models import squeal_branch
 
     space = ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5})
     axis = Axis("Omega", 30.0, 200.0)

@@ -84,7 +84,7 @@ def builder_rhs(params: Any) -> tuple[Callable[[float, np.ndarray], np.ndarray],
     cm = compile_model(params.model)
     n, m = cm.n, cm.m
     p = list(map(float, params.vector()))
-    sm = silent_motion(params, model=cm)
+    sm = silent_motion(params)
     L = np.array(sm.l0, dtype=float)
     zeros = [0.0] * n
 
@@ -112,7 +112,8 @@ def builder_rhs(params: Any) -> tuple[Callable[[float, np.ndarray], np.ndarray],
 
 
 def _compiled_run(model_name: str, params: Any, t_end: float, rtol: float, **kw: Any) -> tuple[float, Any, float]:
-    from brakesqueal.simulation import simulate, simulation_model
+    from brakesqueal import simulation_model
+    from brakesqueal.simulation import simulate
 
     t0 = time.perf_counter()
     model = simulation_model(model_name)
@@ -150,7 +151,8 @@ def bench_simulate(*, baseline_t: float = 0.002, t_end: float = 1.0, rtol: float
     from scipy.integrate import solve_ivp
 
     from brakesqueal.model import get_preset, resolve_parameters
-    from brakesqueal.simulation import simulate, simulation_model
+    from brakesqueal import simulation_model
+    from brakesqueal.simulation import simulate
 
     params = get_preset("paper-fig2").resolve()
     t_jit, tr, warm = _compiled_run("paper", params, t_end, rtol, perturbation=[1e-5, 0.0])  # as the baseline

@@ -66,7 +66,7 @@ def balance_slope(d_ip: float = 1.0, omega: float = 160.0, t_end: float = 0.3) -
     psub = dict(zip(eq.params, values))
     args = [*eq.Q, *eq.dQ, *eq.L, *eq.dL, *chi.values()]
     dG = [sp.lambdify(args, sp.diff(g, dl).subs(psub), "numpy") for g, dl in zip(eq.G, eq.dL)]
-    tr = simulate(None, params, t_end, perturbation=[1e-2, 0.0], contact="unilateral", events="continue")
+    tr = simulate(params, t_end, perturbation=[1e-2, 0.0], contact="unilateral", events="continue")
     n = len(eq.Q)
     Fn = tr.contact[:, :, 0]
     k = spec.pads[0].k_ip  # both pads: k_ip = 1e6

@@ -248,7 +248,7 @@ ENTRY_MODULES = {
 }
 ENTRY_UNITS = {"cli", "explorer"}
 #: Modules still building their own engine while their package moves onto the engine (none when done).
-PENDING_BUILD = {"brakesqueal.simulation._integrate"}
+PENDING_BUILD: set[str] = set()
 
 
 def _calls(tree: ast.AST, names: set[str]) -> list[int]:

@@ -34,8 +34,8 @@ from brakesqueal import critical_speeds, crossings, stability_map
 from brakesqueal.export import TARGETS, export_code
 from brakesqueal.model import MODELS, Disk, FrictionLaw, ModelSpec, Pad, ParameterSpace
 from brakesqueal.model.library import paper_parameters_full
-from brakesqueal.nonlinear.models import hopf_points
-from brakesqueal.simulation import simulate
+from brakesqueal import hopf_points
+from brakesqueal import simulate
 
 
 # ----------------------------------------------------------------------------- independent eigenvalues
@@ -409,7 +409,7 @@ def test_simulate_short_run(name):
     lm = linearize(params)
     lam = pencil_eigenvalues(lm)
     lead = lam[np.argmax(lam.real)]
-    tr = simulate(None, params, 0.005, method="DOP853")  # SciPy's stepper: no integrator compilation (time)
+    tr = simulate(params, 0.005, method="DOP853")  # SciPy's stepper: no integrator compilation (time)
     assert tr.status == "finished" and tr.model == name
     assert tr.y.shape == (tr.t.size, 2 * lm.n + len(lm.pad_states)) and np.isfinite(tr.y).all()
     assert 0.005 - 1 / tr.sample_rate < tr.t[-1] <= 0.005

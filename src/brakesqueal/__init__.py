@@ -13,7 +13,9 @@ The public API follows the layers of the package:
   model (eqs. 46-48) of any model,
 * :func:`stability_map`, :func:`crossings`, :func:`critical_speeds` — the
   stability routes of every model (closed-form kernels where the model allows
-  them, certified per-point eigenvalue verdicts otherwise).
+  them, certified per-point eigenvalue verdicts otherwise),
+* :func:`simulate`, :func:`hopf_points`, :func:`limit_cycles` — the nonlinear
+  time simulation and the nonlinear analysis after onset (:mod:`.api_nonlinear`).
 
 Heavy symbolic modules are imported lazily.
 """
@@ -50,8 +52,17 @@ __all__ = [
     "LinearModel",
     "pad_rate_eigenvalues",
     "simulate",
+    "simulation_model",
     "Trajectory",
     "SimulationModel",
+    "hopf_points",
+    "limit_cycles",
+    "squeal_branch",
+    "harmonic_branch",
+    "model_system",
+    "model_piecewise_system",
+    "exact_lyapunov",
+    "model_flow",
     "ModelSpec",
     "Disk",
     "Pad",
@@ -99,7 +110,16 @@ _LAZY = {
     "linearize": "api",
     "LinearModel": "analysis.linear",
     "pad_rate_eigenvalues": "api",
-    "simulate": "simulation",
+    "simulate": "api_nonlinear",
+    "simulation_model": "api_nonlinear",
+    "hopf_points": "api_nonlinear",
+    "limit_cycles": "api_nonlinear",
+    "squeal_branch": "api_nonlinear",
+    "harmonic_branch": "api_nonlinear",
+    "model_system": "api_nonlinear",
+    "model_piecewise_system": "api_nonlinear",
+    "exact_lyapunov": "api_nonlinear",
+    "model_flow": "api_nonlinear",
     "Trajectory": "simulation",
     "SimulationModel": "simulation",
     "ModelSpec": "model",

@@ -59,10 +59,10 @@ def test_built_model_map_agrees_with_pointwise_linearization():
 
 def test_built_model_simulation_matches_the_linear_growth():
     from brakesqueal.model.options import resolve_parameters
-    from brakesqueal.simulation import simulate
+    from brakesqueal import simulate
 
     lm = linearize(resolve_parameters("belt", sets={"slope": 0.2}))
-    tr = simulate("belt", resolve_parameters("belt", sets={"slope": 0.2}), 0.5, perturbation=[1e-6], rtol=1e-10)
+    tr = simulate(resolve_parameters("belt", sets={"slope": 0.2}), 0.5, perturbation=[1e-6], rtol=1e-10)
     s = tr.summary
     assert tr.status == "finished"
     assert abs(s.growth_rate - lm.max_real) <= 0.02 * abs(lm.max_real)

@@ -166,7 +166,7 @@ def test_simulate_api_bounds_the_number_of_samples():
 
     p = get_preset("paper-fig2").resolve({})
     with pytest.raises(ParameterError, match="at most 5e\\+07") as exc:
-        simulate(None, p, 1e308)
+        simulate(p, 1e308)
     assert exc.value.parameter == "sample_rate" and "t_end" in exc.value.names
 
 

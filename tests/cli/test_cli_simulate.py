@@ -81,7 +81,7 @@ def test_simulate_unilateral_contact_matches_library(capsys):
     import numpy as np
 
     from brakesqueal.model.options import resolve_space
-    from brakesqueal.simulation import simulate, simulation_model
+    from brakesqueal import simulate, simulation_model
 
     args = ["simulate", "--preset", "paper-fig3", "--set", "Omega=60", "--t-end", "0.01", "--q0", "3e-2,0",
             "--events", "continue", "--format", "json", "--no-progress"]  # fmt: skip
@@ -89,7 +89,7 @@ def test_simulate_unilateral_contact_matches_library(capsys):
     data = json.loads(capsys.readouterr().out)
     assert data["contact"] == "unilateral" and data["status"] == "finished"
     p = resolve_space(None, "paper-fig3", None, ["Omega=60"]).resolve({})
-    tr = simulate(simulation_model(p.model), p, 0.01, contact="unilateral", events="continue",
+    tr = simulate(p, 0.01, contact="unilateral", events="continue",
                   perturbation=[3e-2, 0.0])
     duty = np.asarray(tr.duty_cycle)
     assert np.all(duty < 0.9)  # both pads spend a real part of the run lifted off

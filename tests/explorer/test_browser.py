@@ -215,7 +215,7 @@ def test_limit_cycles_end_at_the_contact_loss(page):
     from brakesqueal import resolve_space
     from brakesqueal import Axis
     from brakesqueal.explorer.state import slider_range
-    from brakesqueal.nonlinear.models import hopf_points
+    from brakesqueal import hopf_points
 
     space = resolve_space(None, "paper-fig3", None, ["mu1=0.5", "mu2=0.5", "Omega=36"])
     rng = slider_range(space, "Omega")
@@ -225,7 +225,7 @@ def test_limit_cycles_end_at_the_contact_loss(page):
     # cycles with their rates kept (harmonic balance, as `brakesqueal cycles`) and says so
     assert onset.simulated is not None and "exact pads" in s["cycles"]["summary"]
     assert s["cycles"]["points"] >= 3
-    from brakesqueal.nonlinear.harmonic import harmonic_branch
+    from brakesqueal import harmonic_branch
 
     hb = harmonic_branch(space, Axis("Omega", rng.low, rng.high, 2, rng.log), max_points=25, max_harmonics=40)
     assert hb.contact_loss is not None and s["cycles"]["contact_loss"] == pytest.approx(hb.contact_loss, rel=1e-9)

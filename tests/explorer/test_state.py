@@ -105,9 +105,9 @@ def test_locus_lines_hold_every_mode_between_nans(origin):
 
 
 def test_audio_equals_the_wav_file(tmp_path):
-    from brakesqueal.simulation import simulate
+    from brakesqueal import simulate
 
-    tr = simulate(None, resolve_space(None, None, None, ["mu=1"]).resolve({}), 0.02)
+    tr = simulate(resolve_space(None, None, None, ["mu=1"]).resolve({}), 0.02)
     pcm = audio_samples(tr.audio_velocity()[0])
     frames = tr.to_wav(str(tmp_path / "a.wav"))
     with wave.open(str(tmp_path / "a.wav")) as w:
@@ -146,7 +146,7 @@ def test_hopf_line_names_the_predicted_lift_off_and_drops_the_amplitude_beyond_i
     # pads lift off at mu = 0.41027, beyond which the normal form of the bilateral equations does not hold
     from brakesqueal import Axis
     from brakesqueal.explorer.state import SliderRange, hopf_scan, hopf_text
-    from brakesqueal.nonlinear.models import hopf_points
+    from brakesqueal import hopf_points
 
     space = resolve_space(None, "paper-fig2", None, [])
     rng = SliderRange(0.01, 1.0, False)

@@ -995,10 +995,10 @@ def test_api_defaults_are_those_of_the_options():
 
 def test_paper_rhs_agrees_with_the_simulator(python_modules, cases):
     """The exported paper RHS equals the library's compiled simulator RHS (closed-form 2 x 2 solve, numba)."""
-    from brakesqueal.simulation._integrate import default_model
+    from brakesqueal import simulation_model
 
     case = cases["paper"]
-    f = default_model().rhs(case.params)
+    f = simulation_model("paper").rhs(case.params)
     mod = python_modules[("paper", "nonlinear")]
     p = list(case.params.vector())
     rng = np.random.default_rng(7)

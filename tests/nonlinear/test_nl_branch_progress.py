@@ -19,10 +19,11 @@ from brakesqueal import Axis
 from brakesqueal.errors import ParameterError
 from brakesqueal.model.parameters import ParameterSpace
 from brakesqueal.nonlinear import continue_cycles, find_periodic_orbit, first_lyapunov
-from brakesqueal.nonlinear.harmonic import harmonic_branch
-from brakesqueal.nonlinear.models import cycle_route, squeal_branch
+from brakesqueal import harmonic_branch
+from brakesqueal.nonlinear.models import cycle_route
 
 #: paper-fig3 at mu1 = mu2 = 0.5: Hopf point at Omega ~ 35.6 (rigid pads) / 35.74 (k_ip = 1e8), a pad loses
+from brakesqueal import squeal_branch
 #: contact near 36.04 / 36.19 (test_nl_models, test_nl_harmonic); the ranges end just past it, so both the
 #: distance in the parameter and the located contact loss take part
 RIGID = {"mu1": 0.5, "mu2": 0.5, "k_ip": math.inf}

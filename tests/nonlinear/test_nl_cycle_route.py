@@ -19,8 +19,10 @@ from brakesqueal.errors import ParameterError
 from brakesqueal.model import MODELS, get_model
 from brakesqueal.model.options import damped_pads, regularised_pads
 from brakesqueal.model.parameters import ParameterSpace
-from brakesqueal.nonlinear.harmonic import harmonic_branch, turning_points
-from brakesqueal.nonlinear.models import cycle_route, soft_quasi_static_pads, squeal_branch
+from brakesqueal.nonlinear.harmonic import turning_points
+from brakesqueal import harmonic_branch
+from brakesqueal.nonlinear.models import cycle_route, soft_quasi_static_pads
+from brakesqueal import squeal_branch
 
 FIG3 = ["--preset", "paper-fig3", "--set", "mu1=0.5", "--set", "mu2=0.5", "--along", "Omega=30:40"]
 
@@ -228,11 +230,11 @@ def test_hill_pencil_equals_the_complex_companion_form(seed):
 
 
 def test_a_nonlinear_simulation_says_when_its_pads_are_quasi_static():
-    from brakesqueal.simulation import simulate
+    from brakesqueal import simulate
 
     def run(over, **kw):
         space = ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5, "Omega": 60.0, **over})
-        return space, simulate(None, space.resolve({}), 0.3, events="continue", **kw)
+        return space, simulate(space.resolve({}), 0.3, events="continue", **kw)
 
     space, tr = run({}, perturbation=[3e-3, 0.0])
     assert tr.summary.regime == "nonlinear"
@@ -244,7 +246,7 @@ def test_a_nonlinear_simulation_says_when_its_pads_are_quasi_static():
     _, rigid = run({"k_ip": math.inf}, perturbation=[3e-3, 0.0])
     assert rigid.soft_quasi_static_pads == () and not any("quasi-static" in w for w in rigid.summary.warnings)
     damped = damped_pads(ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5, "Omega": 60.0}), 10.0)
-    tr_d = simulate(None, damped.resolve({}), 0.05, perturbation=[3e-3, 0.0], events="continue")
+    tr_d = simulate(damped.resolve({}), 0.05, perturbation=[3e-3, 0.0], events="continue")
     assert tr_d.soft_quasi_static_pads == ()
 
 

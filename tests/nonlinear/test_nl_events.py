@@ -12,7 +12,7 @@ import pytest
 from brakesqueal import Axis
 from brakesqueal.model import ParameterSpace
 from brakesqueal.nonlinear import find_periodic_orbit
-from brakesqueal.nonlinear.models import model_system, squeal_branch
+from brakesqueal import model_system, squeal_branch
 
 RUNS = [  # (range, options): narrow, wide linear, wide log; several max_points / step settings
     (Axis("Omega", 30.0, 40.0), {"max_points": 25}),

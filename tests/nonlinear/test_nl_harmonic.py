@@ -24,8 +24,8 @@ from brakesqueal import Axis
 from brakesqueal.cli import main
 from brakesqueal.errors import ParameterError
 from brakesqueal.model import ParameterSpace
-from brakesqueal.nonlinear.harmonic import harmonic_branch
-from brakesqueal.nonlinear.models import squeal_branch
+from brakesqueal import harmonic_branch
+from brakesqueal import squeal_branch
 
 SOFT = {"mu1": 0.5, "mu2": 0.5, "k_ip1": 1e6, "k_ip2": 1e6}  # Hopf at 64.81 rad/s, 1741 Hz, supercritical
 
@@ -137,7 +137,7 @@ def test_rigid_pads_equal_the_shooting_branch(rigid):
 
 def _independent_residual(space, pt, cm, t):
     """max_i |r_i| / (terms' magnitude) at times t, with the series and its derivatives written here."""
-    from brakesqueal.simulation import simulation_model
+    from brakesqueal import simulation_model
 
     params = space.resolve({"Omega": pt.p})
     sim = simulation_model(params.model)
@@ -186,14 +186,13 @@ def test_orbit_satisfies_the_equations_off_grid_and_truncation_shrinks(soft):
 
 
 def test_exact_jacobian_against_central_differences(onset_branch, soft):
-    from brakesqueal.codegen import compile_model
+    from brakesqueal import simulation_model
     from brakesqueal.nonlinear.harmonic import _Balance
 
     P = onset_branch.points[-1]
-    cm = compile_model(soft.resolve({}).model)
     H = P.harmonics
     scale = np.maximum(np.hypot(P.coefficients[:, 1], P.coefficients[:, 2]), 1e-9)
-    bal = _Balance(soft, "Omega", cm, H, 0, scale)
+    bal = _Balance(soft, "Omega", simulation_model(soft), H, 0, scale)
     y = np.concatenate([P.coefficients.ravel(), [P.omega, P.p]])
     J = bal.jacobian(y)
     s = np.concatenate([np.repeat(scale, bal.K), [P.omega, 1.0]])

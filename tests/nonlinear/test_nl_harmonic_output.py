@@ -15,7 +15,7 @@ import xarray as xr
 from brakesqueal import Axis
 from brakesqueal.cli import main
 from brakesqueal.model.options import resolve_space
-from brakesqueal.nonlinear.harmonic import harmonic_branch
+from brakesqueal import harmonic_branch
 
 SETS = ["mu1=0.5", "mu2=0.5", "k_ip1=1e6", "k_ip2=1e6"]
 
@@ -120,7 +120,7 @@ def test_subcritical_onsets_of_the_larger_models_agree_with_shooting(name):
     from test_pad_limit_and_api_matrix import PATHS
 
     from brakesqueal.model import ParameterSpace
-    from brakesqueal.nonlinear.models import squeal_branch
+    from brakesqueal import squeal_branch
 
     pname, a, b, log = PATHS[name][0]
     space = ParameterSpace.from_preset(name)

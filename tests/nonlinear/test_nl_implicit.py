@@ -25,8 +25,8 @@ from brakesqueal.model import MODELS, ParameterSpace
 from brakesqueal.model.io import model_to_toml
 from brakesqueal.model.options import resolve_space
 from brakesqueal.nonlinear import find_periodic_orbit, first_lyapunov
-from brakesqueal.nonlinear.implicit import exact_lyapunov
-from brakesqueal.nonlinear.models import hopf_points, model_system
+from brakesqueal import exact_lyapunov
+from brakesqueal import hopf_points, model_system
 
 K_IP = 1e5
 ONSET = 3.3533  # the Coulomb model's Hopf point near 3.35 rad/s at k_ip = 1e5 (refined by the code)
@@ -205,7 +205,7 @@ def test_branch_of_regularised_pads(rising_friction_model):
     """The documented how-to: `cycles` on the regularised model continues past the stiff orbits where a
     sampling run of the explicit integrator failed (it used to end the command), and its first points have
     the exact Coulomb normal form's amplitude."""
-    from brakesqueal.nonlinear.models import squeal_branch
+    from brakesqueal import squeal_branch
 
     exact = hopf_points(resolve_space(None, None, None, ["k_ip=1e6"]), Axis("Omega", 10.0, 200.0))[0].hopf
     reg = resolve_space(rising_friction_model, None, None, ["k_ip1=1e6", "k_ip2=1e6", "s=-1e-4"])
@@ -236,7 +236,7 @@ def test_pad_slope_option_equals_the_model_file_route(rising_friction_model, cap
     """`squeal_branch(pad_slope=...)` / `cycles --pad-slope` build the same regularised model as the how-to's
     model file (an independent construction: TOML text vs. the spec rewritten in code)."""
     from brakesqueal.model.options import regularised_pads
-    from brakesqueal.nonlinear.models import squeal_branch
+    from brakesqueal import squeal_branch
 
     coulomb = resolve_space(None, None, None, ["k_ip=1e6"])
     toml = resolve_space(rising_friction_model, None, None, ["k_ip1=1e6", "k_ip2=1e6", "s=-1e-4"])

@@ -13,10 +13,13 @@ import pytest
 from brakesqueal import Axis
 from brakesqueal.errors import ParameterError
 from brakesqueal.model.parameters import ParameterSpace
-from brakesqueal.nonlinear.harmonic import HarmonicBranch, harmonic_branch
-from brakesqueal.nonlinear.models import SquealBranch, cycle_route, limit_cycles, squeal_branch
+from brakesqueal.nonlinear.harmonic import HarmonicBranch
+from brakesqueal import harmonic_branch
+from brakesqueal.nonlinear.models import cycle_route
+from brakesqueal.nonlinear.squeal import SquealBranch
 
 #: paper-fig3 at mu1 = mu2 = 0.5 (onset ~35.6 rigid / 35.74 with k_ip = 1e8; contact loss near 36.04 / 36.19)
+from brakesqueal import limit_cycles, squeal_branch
 RIGID = {"mu1": 0.5, "mu2": 0.5, "k_ip": math.inf}
 SOFT = {"mu1": 0.5, "mu2": 0.5}
 AXIS = Axis("Omega", 30.0, 36.3)

@@ -23,8 +23,8 @@ from brakesqueal import Axis
 from brakesqueal.cli import main
 from brakesqueal.model import MODELS, ParameterSpace
 from brakesqueal.nonlinear import find_periodic_orbit
-from brakesqueal.nonlinear.models import hopf_points, model_system
-from brakesqueal.simulation import simulation_model
+from brakesqueal import hopf_points, model_system
+from brakesqueal import simulation_model
 
 
 @pytest.mark.parametrize("name", list(MODELS))
@@ -113,7 +113,7 @@ def test_hopf_text_and_bad_parameter(capsys):
 
 def test_squeal_branch_finds_contact_loss(tmp_path, capsys):
     """The branch's contact loss is where a periodic orbit (shooting, independent of the branch) grazes F_n = 0."""
-    from brakesqueal.nonlinear.models import squeal_branch
+    from brakesqueal import squeal_branch
 
     space = ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5, "k_ip": math.inf})
     b = squeal_branch(space, Axis("Omega", 30.0, 40.0), max_points=25)

@@ -20,9 +20,9 @@ import pytest
 
 from brakesqueal import Axis
 from brakesqueal.model.options import damped_pads, resolve_space
-from brakesqueal.nonlinear.harmonic import harmonic_branch
-from brakesqueal.nonlinear.models import squeal_branch
-from brakesqueal.simulation import simulate
+from brakesqueal import harmonic_branch
+from brakesqueal import squeal_branch
+from brakesqueal import simulate
 
 from _disk_energy import disk_work
 
@@ -60,7 +60,7 @@ def test_the_unilateral_branch_continues_past_lift_off_and_an_orbit_reproduces_i
     orbit = unilateral.branch.orbits[i]
     assert orbit.events  # the orbit's own lift-off and re-contact events
     params = space.resolve({"Omega": float(p[i])})
-    tr = simulate(None, params, 5 * orbit.period, x0=orbit.x[0], rtol=1e-11, events="continue",
+    tr = simulate(params, 5 * orbit.period, x0=orbit.x[0], rtol=1e-11, events="continue",
                   contact="unilateral", sample_rate=8 / orbit.period)
     assert tr.status == "finished", tr.message
     for pad in ("1", "2"):  # one lift-off and one re-contact per period and pad
@@ -79,7 +79,7 @@ def test_energy_balance_over_one_period_past_lift_off(space, unilateral):
     orbit = unilateral.branch.orbits[i]
     params = space.resolve({"Omega": float(p[i])})
     N = 20000
-    tr = simulate(None, params, orbit.period, x0=orbit.x[0], rtol=1e-12, events="continue", contact="unilateral",
+    tr = simulate(params, orbit.period, x0=orbit.x[0], rtol=1e-12, events="continue", contact="unilateral",
                   sample_rate=N / orbit.period * (1 + 1e-12))
     assert tr.t.size == N + 1 and tr.engaged is not None and not tr.engaged.all()  # the pads lift off
     work = disk_work(params, tr)

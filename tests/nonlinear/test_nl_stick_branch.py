@@ -18,9 +18,10 @@ from brakesqueal import Axis
 from brakesqueal.cli import main
 from brakesqueal.errors import ParameterError
 from brakesqueal.model.options import resolve_space
-from brakesqueal.nonlinear.models import SquealBranch, squeal_branch, squeal_summary
+from brakesqueal.nonlinear.squeal import SquealBranch, squeal_summary
 
 #: paper-fig3 with soft pads and mu = 1: Hopf point at 29.14 rad/s, the pads approach stick on the cycles
+from brakesqueal import squeal_branch
 SETS = ["mu1=1", "mu2=1", "k_ip=1e6"]
 AXIS = Axis("Omega", 29.0, 40.0)
 

@@ -17,7 +17,8 @@ from brakesqueal.errors import ParameterError
 from brakesqueal.model.options import damped_pads, resolve_space
 from brakesqueal.nonlinear import PiecewiseSystem, ScipyFlow, SmoothSystem, Transition
 from brakesqueal.nonlinear.flow import _augmented_rhs, augmented_jacobian
-from brakesqueal.nonlinear.models import _shooting_flow, model_piecewise_system, squeal_branch, stiffness_ratio
+from brakesqueal.nonlinear.squeal import _shooting_flow, stiffness_ratio
+from brakesqueal import model_piecewise_system, squeal_branch
 
 LAM = 2e3  # rate of the fast variable: stiff against the O(1) oscillation
 

@@ -20,8 +20,9 @@ import pytest
 from brakesqueal import Axis
 from brakesqueal.model import ParameterSpace
 from brakesqueal.nonlinear import find_periodic_orbit
-from brakesqueal.nonlinear.models import _duty_cycle, hopf_points, model_piecewise_system, model_system
-from brakesqueal.simulation import simulate
+from brakesqueal.nonlinear.squeal import _duty_cycle
+from brakesqueal import hopf_points, model_piecewise_system, model_system
+from brakesqueal import simulate
 
 from _disk_energy import disk_work
 
@@ -46,7 +47,7 @@ def test_orbit_through_contact_loss_matches_event_driven_simulation(lifting_orbi
     T = o.period
     params = space.resolve({"Omega": P_LIFT})
     n_per = 100
-    tr = simulate(None, params, n_per * T, x0=o.x[0], rtol=1e-11, events="continue", contact="unilateral",
+    tr = simulate(params, n_per * T, x0=o.x[0], rtol=1e-11, events="continue", contact="unilateral",
                   sample_rate=16 / T)
     assert tr.status == "finished"
     returns = tr.y[::16]
@@ -83,7 +84,7 @@ def test_energy_balance_over_one_period(lifting_orbit):
     space, pw, o = lifting_orbit
     params = space.resolve({"Omega": P_LIFT})
     N = 20000
-    tr = simulate(None, params, o.period, x0=o.x[0], rtol=1e-12, events="continue", contact="unilateral",
+    tr = simulate(params, o.period, x0=o.x[0], rtol=1e-12, events="continue", contact="unilateral",
                   sample_rate=N / o.period * (1 + 1e-12))
     assert tr.t.size == N + 1 and tr.engaged is not None and not tr.engaged.all()  # the pads lift off
     work = disk_work(params, tr)

@@ -11,7 +11,7 @@ import pytest
 
 from brakesqueal.errors import ParameterError
 from brakesqueal.model.options import regularised_pads, resolve_space
-from brakesqueal.nonlinear.models import model_piecewise_system
+from brakesqueal import model_piecewise_system
 
 SETS = ["mu1=0.5", "mu2=0.5", "k_ip1=1e6", "k_ip2=1e6"]
 

@@ -18,7 +18,7 @@ from brakesqueal.model import ParameterSpace
 from brakesqueal.model.components import Disk, FrictionLaw, ModelSpec, Pad
 from brakesqueal.model.library import paper_parameters_full
 from brakesqueal.model.parameters import Parameters
-from brakesqueal.simulation import simulation_model
+from brakesqueal import simulation_model
 
 CASES = [
     ("paper-fig3", {"mu1": 0.5, "mu2": 0.5, "k_ip": math.inf}, "Omega"),
@@ -108,8 +108,8 @@ def test_branch_with_compiled_jacobian_equals_python_route():
     """The limit-cycle branch of the paper's model: compiled flow (generated Jacobian) vs ScipyFlow (Python)."""
     from brakesqueal import Axis
     from brakesqueal.nonlinear import ScipyFlow, continue_cycles
-    from brakesqueal.nonlinear.compiled import model_flow
-    from brakesqueal.nonlinear.models import hopf_points, model_system
+    from brakesqueal import model_flow
+    from brakesqueal import hopf_points, model_system
 
     space = ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5, "k_ip": math.inf})
     hp = hopf_points(space, Axis("Omega", 30.0, 40.0))[0]

@@ -32,7 +32,7 @@ from brakesqueal.model.components import Pad
 from brakesqueal.model.io import model_to_toml, spec_from_dict
 from brakesqueal.model.library import get_model
 from brakesqueal.model.options import MAX_PAD_DAMPING, damped_pads, resolve_space
-from brakesqueal.simulation import simulate, simulation_model
+from brakesqueal import simulate, simulation_model
 from brakesqueal.symbolic.assemble import build_equations
 
 SETS = ["mu1=0.5", "mu2=0.5", "k_ip=1e6"]
@@ -129,7 +129,7 @@ def test_unilateral_simulation_passes_lift_off_and_a_lifted_pad_relaxes(damped_s
     st = sim.silent(params)
     v = np.real(sim.linear_modes(params).right[:, 0])
     x0 = st.y + 5e-3 * v / np.abs(v[:2]).max()  # a tilt of 5 mrad along the leading mode: near the limit cycle
-    tr = simulate(sim, params, 4e-3, x0=x0, contact="unilateral", events="continue", rtol=1e-10, atol=1e-13,
+    tr = simulate(params, 4e-3, x0=x0, contact="unilateral", events="continue", rtol=1e-10, atol=1e-13,
                   sample_rate=4e6)
     assert tr.status == "finished", tr.message
     assert tr.engaged is not None and not tr.engaged.all() and tr.engaged.any(axis=0).all()
@@ -159,7 +159,7 @@ def test_a_tilted_start_puts_the_damped_pads_at_rest_on_their_supports(damped_sp
     ``ldot ~ 1e3 N / 10 N s/m``, faster than the sliding speed: a spurious reversal at the start)."""
     params = damped_space.resolve({"Omega": 160.0, "d_ip": 10.0})
     sim = simulation_model(params.model)
-    tr = simulate(sim, params, 2e-4, perturbation=[8e-3, 0.0], contact="unilateral")
+    tr = simulate(params, 2e-4, perturbation=[8e-3, 0.0], contact="unilateral")
     assert tr.status == "finished" and "damped pads at rest" in tr.start, (tr.status, tr.message)
     y0, p = tr.y[0], sim.parameter_vector(params)
     l = np.array(y0[4:6])
@@ -168,7 +168,7 @@ def test_a_tilted_start_puts_the_damped_pads_at_rest_on_their_supports(damped_sp
     assert np.abs(g[:2]).max() < 1e-14 and np.abs(l - sim.silent(params).l).min() > 1e-5  # moved, and balanced
     # the pad states given (the silent motion's l): kept, and the start is the spurious reversal described above
     with pytest.raises(ParameterError, match="does not slide forward at the initial state"):
-        simulate(sim, params, 2e-4, x0=sim.silent(params).y + np.r_[8e-3, 0, 0, 0, 0, 0], contact="unilateral")
+        simulate(params, 2e-4, x0=sim.silent(params).y + np.r_[8e-3, 0, 0, 0, 0, 0], contact="unilateral")
 
 
 def test_the_command_line_option(capsys: Any) -> None:

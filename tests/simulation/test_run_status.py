@@ -13,15 +13,15 @@ import xarray as xr
 
 from brakesqueal import resolve_parameters
 from brakesqueal.cli import main
-from brakesqueal.simulation import simulate
+from brakesqueal import simulate
 from brakesqueal.status import RunStatus
 
 
 def test_statuses_are_the_shared_enum(tmp_path):
     params = resolve_parameters(None, "paper-fig2", None, ["mu=1", "h=0.05"])
-    done = simulate(None, params, 0.002)
+    done = simulate(params, 0.002)
     assert done.status is RunStatus.FINISHED and done.status == "finished" and done.success
-    lost = simulate(None, params, 0.5, perturbation=[2e-3, 0.0])  # paper-fig2 with mu = 1: contact loss at 0.1 s
+    lost = simulate(params, 0.5, perturbation=[2e-3, 0.0])  # paper-fig2 with mu = 1: contact loss at 0.1 s
     assert lost.status is RunStatus.CONTACT_LOSS and lost.status == "contact-loss" and not lost.success
     assert json.loads(json.dumps(lost.summary.to_dict()))["status"] == "contact-loss"
     path = tmp_path / "run.nc"
@@ -45,7 +45,7 @@ def test_cli_json_status(capsys):
 def test_a_division_by_zero_in_compiled_code_is_a_failed_run(monkeypatch, method, kernel, after):
     """numba raises ZeroDivisionError for ``0.0 ** -1`` under any error model (a Coulomb friction direction at
     exactly zero sliding speed): the run ends ``failed`` with a message saying so, never with a traceback."""
-    from brakesqueal.simulation import simulation_model
+    from brakesqueal import simulation_model
 
     params = resolve_parameters(None, "paper-fig2", None, [])
     sim = simulation_model(params.model)
@@ -59,6 +59,6 @@ def test_a_division_by_zero_in_compiled_code_is_a_failed_run(monkeypatch, method
         return real(*args)
 
     monkeypatch.setattr(sim.kernels, kernel, flaky)
-    tr = simulate(sim, params, 0.002, method=method)
+    tr = simulate(params, 0.002, method=method)
     assert tr.status is RunStatus.FAILED and "divided by zero" in tr.message, tr.message
     assert calls["n"] > after

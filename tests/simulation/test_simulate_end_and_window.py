@@ -10,7 +10,7 @@ import pytest
 
 from brakesqueal.cli import main
 from brakesqueal.model import get_preset
-from brakesqueal.simulation import simulate
+from brakesqueal import simulate
 from brakesqueal.simulation.trajectory import summarize
 
 
@@ -21,7 +21,7 @@ def params():
 
 def test_end_time_is_where_the_integration_ended_not_the_last_sample(params):
     # 10 output samples per second: the last one (0.01 s) lies before the end time 0.0105 s
-    tr = simulate(None, params, 0.0105, sample_rate=100.0)
+    tr = simulate(params, 0.0105, sample_rate=100.0)
     assert tr.status == "finished" and tr.t[-1] == pytest.approx(0.01)
     assert tr.t_end_reached == 0.0105
 
@@ -36,7 +36,7 @@ def test_end_time_of_a_contact_loss_is_the_event_time(capsys):
 
 
 def test_window_shorter_than_a_period_has_no_frequency(params, capsys):
-    tr = simulate(None, params, 1e-9)
+    tr = simulate(params, 1e-9)
     s = tr.summary
     assert s.estimate_status == "window-shorter-than-a-period" and s.regime == "unknown"
     assert math.isnan(s.frequency_hz) and math.isnan(s.growth_rate) and math.isnan(s.frequency_stderr)

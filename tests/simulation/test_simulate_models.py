@@ -36,7 +36,7 @@ from brakesqueal.model.components import Disk, FrictionLaw, ModelSpec, Pad
 from brakesqueal.model.library import paper_parameters_full
 from brakesqueal.model.options import resolve_parameters
 from brakesqueal.model.parameters import Parameters
-from brakesqueal.simulation import simulate, simulation_model
+from brakesqueal import simulate, simulation_model
 
 TWO_PI = 2 * math.pi
 MODELS = ["paper", "minimal", "in-plane-pad", "six-dof", "eight-dof", "four-pad", "belt"]
@@ -79,7 +79,7 @@ def test_growth_and_frequency_are_the_leading_eigenvalue(name):
     params = resolve_parameters(name)
     lm = linearize(params, pad_rates="quasi-static")  # the built-in models' massless pads are coulomb: quasi-static
     lam = descriptor_leading(lm)
-    tr = simulate(name, params, DURATION.get(name, 0.3))
+    tr = simulate(params, DURATION.get(name, 0.3))
     assert tr.status == "finished", tr.message
     s = tr.summary
     check_estimate(s, lam)
@@ -115,12 +115,12 @@ def test_energy_is_conserved_without_friction_and_damping(name):
     if m.n > 1:
         pert[1] = 5e-6
     params = resolve_parameters(name, sets=ZERO[name])
-    tr = simulate(m, params, 0.3, perturbation=pert, rtol=1e-11, events="off", sample_rate=20000)
+    tr = simulate(params, 0.3, perturbation=pert, rtol=1e-11, events="off", sample_rate=20000)
     assert tr.status == "finished"
     e = tr.energy()
     assert np.abs(e["E"] - e["E"][0]).max() <= 1e-7 * e["T2"].max()
     # negative control: with the model's friction and damping E changes measurably
-    rub = simulate(m, resolve_parameters(name), 0.3, perturbation=pert, events="off", sample_rate=20000)
+    rub = simulate(resolve_parameters(name), 0.3, perturbation=pert, events="off", sample_rate=20000)
     er = rub.energy()
     assert np.abs(er["E"] - er["E"][0]).max() > 1e-2 * er["T2"].max()
 
@@ -130,8 +130,8 @@ def test_compiled_integrator_agrees_with_solve_ivp(name):
     """The compiled DOP853 and SciPy's solve_ivp on the same generated right-hand side."""
     params = resolve_parameters(name)
     T = 0.1 if name == "belt" else 0.01
-    a = simulate(name, params, T, rtol=1e-10, sample_rate=20000)
-    b = simulate(name, params, T, rtol=1e-10, sample_rate=20000, method="DOP853")
+    a = simulate(params, T, rtol=1e-10, sample_rate=20000)
+    b = simulate(params, T, rtol=1e-10, sample_rate=20000, method="DOP853")
     scale = np.abs(a.y - a.silent_state).max(axis=0)
     n = a.n  # components that hardly move (a caliper's tangential rate) are compared on their block's scale
     scale[:n] = np.maximum(scale[:n], 1e-3 * scale[:n].max())
@@ -139,7 +139,7 @@ def test_compiled_integrator_agrees_with_solve_ivp(name):
     assert a.status == b.status == "finished" and a.t.size == b.t.size
     assert (np.abs(a.y - b.y).max(axis=0) / scale).max() < 1e-6
     np.testing.assert_allclose(a.contact[..., 0], b.contact[..., 0], rtol=1e-9)
-    loose = simulate(name, params, T, rtol=1e-3, sample_rate=20000, method="RK45")  # the comparison can fail
+    loose = simulate(params, T, rtol=1e-3, sample_rate=20000, method="RK45")  # the comparison can fail
     assert (np.abs(loose.y - a.y).max(axis=0) / scale).max() > 1e-4
 
 
@@ -163,9 +163,9 @@ def test_falling_friction_pad_mode_grows_in_the_simulation():
     assert lm.pad_states == ("l1", "l2")
     lam = descriptor_leading(lm)
     assert lam.imag == 0 and lam.real == pytest.approx(1e4 / (3600 * 0.05), rel=1e-3)  # k_ip/(N0 slope)
-    start = simulate(m, params, 1e-4)
+    start = simulate(params, 1e-4)
     small = 0.01 * (start.y_start - start.silent_state)  # 1.3e-8 m along the pad mode
-    tr = simulate(m, params, 0.04, perturbation=small)
+    tr = simulate(params, 0.04, perturbation=small)
     assert tr.status == "finished" and tr.y.shape[1] == 2 * 2 + 2
     s = tr.summary
     # a real mode: its growth depends on the amplitude to first order (1.8e-3 1/s at 1.3e-6 m, measured), so
@@ -210,8 +210,8 @@ def test_mixed_pads_match_their_own_linearization():
     lam = sla.eigvals(Am, E)
     lead = _leading(lam[np.isfinite(lam)])
     assert m.linear_modes(params).eigenvalues[0] == pytest.approx(lead, rel=1e-8)
-    start = simulate(m, params, 1e-4)
-    tr = simulate(m, params, 0.04, perturbation=0.01 * (start.y_start - start.silent_state))
+    start = simulate(params, 1e-4)
+    tr = simulate(params, 0.04, perturbation=0.01 * (start.y_start - start.silent_state))
     assert tr.status == "finished"
     check_estimate(tr.summary, lead, rel=1e-6, sigmas=3.0)
 
@@ -219,7 +219,7 @@ def test_mixed_pads_match_their_own_linearization():
 def test_zero_friction_slope_is_refused_in_one_line():
     params = _paper_like(("linear", "linear"), "falling").replace(s1=0.0)
     with pytest.raises(Exception, match="pad '1'") as exc:
-        simulate(None, params, 0.01)
+        simulate(params, 0.01)
     msg = str(exc.value)
     assert type(exc.value).__name__ == "ParameterError" and "\n" not in msg
     assert "friction slope" in msg and ("too fast" in msg or "does not determine" in msg)
@@ -229,13 +229,13 @@ def test_zero_friction_slope_is_refused_in_one_line():
 def _large_start(name, factor):
     m = simulation_model(name)
     params = resolve_parameters(name)
-    tr = simulate(m, params, 1e-4)
+    tr = simulate(params, 1e-4)
     return m, params, factor * (tr.y_start - tr.silent_state)
 
 
 def test_contact_loss_of_one_of_four_pads():
     m, params, pert = _large_start("four-pad", 300)  # 3e-3 rad along the leading (whirling) mode
-    tr = simulate(m, params, 2.0, perturbation=pert, sample_rate=20000)
+    tr = simulate(params, 2.0, perturbation=pert, sample_rate=20000)
     assert tr.status == "contact-loss" and tr.event_pad in m.pads
     assert f"pad '{tr.event_pad}' lost contact" in tr.message
     c = m.contact_at(params, tr.y_event)  # independent evaluation at the located state
@@ -244,7 +244,7 @@ def test_contact_loss_of_one_of_four_pads():
     assert np.all(np.delete(c[:, 0], j) > 0.1 * params["N0"])
     assert np.all(tr.normal_forces[:-1] > 0) and tr.t[-1] <= tr.t_event
     # reference: the first zero of any pad's F_n on a 2 MHz grid of a run without events (linear interpolation)
-    fine = simulate(m, params, tr.t_event + 2e-4, perturbation=pert, sample_rate=2e6, rtol=1e-11, events="off")
+    fine = simulate(params, tr.t_event + 2e-4, perturbation=pert, sample_rate=2e6, rtol=1e-11, events="off")
     fn = fine.normal_forces
     below = np.argwhere(fn <= 0)
     i, jj = below[np.argmin(below[:, 0])]
@@ -253,11 +253,11 @@ def test_contact_loss_of_one_of_four_pads():
     assert -fn[:, jj].min() < 5.0  # a grazing first crossing (about -0.8 N): not a sign change at the checked points
     # the same event at a loose tolerance (longer steps) and with solve_ivp's event location
     for kw in ({"rtol": 1e-7}, {"rtol": 1e-10, "method": "RK45"}):
-        ref = simulate(m, params, 2.0, perturbation=pert, sample_rate=20000, **kw)
+        ref = simulate(params, 2.0, perturbation=pert, sample_rate=20000, **kw)
         assert (ref.status, ref.event_pad) == (tr.status, tr.event_pad), kw
         assert ref.t_event == pytest.approx(tr.t_event, abs=1e-7), kw
     # recorded and continued: every pad's crossings, named per pad; the first is the stopping event
-    cont = simulate(m, params, tr.t_event + 0.002, perturbation=pert, sample_rate=20000, events="continue")
+    cont = simulate(params, tr.t_event + 0.002, perturbation=pert, sample_rate=20000, events="continue")
     assert cont.status == "finished"
     assert set(cont.event_times) == {f"contact-loss-pad-{p}" for p in m.pads}
     first = min(cont.event_times, key=lambda k: cont.event_times[k][0])
@@ -279,11 +279,11 @@ def test_first_contact_loss_is_not_missed(seed):
     amp, phi = rng.uniform(1.5e-3, 2.5e-3), rng.uniform(0, TWO_PI)
     pert = [amp * math.cos(phi), amp * math.sin(phi)]
     m = simulation_model("paper")
-    tr = simulate(m, params, 1.0, perturbation=pert, sample_rate=5000)
+    tr = simulate(params, 1.0, perturbation=pert, sample_rate=5000)
     assert tr.status == "contact-loss"
     j = m.pads.index(tr.event_pad)
     assert abs(m.contact_at(params, tr.y_event)[j, 0]) <= 1e-6 * params.N0
-    fine = simulate(m, params, tr.t_event + 2e-5, perturbation=pert, sample_rate=2e6, rtol=1e-11, events="off")
+    fine = simulate(params, tr.t_event + 2e-5, perturbation=pert, sample_rate=2e6, rtol=1e-11, events="off")
     fn = fine.normal_forces
     before = fine.t < tr.t_event - 1e-7
     assert fn[before].min() > 0.0
@@ -294,7 +294,7 @@ def test_first_contact_loss_is_not_missed(seed):
 def test_sliding_reversal_on_the_belt():
     m = simulation_model("belt")
     params = resolve_parameters("belt")
-    tr = simulate(m, params, 3.0, sample_rate=5000)
+    tr = simulate(params, 3.0, sample_rate=5000)
     assert tr.status == "sliding-reversal" and tr.event_pad == "pad" and "pad 'pad'" in tr.message
     st = m.silent(params)
     c = m.contact_at(params, tr.y_event)
@@ -309,7 +309,7 @@ def test_cli_model_run_equals_the_library_run(tmp_path, capsys):
                "--wav", str(wav), "--format", "json", "--no-progress"])  # fmt: skip
     assert rc == 0
     d = json.loads(capsys.readouterr().out)
-    tr = simulate("eight-dof", resolve_parameters("eight-dof", sets={"m_c": 5}), 0.05)
+    tr = simulate(resolve_parameters("eight-dof", sets={"m_c": 5}), 0.05)
     assert d["model"] == "eight-dof" and d["status"] == "finished"
     assert d["growth_rate"] == tr.summary.growth_rate and d["frequency_hz"] == tr.summary.frequency_hz
     import xarray as xr

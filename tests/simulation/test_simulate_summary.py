@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from brakesqueal import linearize
+from brakesqueal import linearize, simulate
 from brakesqueal.cli import main
 from brakesqueal.errors import ParameterError
 from brakesqueal.model import get_preset
@@ -27,7 +27,6 @@ from brakesqueal.simulation import (
     linear_modes,
     matrix_pencil,
     modal_projection,
-    simulate,
 )
 
 TWO_PI = 2 * math.pi
@@ -221,7 +220,7 @@ def _check_against_linear(s, lam):
 @pytest.mark.parametrize("preset, overrides, params, lam", POINTS, ids=[f"{p}-{i}" for i, (p, *_) in
                                                                         enumerate(POINTS)])  # fmt: skip
 def test_default_run_gives_the_leading_eigenvalue(preset, overrides, params, lam):
-    tr = simulate(None, params, 0.5)
+    tr = simulate(params, 0.5)
     assert tr.status == "finished", tr.message
     s = tr.summary
     _check_against_linear(s, lam)
@@ -248,7 +247,7 @@ def test_default_cli_run_gives_the_leading_eigenvalue(k, capsys):
 
 def test_default_start_is_along_the_leading_mode():
     params = get_preset("paper-fig2").resolve()
-    tr = simulate(None, params, 0.001)
+    tr = simulate(params, 0.001)
     x0 = tr.y[0] - np.r_[tr.q_m0, 0.0, 0.0]
     assert np.abs(x0[:2]).max() == pytest.approx(1e-5, rel=1e-12)
     lm = linearize(params)
@@ -263,7 +262,7 @@ def test_generic_start_no_longer_biased_by_beating():
     """The reported case (q0 = (1e-5, 0) excites both modes): the summary still gives Re lambda."""
     params = get_preset("paper-fig2").resolve()
     lam = leading_eigenvalue(params)
-    tr = simulate(None, params, 0.5, perturbation=[1e-5, 0.0])
+    tr = simulate(params, 0.5, perturbation=[1e-5, 0.0])
     _check_against_linear(tr.summary, lam)
     # negative control: the former envelope fit on the same samples reported about -0.037 1/s
     g_env, _ = fit_growth_frequency(tr.t, tr.dq)
@@ -274,8 +273,8 @@ def test_generic_start_no_longer_biased_by_beating():
 def test_low_output_rate_keeps_the_summary_and_warns():
     params = get_preset("paper-fig2").resolve({"mu": 0.3})
     lam = leading_eigenvalue(params)
-    fine = simulate(None, params, 0.5)
-    coarse = simulate(None, params, 0.5, sample_rate=10.0)
+    fine = simulate(params, 0.5)
+    coarse = simulate(params, 0.5, sample_rate=10.0)
     assert coarse.t.size == 6
     s = coarse.summary
     _check_against_linear(s, lam)
@@ -284,7 +283,7 @@ def test_low_output_rate_keeps_the_summary_and_warns():
     assert any("below twice the leading frequency" in w for w in s.warnings)
     assert not fine.summary.warnings
     # the same at a rate between the frequency and twice the frequency
-    mid = simulate(None, params, 0.2, sample_rate=3000.0).summary
+    mid = simulate(params, 0.2, sample_rate=3000.0).summary
     _check_against_linear(mid, lam)
     assert any("below twice" in w for w in mid.warnings)
 
@@ -294,7 +293,7 @@ def test_high_frequency_parameters_with_a_low_sample_rate():
     params = get_preset("paper-fig2").resolve().replace(k_t=9 * 18.8e6)
     lam = leading_eigenvalue(params)
     assert lam.imag / TWO_PI > 5000
-    tr = simulate(None, params, 0.3, sample_rate=4000.0)
+    tr = simulate(params, 0.3, sample_rate=4000.0)
     s = tr.summary
     _check_against_linear(s, lam)
     assert s.estimate_rate_hz > 20 * lam.imag / TWO_PI * 0.99
@@ -319,7 +318,7 @@ def test_cli_warns_on_stderr_for_an_aliased_output_rate(capsys):
 def test_estimation_record_is_bounded():
     params = get_preset("paper-fig2").resolve({"mu": 0.8})
     lam = leading_eigenvalue(params)
-    tr = simulate(None, params, 0.5, estimate_samples=4096)
+    tr = simulate(params, 0.5, estimate_samples=4096)
     r = tr.record
     assert r.y.shape == (4096, 4) and not r.complete
     assert r.t[-1] == pytest.approx(0.5, abs=1 / r.rate) and np.allclose(np.diff(r.t), 1 / r.rate)
@@ -337,8 +336,8 @@ def test_estimation_record_is_bounded():
 def test_scipy_method_fills_the_record_in_chunks():
     params = get_preset("paper-fig2").resolve({"mu": 1.0, "h": 0.05})
     lam = leading_eigenvalue(params)
-    a = simulate(None, params, 0.05, estimate_samples=256, rtol=1e-10)
-    b = simulate(None, params, 0.05, estimate_samples=256, rtol=1e-10, method="DOP853")
+    a = simulate(params, 0.05, estimate_samples=256, rtol=1e-10)
+    b = simulate(params, 0.05, estimate_samples=256, rtol=1e-10, method="DOP853")
     assert np.array_equal(a.record.t, b.record.t)
     scale = np.abs(a.record.y).max(axis=0)
     assert (np.abs(a.record.y - b.record.y).max(axis=0) / scale).max() < 1e-6
@@ -367,7 +366,7 @@ def test_large_amplitude_is_flagged_nonlinear_and_matches_the_motion():
     w, V = np.linalg.eig(lm.A)
     v = V[:, np.argmin(np.abs(w - lam))]
     v = np.real(v / v[np.argmax(np.abs(v[:2]))])
-    tr = simulate(None, params, 0.3, perturbation=2e-3 * v)
+    tr = simulate(params, 0.3, perturbation=2e-3 * v)
     assert tr.status == "contact-loss"
     s = tr.summary
     assert s.regime == "nonlinear" and abs(s.growth_rate - lam.real) > 3 * s.growth_rate_stderr

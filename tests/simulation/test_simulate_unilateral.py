@@ -16,7 +16,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from brakesqueal.model import get_preset
-from brakesqueal.simulation import simulate, simulation_model
+from brakesqueal import simulate, simulation_model
 
 
 def _params():
@@ -103,7 +103,7 @@ def test_unilateral_run_matches_an_independent_event_loop(ref):
     """Lift-offs and re-contacts of the compiled run = an independent solve_ivp event loop on the symbolic equations."""
     params = _params()
     t_end = 0.1025
-    tr = simulate(None, params, t_end, perturbation=[2e-3, 0], rtol=1e-11, events="continue", contact="unilateral")
+    tr = simulate(params, t_end, perturbation=[2e-3, 0], rtol=1e-11, events="continue", contact="unilateral")
     assert tr.status == "finished"
     got = sorted((t, name) for name, ts in tr.event_times.items() for t in ts if "sliding" not in name)
     t_end = float(tr.t[-1])  # the last output sample
@@ -144,9 +144,9 @@ def test_acting_normal_force_and_duty_cycle():
     """F_n >= 0 always; the samples of a lifted pad have F_n = 0; the bilateral run with stop ends at the first
     lift-off; the duty cycle is the fraction of pressed samples; the state is continuous at a switch."""
     params = _params()
-    tr = simulate(None, params, 0.11, perturbation=[2e-3, 0], events="continue", contact="unilateral",
+    tr = simulate(params, 0.11, perturbation=[2e-3, 0], events="continue", contact="unilateral",
                   sample_rate=2e6)
-    stop = simulate(None, params, 0.11, perturbation=[2e-3, 0], sample_rate=2e6)
+    stop = simulate(params, 0.11, perturbation=[2e-3, 0], sample_rate=2e6)
     assert stop.status == "contact-loss"
     t_loss = min(min(v) for k, v in tr.event_times.items() if k.startswith("contact-loss"))
     assert abs(t_loss - stop.t_event) < 1e-9
@@ -167,10 +167,10 @@ def test_unilateral_stops_at_sliding_reversal_and_refuses_bad_options():
 
     params = _params()
     with pytest.raises(ParameterError, match="contact='unilateral' needs"):
-        simulate(None, params, 0.01, contact="unilateral", method="RK45")
+        simulate(params, 0.01, contact="unilateral", method="RK45")
     with pytest.raises(ParameterError, match="contact"):
-        simulate(None, params, 0.01, contact="sometimes")
-    tr = simulate(None, params, 0.5, perturbation=[2e-3, 0], contact="unilateral", events="stop")
+        simulate(params, 0.01, contact="sometimes")
+    tr = simulate(params, 0.5, perturbation=[2e-3, 0], contact="unilateral", events="stop")
     # the paper-fig2 cycle with mu = 1 reaches a sliding reversal (the model's validity ends) or finishes
     assert tr.status in ("sliding-reversal", "finished")
     if tr.status == "sliding-reversal":

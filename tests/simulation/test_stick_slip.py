@@ -19,7 +19,7 @@ from brakesqueal.cli import main
 from brakesqueal.errors import ParameterError
 from brakesqueal.model.friction import LAWS
 from brakesqueal.model.options import MAX_STICK_SPEED, regularised_pads
-from brakesqueal.simulation import simulate
+from brakesqueal import simulate
 
 #: paper-fig3 with soft pads (a pad's sliding reverses on the cycles; docs/nonlinear.md)
 SETS = ["mu1=0.5", "mu2=0.5", "k_ip1=1e6", "k_ip2=1e6"]
@@ -64,7 +64,7 @@ def test_stick_speed_needs_pad_slope_on_the_command_line(capsys):
 
 def _run(vs, omega, t_end, perturbation):
     space = resolve_space(preset="paper-fig3", sets=[*SETS, f"Omega={omega}"])
-    return simulate(None, regularised_pads(space, SLOPE, vs).resolve({}), t_end, perturbation=perturbation,
+    return simulate(regularised_pads(space, SLOPE, vs).resolve({}), t_end, perturbation=perturbation,
                     events="continue", sample_rate=200_000.0)
 
 
@@ -117,7 +117,7 @@ def test_the_pad_solve_converges_from_any_warm_start(vs):
     from any start.  Random states (tilts, tilt rates up to the kick above, pad deformations) and random warm
     starts; each returned rate is checked by evaluating the balance again: the remaining Newton step is within
     the solve's tolerance and the balance changes sign across the root."""
-    from brakesqueal.simulation import simulation_model
+    from brakesqueal import simulation_model
 
     space = regularised_pads(resolve_space(preset="paper-fig3", sets=[*SETS, "Omega=10"]), SLOPE, vs)
     params = space.resolve({})
@@ -154,15 +154,15 @@ def test_with_stick_slip_events_stop_only_at_contact_loss(method):
     t_end = 0.002
     kick = [0.0, 0.0, 30.0, 0.0, 0.0, 0.0]  # F_n stays above 850 N
     if method == "DOP853-jit":  # (solve_ivp checks events at its step ends only and misses these brief dips)
-        plain = simulate(None, regularised_pads(space, SLOPE).resolve({}), t_end, perturbation=kick)
+        plain = simulate(regularised_pads(space, SLOPE).resolve({}), t_end, perturbation=kick)
         assert plain.status == "sliding-reversal" and plain.t_event < t_end
-        stick = simulate(None, regularised_pads(space, SLOPE, 1e-3).resolve({}), t_end, perturbation=kick)
+        stick = simulate(regularised_pads(space, SLOPE, 1e-3).resolve({}), t_end, perturbation=kick)
         assert stick.status == "finished" and not stick.event_times
     lift = [0.0, 0.0, 60.0, 0.0, 0.0, 0.0]  # the tilt reaches 5.5e-3 rad: a pad's F_n falls through 0 at 70 us
-    ref = simulate(None, regularised_pads(space, SLOPE).resolve({}), t_end, perturbation=lift, method=method,
+    ref = simulate(regularised_pads(space, SLOPE).resolve({}), t_end, perturbation=lift, method=method,
                    events="continue")
     t_loss = min(v[0] for k, v in ref.event_times.items() if k.startswith("contact-loss"))
-    tr = simulate(None, regularised_pads(space, SLOPE, 1e-3).resolve({}), t_end, perturbation=lift, method=method)
+    tr = simulate(regularised_pads(space, SLOPE, 1e-3).resolve({}), t_end, perturbation=lift, method=method)
     assert tr.status == "contact-loss" and tr.t_event == pytest.approx(t_loss, rel=1e-5)
     # as F_n -> 0 the friction can no longer hold the pad's spring: it slips forward (a true reversal),
     # which is recorded and passed (a second turn located at the contact loss itself, where F_n = 0 leaves the pad

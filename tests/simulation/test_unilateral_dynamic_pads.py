@@ -22,7 +22,7 @@ from scipy.optimize import brentq
 
 from brakesqueal.errors import ParameterError
 from brakesqueal.model.options import regularised_pads, resolve_space
-from brakesqueal.simulation import simulate, simulation_model
+from brakesqueal import simulate, simulation_model
 
 SETS = ["mu1=0.5", "mu2=0.5", "k_ip1=1e6", "k_ip2=1e6"]
 
@@ -37,14 +37,14 @@ def case():
     modes = sim.linear_modes(params)
     v = np.real(modes.right[:, 0])
     x0 = st.y + 5e-3 * v / np.abs(v[:2]).max()  # a tilt of 5 mrad along the leading mode: F_n swings by ~3 kN
-    tr = simulate(sim, params, 3e-4, x0=x0, contact="bilateral", events="off", sample_rate=1e8)
+    tr = simulate(params, 3e-4, x0=x0, contact="bilateral", events="off", sample_rate=1e8)
     return sim, params, st, x0, tr
 
 
 def test_unilateral_contact_refuses_dynamic_pads_and_names_them(case):
     sim, params, st, x0, _tr = case
     with pytest.raises(ParameterError, match=r"needs a tangential damper d_ip > 0 .*\(l1, l2, rate-dependent friction\).*dG/dldot"):
-        simulate(sim, params, 1e-3, x0=x0, contact="unilateral", events="continue")
+        simulate(params, 1e-3, x0=x0, contact="unilateral", events="continue")
 
 
 def _G(sim, p, y, l, dl, j):

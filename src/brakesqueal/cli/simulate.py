@@ -152,10 +152,11 @@ def _simulate_cmd(
 
 def _run(p: Parameters, t_end: float, method: str, rtol: float, atol: float | None, events: str, sample_rate: float,
          progress: bool, no_cache: bool, init: dict[str, Any]) -> Trajectory:
-    from ..simulation import simulate, simulation_model
+    from ..codegen import build
     from ..interrupts import check_interrupt
+    from ..simulation import simulate, simulation_model
 
-    sim = simulation_model(p.model, use_cache=not no_cache)
+    sim = simulation_model(build(p.model, use_cache=not no_cache), use_cache=not no_cache)  # the entry point's engine
     check_interrupt()
     from ._progress import progress as _progress
 

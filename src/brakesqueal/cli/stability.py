@@ -13,7 +13,7 @@ import json
 import math
 import sys
 from enum import Enum
-from typing import TYPE_CHECKING, Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Any, Optional
 
 import typer
 
@@ -92,7 +92,7 @@ def _write_crossings(r: CrossingResult, space: ParameterSpace, axis: Axis, fmt: 
     if not hopf:
         sys.stdout.write(json.dumps(r.to_dict(), indent=2) + "\n" if fmt == OutFormat.json else r.text())
         return
-    from ..nonlinear.models import hopf_points
+    from ..api_nonlinear import hopf_points
 
     pts = hopf_points(space, axis, result=r)
     if fmt == OutFormat.json:
@@ -252,15 +252,17 @@ def hopf(
     fmt: FormatOpt = OutFormat.text, pad_damping: PadDampingOpt = None,
 ) -> None:
     """Hopf criticality at every stability crossing on a path: l1, sub/supercritical, predicted cycle amplitude."""
+    from ..analysis.crossings import crossings as _crossings
     from ..analysis.maps import parse_axis
-    from ..api import crossings as _crossings
+    from ..codegen import build
     from ..nonlinear.models import hopf_points
 
     axis = parse_axis(along, with_num=False)
     refuse_set_of_axes(set_, {axis.name: "--along"})
     space = pads_option(space_from(model, preset, params, set_), None, None, pad_damping)
-    r: CrossingResult = _crossings(space, axis)
-    pts = hopf_points(space, axis, result=r)
+    engine = build(space.model)  # the entry point's engine, passed down
+    r: CrossingResult = _crossings(engine, space, axis)
+    pts = hopf_points(engine, space, axis, result=r)
     if fmt == OutFormat.json:
         d = r.to_dict()
         d["crossings"] = [hp.to_dict() for hp in pts]
@@ -304,8 +306,9 @@ def cycles(
 ) -> None:
     """Limit cycles from the first Hopf point on a path: amplitude, frequency, stability, where a pad lifts off."""
     from ..analysis.maps import parse_axis
-    from ..nonlinear.models import PAD_TREATMENTS, cycle_route, squeal_branch
-    from ..outputs import atomic_write, check_output
+    from ..codegen import build
+    from ..nonlinear.models import PAD_TREATMENTS, cycle_route, limit_cycles
+    from ..outputs import check_output
 
     axis = parse_axis(along, with_num=False)
     refuse_set_of_axes(set_, {axis.name: "--along"})
@@ -321,19 +324,46 @@ def cycles(
                              "(they keep the pads' rates)")
     base = space_from(model, preset, params, set_)
     space = pads_option(base, pad_slope, stick_speed, pad_damping)  # checked before anything is computed
-    if cycle_route(space, axis, contact=contact, pads=pads) == "harmonic balance":
-        _cycles_exact_pads(axis, base, fmt=fmt, max_points=max_points, harmonics=harmonics,
-                           max_harmonics=max_harmonics, contact=contact, pad_slope=pad_slope,
-                           stick_speed=stick_speed, pad_damping=pad_damping, plot=plot, out=out, progress=progress)
-        return
+    route = cycle_route(space, axis, contact=contact, pads=pads)
+    options: dict[str, Any] = {}
+    if route == "harmonic balance":
+        for flag, bad in (("--contact unilateral", contact != "bilateral"), ("--pad-slope", pad_slope is not None),
+                          ("--stick-speed", stick_speed is not None)):
+            if bad:
+                raise ParameterError(f"The option '--pads exact' (or --exact-pads) cannot be combined with {flag} "
+                                     "(the exact pads are bilateral and unregularised)")
+        if max_harmonics < harmonics:
+            raise ParameterError(f"The option '--max-harmonics' must be >= --harmonics = {harmonics}; got "
+                                 f"{max_harmonics}")
+        options = {"harmonics": harmonics, "max_harmonics": max_harmonics}
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
     if out:
         check_output(out, what="--out", suffixes=(".nc",))
     from ._progress import progress as _progress
 
-    with _progress("cycles", progress) as cb:
-        b = squeal_branch(space, axis, max_points=max_points, contact=contact, progress=cb)
+    engine = build(space.model)  # the entry point's engine, passed down
+    title = "cycles (harmonic balance)" if route == "harmonic balance" else "cycles"
+    with _progress(title, progress) as cb:
+        b = limit_cycles(engine, space, axis, contact=contact, pads=pads, max_points=max_points, progress=cb,
+                         **options)
+    if route == "harmonic balance":
+        _write_harmonic(b, axis, fmt=fmt, plot=plot, out=out)
+    else:
+        _write_shooting(b, axis, fmt=fmt, plot=plot, out=out)
+
+
+def _write_branch_data(ds: Any, out: str) -> None:
+    """The branch's Dataset as NetCDF (``--out``; strings as bytes for the scipy engine), written atomically."""
+    from ..outputs import atomic_write
+
+    ds = ds.assign_coords(coord=ds["coord"].astype("S"), pad=ds["pad"].astype("S"))
+    with atomic_write(out, what="--out") as tmp:
+        ds.to_netcdf(str(tmp), engine="scipy")
+
+
+def _write_shooting(b: Any, axis: Any, *, fmt: OutFormat, plot: str | None, out: str | None) -> None:
+    """``cycles`` by shooting: text or JSON, ``--out`` NetCDF, ``--plot`` bifurcation diagram."""
     if out:
         ds = b.data.copy()
         ds.attrs = {k: (json.dumps(v) if isinstance(v, (dict, list, tuple)) or v is None else v)
@@ -341,9 +371,7 @@ def cycles(
         for k in ("label", "special_kind", "special_description"):
             if k in ds:
                 ds[k] = ds[k].astype("S")
-        ds = ds.assign_coords(coord=ds["coord"].astype("S"), pad=ds["pad"].astype("S"))
-        with atomic_write(out, what="--out") as tmp:
-            ds.to_netcdf(str(tmp), engine="scipy")
+        _write_branch_data(ds, out)
     if plot:
         _write_plot(b.plot(), plot)
     d = b.to_dict()
@@ -371,38 +399,11 @@ def cycles(
     sys.stdout.write("\n".join(lines) + "\n" + summary)
 
 
-def _cycles_exact_pads(axis: Axis, space: ParameterSpace, *, fmt: OutFormat, max_points: int, harmonics: int,
-                       max_harmonics: int, contact: str, pad_slope: float | None, stick_speed: float | None,
-                       pad_damping: float | None, plot: str | None, out: str | None,
-                       progress: bool | None = None) -> None:
-    """``cycles --exact-pads``: the harmonic-balance branch of the implicit equations (text or JSON, ``--out``
-    NetCDF, ``--plot`` bifurcation diagram)."""
-    from ..nonlinear.harmonic import harmonic_branch
-
-    from ..outputs import atomic_write, check_output
-
-    for flag, bad in (("--contact unilateral", contact != "bilateral"), ("--pad-slope", pad_slope is not None),
-                      ("--stick-speed", stick_speed is not None)):
-        if bad:
-            raise ParameterError(f"The option '--pads exact' (or --exact-pads) cannot be combined with {flag} (the "
-                                 "exact pads are bilateral and unregularised)")
-    space = pads_option(space, None, None, pad_damping)  # a damper is part of the model: balanced exactly too
-    if max_harmonics < harmonics:
-        raise ParameterError(f"The option '--max-harmonics' must be >= --harmonics = {harmonics}; got {max_harmonics}")
-    if plot:
-        check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
+def _write_harmonic(b: Any, axis: Any, *, fmt: OutFormat, plot: str | None, out: str | None) -> None:
+    """``cycles`` by harmonic balance (exact pads): text or JSON, ``--out`` NetCDF, ``--plot`` bifurcation
+    diagram."""
     if out:
-        check_output(out, what="--out", suffixes=(".nc",))
-    from ._progress import progress as _progress
-
-    with _progress("cycles (harmonic balance)", progress) as cb:
-        b = harmonic_branch(space, axis, max_points=max_points, harmonics=harmonics, max_harmonics=max_harmonics,
-                            progress=cb)
-    if out:
-        ds = b.data
-        ds = ds.assign_coords(coord=ds["coord"].astype("S"), pad=ds["pad"].astype("S"))
-        with atomic_write(out, what="--out") as tmp:
-            ds.to_netcdf(str(tmp), engine="scipy")
+        _write_branch_data(b.data, out)
     if plot:
         _write_plot(b.plot(), plot)
     if fmt == OutFormat.json:

@@ -69,7 +69,6 @@ GENERATOR_MODULES: tuple[str, ...] = (
     "model/friction.py",  # friction laws: their formulas enter the equations
     "model/expressions.py",  # ties as SymPy enter cached kernels (the characteristic polynomial of a space)
     "analysis/_compiled.py",  # numba root isolation linked with the stability kernels
-    "simulation/_kernels.py",  # simulation kernels and their static template
     "export/*.py",  # exported code and LaTeX
     "render.py",  # the rendered closed forms cached by ``derive``
     "nonlinear/*.py",  # compiled flows of the continuation (numba) and what they import

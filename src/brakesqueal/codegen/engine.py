@@ -390,6 +390,31 @@ class Engine:
         return Engine(spec=spec, key=self.key, compiled=cm2, caps=self.caps, use_cache=self.use_cache,
                       _memo=self._memo)
 
+    # ---------------------------------------------------------------- simulation kernels (generated)
+    def simulation_kernels(self, variational: bool = False, use_cache: bool = True) -> types.ModuleType:
+        """The model's compiled simulation kernels (:mod:`.simulation`; numba compiles them on first use).
+
+        Parameters
+        ----------
+        variational : bool, optional
+            The variational module instead (the vector field with its exact Jacobian ``nl_f``, ``nl_jac``,
+            ``nl_dfdp``, and every kernel).
+        use_cache : bool, optional
+            Read and write the on-disk cache.
+
+        Returns
+        -------
+        module
+            ``rhs``, ``solve_pads``, ``event_values``, ``contact``, ``energy``, ``post_process``, ``dop853``,
+            ``META`` (pad treatment :attr:`caps.treatment <Capabilities.treatment>`).
+        """
+        from .simulation import load_kernels
+
+        def make() -> Any:
+            return load_kernels(self, variational=variational, use_cache=use_cache)
+
+        return self._get(("simulation", variational, use_cache), make)  # type: ignore[no-any-return]
+
 
 _ENGINES: dict[tuple[str, bool], Engine] = {}
 _MAX_ENGINES = 64

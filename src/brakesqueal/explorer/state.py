@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -34,7 +34,8 @@ if TYPE_CHECKING:
     from ..model.components import ModelSpec
     from ..model.parameters import ParameterSpace
     from ..nonlinear.harmonic import HarmonicBranch
-    from ..nonlinear.models import HopfPoint, SquealBranch
+    from ..nonlinear.models import HopfPoint
+    from ..nonlinear.squeal import SquealBranch
     from ..results import CriticalSpeedResult, StabilityMap
     from ..simulation.trajectory import Trajectory
 
@@ -483,7 +484,7 @@ def hopf_scan(space: ParameterSpace, along: str, rng: SliderRange) -> list[HopfP
     """Every Hopf point along the path (:func:`~brakesqueal.nonlinear.models.hopf_points`), or why not (a line)."""
     from ..analysis.maps import Axis
     from ..errors import BrakesquealError
-    from ..nonlinear.models import hopf_points
+    from ..api_nonlinear import hopf_points
 
     try:
         return list(hopf_points(space, Axis(along, rng.low, rng.high, 2, rng.log)))
@@ -591,10 +592,10 @@ def simulation_view(space: ParameterSpace, t_end: float, *,
     SilentMotionError
         If the silent motion does not exist.
     """
-    from ..simulation import simulate
+    from ..api_nonlinear import simulate
 
     check_t_end(t_end)
-    tr: Trajectory = simulate(None, space.resolve({}), float(t_end), sample_rate=float(AUDIO_RATE), progress=progress)
+    tr: Trajectory = simulate(space.resolve({}), float(t_end), sample_rate=float(AUDIO_RATE), progress=progress)
     dq = tr.dq[:, 0]
     t, x = _decimate(np.asarray(tr.t, dtype=float), np.asarray(dq, dtype=float), HISTORY_POINTS)
     if tr.t.size >= 16:
@@ -762,18 +763,13 @@ def cycles_view(space: ParameterSpace, along: str, rng: SliderRange, *,
         No Hopf point with a cycle prediction on the path, or ``progress`` not callable.
     """
     from ..analysis.maps import Axis
-    from ..nonlinear.models import cycle_route, squeal_branch
+    from ..api_nonlinear import limit_cycles
+    from ..nonlinear.models import cycle_route
 
     axis = Axis(along, rng.low, rng.high, 2, rng.log)
     harmonic = cycle_route(space, axis) == "harmonic balance"
-    if harmonic:
-        from ..nonlinear.harmonic import harmonic_branch
-
-        # bounded: an interactive view
-        br: HarmonicBranch | SquealBranch = harmonic_branch(space, axis, max_points=25, max_harmonics=40,
-                                                            progress=progress)
-    else:
-        br = squeal_branch(space, axis, progress=progress)
+    bounded: dict[str, Any] = {"max_points": 25, "max_harmonics": 40} if harmonic else {}  # an interactive view
+    br: HarmonicBranch | SquealBranch = limit_cycles(space, axis, progress=progress, **bounded)
     s = br.summary
     rows = list(s.table) if s is not None else []
     p = np.array([float(r["p"]) for r in rows])

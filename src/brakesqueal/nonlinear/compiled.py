@@ -10,10 +10,11 @@ The vector field is given as three numba functions with fixed signatures
 ``p`` is the continuation parameter and ``theta`` a fixed float64 vector of the other model
 parameters (e.g. the vector the simulation kernels take), given once to :func:`compiled_system`.
 
-The integrator kernel (:mod:`._dop853`, same coefficients, error norm and
-step-size control as SciPy's ``DOP853``) takes them as first-class functions,
-so it is compiled once per machine and cached by numba; each system only
-compiles its own three small functions.  :func:`compiled_system` wraps the
+The integrator kernel (:func:`brakesqueal.codegen.simulation.flow_kernel`: the
+one DOP853 step of the package, SciPy's coefficients, error norm and
+step-size control, shared with the simulation) takes them as first-class
+functions, so it is compiled once per machine and cached by numba; each
+system only compiles its own three small functions.  :func:`compiled_system` wraps the
 kernels into a :class:`~.system.SmoothSystem` (Python callables, used by
 :func:`~.hopf.first_lyapunov`), and :class:`CompiledFlow` implements the
 :class:`~.flow.Flow` protocol for shooting and continuation.  Switching
@@ -25,16 +26,27 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
+from numba import types
+
 from ..errors import ParameterError
-from ._dop853 import F_SIGNATURE, JAC_SIGNATURE, dop853
 from .flow import FlowError, FlowResult
 from .system import SmoothSystem
 
+if TYPE_CHECKING:
+    from ..codegen.engine import Engine
+    from ..model.parameters import ParameterSpace
+
 __all__ = ["CompiledFlow", "compiled_system", "model_flow", "F_SIGNATURE", "JAC_SIGNATURE"]
+
+#: ``f(x, p, theta, out)`` and ``dfdp(x, p, theta, out)``: ``x``, ``theta`` (fixed model parameters) and
+#: ``out`` C-contiguous float64 vectors, ``p`` the continuation parameter.
+F_SIGNATURE = types.void(types.float64[::1], types.float64, types.float64[::1], types.float64[::1])
+#: ``jac(x, p, theta, out)`` with ``out`` a C-contiguous float64 ``(n, n)`` matrix.
+JAC_SIGNATURE = types.void(types.float64[::1], types.float64, types.float64[::1], types.float64[:, ::1])
 
 
 def compiled_system(f: Any, jac: Any, dfdp: Any, n: int, theta: Any = (), **kwargs: Any) -> SmoothSystem:
@@ -102,6 +114,8 @@ class CompiledFlow:
     theta_of : callable, optional
         ``theta_of(p) -> ndarray``: the kernels' ``theta`` at the parameter ``p`` (instead of the fixed
         ``theta``; e.g. :func:`model_flow`, where ``theta`` holds the whole parameter vector at ``p``).
+    use_cache : bool
+        Keep the integrator's machine code in the on-disk code cache.
     """
 
     system: SmoothSystem
@@ -111,6 +125,7 @@ class CompiledFlow:
     atol: Any = None
     max_steps: int = 1_000_000
     theta_of: Callable[[float], np.ndarray] | None = None
+    use_cache: bool = True
 
     def __post_init__(self) -> None:
         if not isinstance(self.system, SmoothSystem):
@@ -125,7 +140,9 @@ class CompiledFlow:
         self.theta = np.ascontiguousarray(np.asarray(th, dtype=float).ravel())
         if not (isinstance(self.rtol, (int, float)) and 1e-13 <= self.rtol <= 1e-3):
             raise ParameterError(f"The option 'rtol' must be in [1e-13, 1e-3]; got {self.rtol!r}")
-        self._kernel = dop853
+        from ..codegen.simulation import flow_kernel
+
+        self._kernel = flow_kernel(self.use_cache).dop853
 
     @property
     def method(self) -> str:
@@ -194,8 +211,8 @@ class CompiledFlow:
         )  # fmt: skip
 
 
-def model_flow(space: Any, name: str, *, system: SmoothSystem | None = None, use_cache: bool = True,
-               rtol: float = 1e-11) -> CompiledFlow:
+def model_flow(engine: Engine, space: ParameterSpace, name: str, *, system: SmoothSystem | None = None,
+               use_cache: bool = True, rtol: float = 1e-11) -> CompiledFlow:
     """The compiled flow of a brake model with its exact, generated Jacobian (variational equations in numba).
 
     The vector field, its Jacobian and its parameter derivative are the model's generated kernels
@@ -208,12 +225,14 @@ def model_flow(space: Any, name: str, *, system: SmoothSystem | None = None, use
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine (built by the caller).
     space : ParameterSpace
         The model, preset and overrides.
     name : str
         The continuation parameter (settable in ``space``).
     system : SmoothSystem, optional
-        The system the flow belongs to (default :func:`~.models.model_system` ``(space, name)``).
+        The system the flow belongs to (default :func:`~.models.model_system` ``(engine, space, name)``).
     use_cache : bool
         Use the on-disk code cache.
     rtol : float
@@ -228,9 +247,8 @@ def model_flow(space: Any, name: str, *, system: SmoothSystem | None = None, use
     from .models import model_system
 
     if system is None:
-        system = model_system(space, name, use_cache=use_cache)
-    params0 = space.resolve({})
-    sim = simulation_model(params0.model, use_cache=use_cache)
+        system = model_system(engine, space, name, use_cache=use_cache)
+    sim = simulation_model(engine, use_cache=use_cache)
     mod = sim.variational_kernels()
     cache: dict[float, np.ndarray] = {}
 
@@ -252,4 +270,4 @@ def model_flow(space: Any, name: str, *, system: SmoothSystem | None = None, use
         return th
 
     return CompiledFlow(system, kernels=(mod.nl_f, mod.nl_jac, mod.nl_dfdp), theta=np.empty(0), rtol=rtol,
-                        theta_of=theta_of)
+                        theta_of=theta_of, use_cache=use_cache)

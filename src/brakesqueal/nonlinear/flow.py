@@ -50,6 +50,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from collections.abc import Callable
 from typing import Any, Literal, Protocol
 
 import numpy as np
@@ -320,7 +321,7 @@ class ScipyFlow:
                 jac_opt["jac"] = _jac_failing(
                     (lambda _t, yy, _m=msys: augmented_jacobian(_m, yy, p, coupling=full)) if sens
                     else (lambda _t, yy, _m=msys: _m.jacobian(yy, p)))
-            evs = []
+            evs: list[Callable[..., float]] = []
             dirs = [float(start_dirs.get(i, tr.direction)) for i, tr in enumerate(trans)]
             # a guard that is zero at the segment start (just after an event) would report a root there:
             # its event function is shifted by a tiny bias to the side the flow leaves to, and the true
@@ -331,7 +332,7 @@ class ScipyFlow:
                 w = 1e-8 * float(np.sum(np.abs(tr.grad(xs0, p)) * np.maximum(np.abs(xs0), sref)))
                 bias.append(w if abs(float(tr.guard(xs0, p))) <= 1e-2 * w else 0.0)
             for i, tr in enumerate(trans):
-                def ev(_t: float, yy: np.ndarray, _tr=tr, _b=-dirs[i] * bias[i]) -> float:
+                def ev(_t: float, yy: np.ndarray, _tr: Transition = tr, _b: float = -dirs[i] * bias[i]) -> float:
                     return float(_tr.guard(yy[:n], p)) + _b
                 ev.terminal = True  # type: ignore[attr-defined]
                 ev.direction = dirs[i]  # type: ignore[attr-defined]
@@ -339,7 +340,7 @@ class ScipyFlow:
             # extrema of each guard (dh/dt = 0): a crossing in and out within one step is missed by the
             # sign test; it is found afterwards from the extremum's sign and the dense output
             for i, tr in enumerate(trans):
-                def ext(_t: float, yy: np.ndarray, _tr=tr, _m=msys) -> float:
+                def ext(_t: float, yy: np.ndarray, _tr: Transition = tr, _m: SmoothSystem = msys) -> float:
                     xx = yy[:n]
                     return float(_tr.grad(xx, p) @ _m.rhs(xx, p))
                 ext.terminal = False  # type: ignore[attr-defined]
@@ -455,10 +456,10 @@ def _true_root(sol: Any, tr: Transition, direction: float, n: int, p: float, t0:
     hfun = lambda tq: float(tr.guard(sol.sol(tq)[:n], p))  # noqa: E731
     ts = np.linspace(t0, te, 65)[1:]
     hs = np.array([hfun(tq) for tq in ts])
-    j = np.flatnonzero(hs * side0 > 0)
-    if j.size == 0 or j[-1] + 1 >= ts.size:
+    idx = np.flatnonzero(hs * side0 > 0)
+    if idx.size == 0 or idx[-1] + 1 >= ts.size:
         return te
-    j = int(j[-1])
+    j = int(idx[-1])
     if hs[j + 1] * side0 > 0:  # pragma: no cover - the biased event lies past the true root
         return te
     return float(brentq(hfun, ts[j], ts[j + 1], xtol=4 * np.finfo(float).eps * max(1.0, abs(te))))
@@ -488,10 +489,10 @@ def _missed_crossing(sol: Any, trans: tuple, dirs: list[float], n: int, p: float
                 continue
             ts = np.linspace(prev, tm, 33)
             hs = np.array([float(tr.guard(sol.sol(tq)[:n], p)) for tq in ts])
-            j = np.flatnonzero(hs * side0 > 0)
-            if j.size == 0:
+            idx = np.flatnonzero(hs * side0 > 0)
+            if idx.size == 0:
                 break
-            j = int(j[-1])
+            j = int(idx[-1])
             hfun = lambda tq: float(tr.guard(sol.sol(tq)[:n], p))  # noqa: E731
             tc = brentq(hfun, ts[j], ts[j + 1], xtol=4 * np.finfo(float).eps * max(1.0, abs(tm)))
             if best is None or tc < best[0]:

@@ -43,11 +43,18 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import BrakesquealError, ParameterError
+
+if TYPE_CHECKING:
+    from ..analysis.maps import Axis
+    from ..codegen.engine import Engine
+    from ..model.parameters import ParameterSpace
+    from ..simulation import SimulationModel
+    from .implicit import PadHopf
 
 __all__ = ["HarmonicPoint", "HarmonicBranch", "harmonic_branch", "pad_mode_rates", "hill_accuracy"]
 
@@ -226,7 +233,7 @@ class HarmonicBranch:
         (the first orbit with a verdict after the turn is stable; right at the fold an exponent crosses 0 and the
         orbits have no verdict), here only if the branch is valid up to there.
         """
-        from .models import SquealSummary
+        from .squeal import SquealSummary
 
         h = self.hopf.hopf
         pts = self.points
@@ -399,8 +406,10 @@ def _basis(theta: np.ndarray, H: int, order: int) -> np.ndarray:
 class _Balance:
     """The harmonic-balance equations of one model with ``H`` harmonics."""
 
-    def __init__(self, space: Any, name: str, cm: Any, H: int, ref: int, scale: np.ndarray) -> None:
-        self.space, self.name, self.cm = space, name, cm
+    def __init__(self, space: ParameterSpace, name: str, sim: SimulationModel, H: int, ref: int,
+                 scale: np.ndarray) -> None:
+        cm = sim.compiled
+        self.space, self.name, self.sim, self.cm = space, name, sim, cm
         self.n, self.m = cm.n, cm.m
         self.N = self.n + self.m
         self.ref, self.scale = ref, scale
@@ -418,12 +427,8 @@ class _Balance:
 
     def pvec(self, p: float) -> list[float]:
         if p not in self._pv:
-            from ..simulation import simulation_model
-
             params = self.space.resolve({self.name: float(p)})
-            if not hasattr(self, "_sim"):
-                self._sim = simulation_model(params.model)
-            self._pv = {p: [float(v) for v in self._sim.parameter_vector(params)]}
+            self._pv = {p: [float(v) for v in self.sim.parameter_vector(params)]}
         return self._pv[p]
 
     def states(self, C: np.ndarray, omega: float, E: list[np.ndarray]) -> list[np.ndarray]:
@@ -537,16 +542,15 @@ class _Continuation:
         return t / np.linalg.norm(t)
 
 
-def _first_hopf(space: Any, axis: Any, use_cache: bool) -> Any:
+def _first_hopf(engine: Engine, space: ParameterSpace, axis: Axis, use_cache: bool) -> PadHopf:
     from ..analysis.crossings import crossings
-    from ..simulation import simulation_model
     from .implicit import exact_lyapunov
 
-    r = crossings(simulation_model(space.resolve({}).model, use_cache=use_cache).engine, space, axis)
+    r = crossings(engine, space, axis)
     errors = []
     for value, _direction in r.crossings:  # type: ignore[attr-defined]
         try:
-            ex = exact_lyapunov(space, axis.name, float(value), use_cache=use_cache)
+            ex = exact_lyapunov(engine, space, axis.name, float(value), use_cache=use_cache)
         except (BrakesquealError, np.linalg.LinAlgError) as exc:
             errors.append(f"{value:.10g}: {exc}")
             continue
@@ -557,7 +561,7 @@ def _first_hopf(space: Any, axis: Any, use_cache: bool) -> Any:
                          f"({axis.start:g}, {axis.stop:g}){extra}; see brakesqueal hopf")
 
 
-def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics: int = 60,
+def harmonic_branch(engine: Engine, space: ParameterSpace, axis: Axis, *, harmonics: int = 6, max_harmonics: int = 60,
                     max_points: int = 40, harmonic_tol: float = 1e-6, tol: float = 1e-10,
                     ds: float = 0.05, ds_max: float = 0.2, start_offset: float = 1e-4,
                     stability: bool = True, use_cache: bool = True,
@@ -567,6 +571,8 @@ def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics:
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine (built by the caller; :func:`brakesqueal.harmonic_branch` builds it).
     space : ParameterSpace
         The model, preset and overrides (any model).
     axis : Axis
@@ -634,11 +640,11 @@ def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics:
         space.resolve({axis.name: axis.start})  # the one message for unknown or tied names
     for bound in (axis.start, axis.stop):
         space.resolve({axis.name: float(bound)})  # ParameterError naming the parameter and its range
-    ex = _first_hopf(space, axis, use_cache)
+    ex = _first_hopf(engine, space, axis, use_cache)
     h = ex.hopf
     from .implicit import _Point, _vectors
 
-    sim = simulation_model(space.resolve({}).model, use_cache=use_cache)
+    sim = simulation_model(engine, use_cache=use_cache)
     pt = _Point(space, sim, axis.name, h.p0)
     cm = pt.cm
     n = cm.n
@@ -658,7 +664,7 @@ def harmonic_branch(space: Any, axis: Any, *, harmonics: int = 6, max_harmonics:
     phi = phi * (abs(phi[ref]) / phi[ref])  # the reference's first harmonic a cosine: b_1 = 0
     coords = tuple(cm.coords) + tuple(cm.algebraic)
     pads = tuple(p.name for p in space.resolve({}).model.pads)
-    bal = _Balance(space, axis.name, cm, harmonics, ref, scale)
+    bal = _Balance(space, axis.name, sim, harmonics, ref, scale)
     cont = _Continuation(bal, h.omega0, dist, tol)
     K = bal.K
 
@@ -860,7 +866,7 @@ def _truncation(C: np.ndarray, scale: np.ndarray, H: int) -> float:
     return float(np.max(top / np.maximum(den, 1e-300)))
 
 
-def _make_point(bal: _Balance, sim: Any, C: np.ndarray, omega: float, p: float, err: float,
+def _make_point(bal: _Balance, sim: SimulationModel, C: np.ndarray, omega: float, p: float, err: float,
                 coords: tuple[str, ...], stability: bool) -> HarmonicPoint:
     cm, n = bal.cm, bal.n
     H = bal.H
@@ -992,9 +998,7 @@ def _hill(bal: _Balance, C: np.ndarray, omega: float, p: float) -> tuple[np.ndar
     # unstable whatever the band says; too few exponents in the band: no verdict.  Only pads with a
     # rate-dependent law are judged: a Coulomb pad's dG/dldot = c dF/dldot >= 0 (the friction force is monotone
     # in the sliding velocity), its mode is stable, and near w = 0 its dG/dldot is at rounding level (any sign)
-    from ..simulation import simulation_model
-
-    judged = np.array([k == "dynamic" for k in simulation_model(bal.space.resolve({}).model).pad_kinds], dtype=bool)
+    judged = np.array([k == "dynamic" for k in bal.sim.pad_kinds], dtype=bool)
     if judged.size == m and np.any(pad_mode_rates(J, n, m)[judged] > 0):
         return rest, False, trivial
     delta = hill_accuracy(omega, trivial)
@@ -1082,7 +1086,7 @@ def hill_accuracy(omega: float, trivial: float) -> float:
     return max(1e3 * abs(trivial), 1e-6 * abs(omega))
 
 
-def _locate(bal: _Balance, cont: _Continuation, sim: Any, coords: tuple[str, ...], Pa: HarmonicPoint,
+def _locate(bal: _Balance, cont: _Continuation, sim: SimulationModel, coords: tuple[str, ...], Pa: HarmonicPoint,
             Pb: HarmonicPoint, ya: np.ndarray, yb: np.ndarray, which: int, fixed_p: Any, adapt: Any,
             stability: bool, tick: Callable[[], None] | None = None) -> tuple[float, HarmonicPoint]:
     """Where indicator ``which`` (0: smallest F_n, 1: sliding margin) reaches 0 between two orbits (Illinois).

@@ -57,13 +57,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import BrakesquealError, ParameterError
 from .hopf import HopfResult, _skeel, hopf_result
 from .system import EPS, H_FIRST, H_SECOND, fd_bilinear, fd_trilinear, step_plateau
+
+if TYPE_CHECKING:
+    from ..codegen.engine import Engine
+    from ..model.parameters import ParameterSpace
+    from ..simulation import SimulationModel
 
 __all__ = ["PadHopf", "exact_lyapunov"]
 
@@ -98,7 +103,7 @@ class PadHopf:
 class _Point:
     """The implicit equations at one parameter value: silent motion, Jacobian, exact linear model."""
 
-    def __init__(self, space: Any, sim: Any, name: str, p: float) -> None:
+    def __init__(self, space: ParameterSpace, sim: SimulationModel, name: str, p: float) -> None:
         from ..analysis.equilibrium import silent_motion
         from ..analysis.linear import linearize
 
@@ -146,12 +151,14 @@ def _track(lams: np.ndarray, target: complex) -> complex:
     return complex(cand[np.argmin(np.abs(cand - target))])
 
 
-def exact_lyapunov(space: Any, name: str, p0: float, *, omega: float | None = None,
+def exact_lyapunov(engine: Engine, space: ParameterSpace, name: str, p0: float, *, omega: float | None = None,
                    use_cache: bool = True) -> PadHopf:  # fmt: skip
     """First Lyapunov coefficient at a stability crossing with the pads' true tangential dynamics.
 
     Parameters
     ----------
+    engine : Engine
+        The model's engine (built by the caller).
     space : ParameterSpace
         The model, preset and overrides (any model).
     name : str
@@ -184,7 +191,7 @@ def exact_lyapunov(space: Any, name: str, p0: float, *, omega: float | None = No
         space.resolve({name: 1.0})  # the one message for unknown or tied names
     if not math.isfinite(float(p0)):
         raise ParameterError(f"The parameter {name} must be finite; got {p0!r}")
-    sim = simulation_model(space.resolve({}).model, use_cache=use_cache)
+    sim = simulation_model(engine, use_cache=use_cache)
     pt = _Point(space, sim, name, float(p0))
     cand = pt.lm.eigenvalues[pt.lm.eigenvalues.imag > 0]
     if cand.size == 0:
@@ -254,7 +261,7 @@ def exact_lyapunov(space: Any, name: str, p0: float, *, omega: float | None = No
     return PadHopf(h, loss, rev, t_loss, t_rev)
 
 
-def _valid(space: Any, name: str, value: float | None) -> bool:
+def _valid(space: ParameterSpace, name: str, value: float | None) -> bool:
     """Whether ``value`` is an allowed value of the path parameter (bounds of the parameter table)."""
     if value is None:
         return False
@@ -323,7 +330,7 @@ def _c1(pt: _Point, w0: float, phi: np.ndarray, psi: np.ndarray,
     return c1, err, h20, h11, X1 * T
 
 
-def _events(pt: _Point, sim: Any, h: HopfResult, w0: float, X1: np.ndarray,
+def _events(pt: _Point, sim: SimulationModel, h: HopfResult, w0: float, X1: np.ndarray,
             phi: np.ndarray) -> tuple[float | None, float | None, float | None, float | None]:  # fmt: skip
     """Leading-order contact loss and sliding reversal on the predicted cycle (parameter values, tilts)."""
     if not h.side or not h.dRe_lambda_dp:

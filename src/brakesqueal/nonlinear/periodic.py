@@ -232,11 +232,15 @@ def _sampled(flow: Any, X: np.ndarray, T: float, p: float, scale: np.ndarray, n_
     With ``n_samples = 0`` the given ``flows`` only provide the events and the sample fields are empty.
     """
     m, n = X.shape
-    t_list, s_list, md_list, events = [], [], [], []
+    t_list: list[np.ndarray] = []
+    s_list: list[np.ndarray] = []
+    md_list: list[int] = []
+    events: list[Event] = []
     ns = -(-n_samples // m) if n_samples else 0
     for i in range(m):
         fr = flow(X[i], T / m, p, sensitivities=False, n_samples=ns, scale=scale) if ns else flows[i]  # type: ignore[index]
         if ns:
+            assert fr.t_samples is not None and fr.x_samples is not None  # asked for: n_samples > 0
             t_list.append(i * T / m + fr.t_samples)
             s_list.append(fr.x_samples)
             md_list.extend(fr.modes)
@@ -262,6 +266,7 @@ def _orbit_from(flow: Any, X: np.ndarray, T: float, p: float, ev: _Eval, scale: 
     n = X.shape[1]
     M = np.eye(n)
     for fr in ev.flows:
+        assert fr.monodromy is not None  # the Newton flows carry sensitivities
         M = fr.monodromy @ M
     f0 = _vector_field(system, X[0], p)
     lam, red, terr = floquet_multipliers(M, f0)

@@ -577,11 +577,11 @@ def matrix_pencil(
         raise ParameterError("the samples are all zero")
     H = H / scale
     if H.shape[0] > H.shape[1]:  # same singular values and right vectors, cheaper: SVD of the QR factor R
-        H = np.linalg.qr(H, mode="r")
+        H = np.asarray(np.linalg.qr(H, mode="r"))
     _, s, Vh = np.linalg.svd(H, full_matrices=False)
     if order is None:
         thr = max(rcond * s[0], 10.0 * float(np.median(s)))
-        m = int(min(max(np.count_nonzero(s > thr), 1), max_order, L))
+        m = min(max(int(np.count_nonzero(s > thr)), 1), max_order, L)
         nxt = np.append(s[1 : m + 1], thr)[:m] if m < s.size else np.append(s[1:m], thr)
         r = int(np.argmax(s[:m] / np.maximum(nxt, 1e-300))) + 1  # at the largest gap of the singular values
     else:
@@ -712,7 +712,7 @@ def dominant_mode(
     part = np.real(Z[:, sel] @ pm.amplitudes[sel])
     share = _share(np.real(xx), part, coordinates)
     fit = np.real(Z @ pm.amplitudes)
-    res = float(np.linalg.norm(fit - np.real(xx)) / max(np.linalg.norm(np.real(xx)), 1e-300))
+    res = float(np.linalg.norm(fit - np.real(xx))) / max(float(np.linalg.norm(np.real(xx))), 1e-300)
     rate = 1.0 / pm.dt
     warns: list[str] = []
     if math.isfinite(share) and share < 0.5 and reference is None:

@@ -6,11 +6,14 @@ import json
 import math
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .estimate import LinearModes, ModeEstimate, dominant_mode, modal_projection
+
+if TYPE_CHECKING:
+    from ..model.parameters import Parameters
 
 __all__ = ["EstimationRecord", "Trajectory", "Summary", "envelope", "fit_growth_frequency", "integration_error_bound",
            "summarize"]
@@ -782,7 +785,8 @@ class Trajectory:
 
         from ..labels import STYLE
 
-        with matplotlib.rc_context(STYLE):
+        style: dict[Any, Any] = dict(STYLE)  # rc values of the package's style (matplotlib's stubs want rc keys)
+        with matplotlib.rc_context(style):
             if fig is None:
                 fig = Figure(figsize=(7.0, 4.4), layout="constrained")
                 FigureCanvasAgg(fig)
@@ -955,10 +959,10 @@ class Trajectory:
         return int(pcm.size)
 
 
-def soft_quasi_static_pads(params: Any) -> tuple[str, ...]:
-    """Pads the simulation treats quasi-statically (``ldot := 0``, :func:`~._kernels.pad_treatment`) although
-    their ``k_ip`` is finite at ``params``: exact only to first order beyond the linear regime
-    (``docs/nonlinear.md``).
+def soft_quasi_static_pads(params: Parameters) -> tuple[str, ...]:
+    """Pads the simulation treats quasi-statically (``ldot := 0``, :attr:`Pad.treatment
+    <brakesqueal.model.components.Pad.treatment>`) although their ``k_ip`` is finite at ``params``: exact only
+    to first order beyond the linear regime (``docs/nonlinear.md``).
 
     Parameters
     ----------
@@ -970,12 +974,9 @@ def soft_quasi_static_pads(params: Any) -> tuple[str, ...]:
     tuple of str
         Pad names, in the model's order.
     """
-    from ._kernels import pad_treatment
-
-    spec = params.model
     out = []
-    for pad, kind in zip([p for p in spec.pads if p.quasi_static], pad_treatment(spec)):
+    for pad in params.model.pads:
         k = pad.k_ip
-        if kind == "quasi-static" and not math.isinf(float(params[k]) if isinstance(k, str) else float(k)):
+        if pad.treatment == "quasi-static" and not math.isinf(float(params[k]) if isinstance(k, str) else float(k)):
             out.append(pad.name)
     return tuple(out)

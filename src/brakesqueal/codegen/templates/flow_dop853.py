@@ -1,32 +1,47 @@
-"""numba kernel: DOP853 (SciPy's coefficients, error norm and step control) with variational equations.
+"""Template: the flow integrator (numba): the shared DOP853 step with variational equations, read as text.
 
-The vector field is passed as first-class functions with fixed signatures
-(:data:`F_SIGNATURE`, :data:`JAC_SIGNATURE`), so the kernel is compiled once
-per machine (``cache=True``) for every system.  Output samples are hit
-exactly by shortening steps (no dense output).
+:func:`brakesqueal.codegen.simulation.flow_kernel` appends the text below the
+marker line to :mod:`.dop853` and loads the module once per machine (the code
+cache).  The vector field is passed as first-class functions with fixed
+signatures (:data:`F_SIGNATURE`, :data:`JAC_SIGNATURE`), so ``dop853`` is
+compiled once for every system (:class:`brakesqueal.nonlinear.CompiledFlow`).
+With ``sens`` the state is ``(x, [M | x_p])`` and the stages integrate the
+variational equations ``M' = f_x M``, ``x_p' = f_x x_p + f_p``.  Output
+samples are hit exactly by shortening steps (no dense output).
+
+The stand-ins above the marker only make this file a valid, linted module.
 """
+# ruff: noqa: E501
+# mypy: ignore-errors
 
-from __future__ import annotations
+import math
 
 import numpy as np
-from numba import njit, types
-from scipy.integrate._ivp import dop853_coefficients as _co
+from numba import njit
+
+
+def dop853_step(ctx, y, h, rtol, atol, K, ynew, ystage):  # template dop853
+    raise NotImplementedError
+
+
+def dop853_factor(err, rejected):  # template dop853
+    raise NotImplementedError
+
+
+_NS = 12  # template dop853
+
+
+# ---- template body ----
+
+from numba import types as _nbt  # noqa: E402
 
 #: ``f(x, p, theta, out)`` and ``dfdp(x, p, theta, out)``: ``x``, ``theta`` (fixed model parameters) and
 #: ``out`` C-contiguous float64 vectors, ``p`` the continuation parameter.
-F_SIGNATURE = types.void(types.float64[::1], types.float64, types.float64[::1], types.float64[::1])
+F_SIGNATURE = _nbt.void(_nbt.float64[::1], _nbt.float64, _nbt.float64[::1], _nbt.float64[::1])
 #: ``jac(x, p, theta, out)`` with ``out`` a C-contiguous float64 ``(n, n)`` matrix.
-JAC_SIGNATURE = types.void(types.float64[::1], types.float64, types.float64[::1], types.float64[:, ::1])
-
-_NS = _co.N_STAGES
-_A = np.ascontiguousarray(_co.A[:_NS, :_NS])
-_B = np.ascontiguousarray(_co.B)
-_C = np.ascontiguousarray(_co.C[:_NS])
-_E3 = np.ascontiguousarray(_co.E3)
-_E5 = np.ascontiguousarray(_co.E5)
-
-_FT = types.FunctionType(F_SIGNATURE)
-_JT = types.FunctionType(JAC_SIGNATURE)
+JAC_SIGNATURE = _nbt.void(_nbt.float64[::1], _nbt.float64, _nbt.float64[::1], _nbt.float64[:, ::1])
+_FT = _nbt.FunctionType(F_SIGNATURE)
+_JT = _nbt.FunctionType(JAC_SIGNATURE)
 
 
 @njit(cache=True)
@@ -49,11 +64,16 @@ def _rhs(f, jac, dfdp, y, p, th, n, sens, xb, J, fp, out):  # pragma: no cover -
             out[n + i * n1 + n] += fp[i]
 
 
-_SIG = types.Tuple((types.int64, types.int64, types.float64))(
-    _FT, _JT, _FT, types.float64[::1], types.float64, types.float64[::1], types.float64, types.float64,
-    types.float64[::1],
-    types.boolean, types.float64[::1], types.float64[:, ::1], types.float64, types.int64,
-)  # fmt: skip
+@njit(cache=True, inline="always")
+def _stage_rhs(ctx, y, out):
+    """The right-hand side of the DOP853 stages: ctx = (f, jac, dfdp, p, theta, n, sens, xb, J, fp)."""
+    _rhs(ctx[0], ctx[1], ctx[2], y, ctx[3], ctx[4], ctx[5], ctx[6], ctx[7], ctx[8], ctx[9], out)
+
+
+_SIG = _nbt.Tuple((_nbt.int64, _nbt.int64, _nbt.float64))(
+    _FT, _JT, _FT, _nbt.float64[::1], _nbt.float64, _nbt.float64[::1], _nbt.float64, _nbt.float64,
+    _nbt.float64[::1], _nbt.boolean, _nbt.float64[::1], _nbt.float64[:, ::1], _nbt.float64, _nbt.int64,
+)
 
 
 @njit(_SIG, cache=True)
@@ -68,11 +88,11 @@ def dop853(f, jac, dfdp, y0, p, th, T, rtol, atol, sens, t_samples, samples, h0,
     xb = np.empty(n)
     J = np.empty((n, n))
     fp = np.empty(n)
-    K = np.empty((_NS + 1, N))
+    ctx = (f, jac, dfdp, p, th, n, sens, xb, J, fp)
+    K = np.empty((16, N))
     yn = np.empty(N)
     tmp = np.empty(N)
-    f0 = np.empty(N)
-    _rhs(f, jac, dfdp, y0, p, th, n, sens, xb, J, fp, f0)
+    _stage_rhs(ctx, y0, K[0])
     nfev = 1
     ks = 0
     nsamp = t_samples.size
@@ -88,19 +108,19 @@ def dop853(f, jac, dfdp, y0, p, th, T, rtol, atol, sens, t_samples, samples, h0,
         for i in range(N):
             sc = atol[i] + abs(y0[i]) * rtol
             d0 += (y0[i] / sc) ** 2
-            d1 += (f0[i] / sc) ** 2
+            d1 += (K[0, i] / sc) ** 2
         d0 = np.sqrt(d0 / N)
         d1 = np.sqrt(d1 / N)
         hh = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
         hh = min(hh, T)
         for i in range(N):
-            tmp[i] = y0[i] + hh * f0[i]
-        _rhs(f, jac, dfdp, tmp, p, th, n, sens, xb, J, fp, yn)
+            tmp[i] = y0[i] + hh * K[0, i]
+        _stage_rhs(ctx, tmp, yn)
         nfev += 1
         d2 = 0.0
         for i in range(N):
             sc = atol[i] + abs(y0[i]) * rtol
-            d2 += ((yn[i] - f0[i]) / sc) ** 2
+            d2 += ((yn[i] - K[0, i]) / sc) ** 2
         d2 = np.sqrt(d2 / N) / hh
         if d1 <= 1e-15 and d2 <= 1e-15:
             h1 = max(1e-6, hh * 1e-3)
@@ -120,58 +140,25 @@ def dop853(f, jac, dfdp, y0, p, th, T, rtol, atol, sens, t_samples, samples, h0,
                 return -1, nfev, h
             clipped = t + h >= target
             hs = target - t if clipped else h
-            # stages
-            for i in range(N):
-                K[0, i] = f0[i]
-            for s in range(1, _NS):
-                for i in range(N):
-                    acc = 0.0
-                    for j in range(s):
-                        acc += K[j, i] * _A[s, j]
-                    tmp[i] = y0[i] + acc * hs
-                _rhs(f, jac, dfdp, tmp, p, th, n, sens, xb, J, fp, K[s])
-            for i in range(N):
-                acc = 0.0
-                for j in range(_NS):
-                    acc += K[j, i] * _B[j]
-                yn[i] = y0[i] + hs * acc
-            _rhs(f, jac, dfdp, yn, p, th, n, sens, xb, J, fp, K[_NS])
+            err = dop853_step(ctx, y0, hs, rtol, atol, K, yn, tmp)
             nfev += _NS
-            e5 = 0.0
-            e3 = 0.0
-            for i in range(N):
-                sc = atol[i] + max(abs(y0[i]), abs(yn[i])) * rtol
-                a5 = 0.0
-                a3 = 0.0
-                for j in range(_NS + 1):
-                    a5 += K[j, i] * _E5[j]
-                    a3 += K[j, i] * _E3[j]
-                e5 += (a5 / sc) ** 2
-                e3 += (a3 / sc) ** 2
-            if e5 == 0.0 and e3 == 0.0:
-                err = 0.0
-            else:
-                err = abs(hs) * e5 / np.sqrt((e5 + 0.01 * e3) * N)
-            if not np.isfinite(err):
+            if not err < math.inf:
                 if rejected and h < min_step * 10:
                     return -3, nfev, h
                 h *= 0.2
                 rejected = True
                 continue
+            fac = dop853_factor(err, rejected)
             if err < 1.0:
-                fac = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** (-1.0 / 8.0))
-                if rejected:
-                    fac = min(1.0, fac)
-                hn = hs * fac
                 # a step shortened to hit an output time does not shrink the next one
-                h = max(hn, h) if clipped and fac >= 1.0 else hn
+                h = max(hs * fac, h) if clipped and fac >= 1.0 else hs * fac
                 break
-            h = hs * max(0.2, 0.9 * err ** (-1.0 / 8.0))
+            h = hs * fac
             rejected = True
         t = target if clipped else t + hs
         for i in range(N):
             y0[i] = yn[i]
-            f0[i] = K[_NS, i]
+            K[0, i] = K[_NS, i]
         if clipped and ks < nsamp and target == t_samples[ks]:
             for i in range(n):
                 samples[ks, i] = y0[i]
@@ -180,12 +167,3 @@ def dop853(f, jac, dfdp, y0, p, th, T, rtol, atol, sens, t_samples, samples, h0,
         if steps > max_steps:
             return -2, nfev, h
     return 0, nfev, h
-
-
-def _guard() -> None:
-    from ..codegen.cache import guard_numba_caches
-
-    guard_numba_caches(globals())  # a damaged or unwritable numba cache file is recompiled, never an error
-
-
-_guard()

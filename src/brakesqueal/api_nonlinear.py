@@ -1,0 +1,311 @@
+r"""The public API of the simulation and the nonlinear analysis: entry points that build the model's engine.
+
+Each function here builds the model's :class:`~brakesqueal.codegen.engine.Engine`
+once (:func:`brakesqueal.codegen.build`, memoized per process by the model's
+equations) from its parameters or parameter space and hands it down to
+:mod:`brakesqueal.simulation` or :mod:`brakesqueal.nonlinear`, which never build
+one themselves.  Re-exported by :mod:`brakesqueal` (``brakesqueal.simulate``,
+``brakesqueal.limit_cycles``, ...).  ``docs/simulation.md``, ``docs/nonlinear.md``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from .analysis.maps import Axis
+    from .codegen.engine import Engine
+    from .model.components import ModelSpec
+    from .model.parameters import Parameters, ParameterSpace
+    from .nonlinear.compiled import CompiledFlow
+    from .nonlinear.harmonic import HarmonicBranch
+    from .nonlinear.implicit import PadHopf
+    from .nonlinear.models import HopfPoint
+    from .nonlinear.squeal import SquealBranch
+    from .nonlinear.system import PiecewiseSystem, SmoothSystem
+    from .results import CrossingResult
+    from .simulation import SimulationModel, Trajectory
+
+__all__ = ["simulate", "simulation_model", "hopf_points", "limit_cycles", "squeal_branch", "harmonic_branch",
+           "model_system", "model_piecewise_system", "exact_lyapunov", "model_flow"]
+
+
+def _engine(model: ModelSpec | str | Parameters | ParameterSpace, use_cache: bool = True) -> Engine:
+    from .codegen import build
+
+    from .model.parameters import Parameters, ParameterSpace
+
+    spec = model.model if isinstance(model, (Parameters, ParameterSpace)) else model
+    return build(spec, use_cache=use_cache)
+
+
+def simulate(params: Parameters, t_span: float | Sequence[float] = 0.5,
+             x0: Sequence[float] | np.ndarray | None = None, *, use_cache: bool = True,
+             **options: Any) -> Trajectory:
+    """Integrate the nonlinear equations of the model of ``params`` (:func:`brakesqueal.simulation.simulate`).
+
+    Parameters
+    ----------
+    params : Parameters
+        The model and its parameter values.
+    t_span : float or (float, float), optional
+        End time [s] (start 0) or ``(t0, t_end)``.
+    x0 : array_like, optional
+        Absolute initial state ``(Q, Qdot[, L_dynamic])``.
+    use_cache : bool, optional
+        Use the on-disk code cache.
+    **options
+        The options of :func:`brakesqueal.simulation.simulate` (``perturbation``, ``method``, ``rtol``,
+        ``atol``, ``sample_rate``, ``events``, ``contact``, ...).
+
+    Returns
+    -------
+    Trajectory
+    """
+    from .analysis.equilibrium import as_parameters
+    from .simulation import simulate as _simulate
+    from .simulation import simulation_model as _simulation_model
+
+    params = as_parameters(params)
+    sim = _simulation_model(_engine(params, use_cache), use_cache=use_cache)
+    return _simulate(sim, params, t_span, x0, **options)
+
+
+def simulation_model(model: ModelSpec | str | Parameters | ParameterSpace, *,
+                     use_cache: bool = True) -> SimulationModel:
+    """The simulation model of a model (a :class:`~brakesqueal.model.components.ModelSpec`, a built-in model's
+    name, a model file, parameters or a parameter space): :func:`brakesqueal.simulation.simulation_model` of
+    its engine.
+
+    Parameters
+    ----------
+    model : ModelSpec, str, Parameters or ParameterSpace
+        The model.
+    use_cache : bool, optional
+        Use the on-disk code cache.
+
+    Returns
+    -------
+    SimulationModel
+    """
+    from .simulation import simulation_model as _simulation_model
+
+    return _simulation_model(_engine(model, use_cache), use_cache=use_cache)
+
+
+def hopf_points(space: ParameterSpace, axis: Axis, *, use_cache: bool = True,
+                result: CrossingResult | None = None) -> list[HopfPoint]:
+    """Every stability crossing along a path with its Hopf normal form
+    (:func:`brakesqueal.nonlinear.models.hopf_points`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    axis : Axis
+        The path.
+    use_cache : bool, optional
+        Use the on-disk code cache.
+    result : CrossingResult, optional
+        The crossings along ``axis`` when already computed.
+
+    Returns
+    -------
+    list of HopfPoint
+    """
+    from .nonlinear.models import hopf_points as _hopf_points
+
+    return _hopf_points(_engine(space, use_cache), space, axis, use_cache=use_cache, result=result)
+
+
+def limit_cycles(space: ParameterSpace, axis: Axis, *, contact: str = "bilateral", pads: str = "auto",
+                 max_points: int | None = None, progress: Callable[[float], None] | None = None,
+                 pad_slope: float | None = None, stick_speed: float | None = None, use_cache: bool = True,
+                 **options: Any) -> SquealBranch | HarmonicBranch:
+    """Limit cycles from the first Hopf point on a path, by the route ``brakesqueal cycles`` takes
+    (:func:`brakesqueal.nonlinear.models.limit_cycles`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    axis : Axis
+        The path.
+    contact : {"bilateral", "unilateral"}, optional
+        As in :func:`~brakesqueal.nonlinear.models.squeal_branch`.
+    pads : {"auto", "exact", "quasi-static"}, optional
+        As in :func:`~brakesqueal.nonlinear.models.cycle_route`.
+    max_points : int, optional
+        Largest number of branch points (default: the route's own).
+    progress : callable, optional
+        ``progress(fraction)`` after each branch point.
+    pad_slope, stick_speed : float, optional
+        Keep the massless Coulomb pads' rates by a slightly rising friction law (the shooting route;
+        :func:`~brakesqueal.nonlinear.models.cycle_space`): another model, whose engine is built here.
+    use_cache : bool, optional
+        Use the on-disk code cache.
+    **options
+        The options of the route taken (see :func:`brakesqueal.nonlinear.models.limit_cycles`).
+
+    Returns
+    -------
+    SquealBranch or HarmonicBranch
+    """
+    from .nonlinear.models import cycle_space
+    from .nonlinear.models import limit_cycles as _limit_cycles
+
+    space = cycle_space(space, pads=pads, pad_slope=pad_slope, stick_speed=stick_speed)
+    return _limit_cycles(_engine(space, use_cache), space, axis, contact=contact, pads=pads,  # type: ignore[no-any-return]
+                         max_points=max_points, progress=progress, use_cache=use_cache, **options)
+
+
+def squeal_branch(space: ParameterSpace, axis: Axis, *, pad_slope: float | None = None,
+                  stick_speed: float | None = None, use_cache: bool = True, **options: Any) -> SquealBranch:
+    """Limit cycles by shooting from the first Hopf point on a path
+    (:func:`brakesqueal.nonlinear.models.squeal_branch`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    axis : Axis
+        The path.
+    pad_slope, stick_speed : float, optional
+        Regularise the massless Coulomb pads (:func:`~brakesqueal.nonlinear.models.cycle_space`).
+    use_cache : bool, optional
+        Use the on-disk code cache.
+    **options
+        ``max_points``, ``tol``, ``contact``, ``ds``, ``ds_max``, ``flow_method``, ``progress``.
+
+    Returns
+    -------
+    SquealBranch
+    """
+    from .nonlinear.models import cycle_space
+    from .nonlinear.squeal import squeal_branch as _squeal_branch
+
+    space = cycle_space(space, pad_slope=pad_slope, stick_speed=stick_speed)
+    return _squeal_branch(_engine(space, use_cache), space, axis, use_cache=use_cache, **options)
+
+
+def harmonic_branch(space: ParameterSpace, axis: Axis, *, use_cache: bool = True, **options: Any) -> HarmonicBranch:
+    """Limit cycles of the implicit equations by harmonic balance
+    (:func:`brakesqueal.nonlinear.harmonic.harmonic_branch`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    axis : Axis
+        The path.
+    use_cache : bool, optional
+        Use the on-disk code cache.
+    **options
+        The options of :func:`~brakesqueal.nonlinear.harmonic.harmonic_branch`.
+
+    Returns
+    -------
+    HarmonicBranch
+    """
+    from .nonlinear.harmonic import harmonic_branch as _harmonic_branch
+
+    return _harmonic_branch(_engine(space, use_cache), space, axis, use_cache=use_cache, **options)
+
+
+def model_system(space: ParameterSpace, name: str, *, use_cache: bool = True) -> SmoothSystem:
+    """A model as a smooth system in the parameter ``name`` (:func:`brakesqueal.nonlinear.models.model_system`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    name : str
+        The continuation parameter.
+    use_cache : bool, optional
+        Use the on-disk code cache.
+
+    Returns
+    -------
+    SmoothSystem
+    """
+    from .nonlinear.models import model_system as _model_system
+
+    return _model_system(_engine(space, use_cache), space, name, use_cache=use_cache)
+
+
+def model_piecewise_system(space: ParameterSpace, name: str, *, use_cache: bool = True) -> PiecewiseSystem:
+    """A model with unilateral contact as a piecewise system
+    (:func:`brakesqueal.nonlinear.models.model_piecewise_system`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    name : str
+        The continuation parameter.
+    use_cache : bool, optional
+        Use the on-disk code cache.
+
+    Returns
+    -------
+    PiecewiseSystem
+    """
+    from .nonlinear.models import model_piecewise_system as _model_piecewise_system
+
+    return _model_piecewise_system(_engine(space, use_cache), space, name, use_cache=use_cache)
+
+
+def exact_lyapunov(space: ParameterSpace, name: str, p0: float, *, omega: float | None = None,
+                   use_cache: bool = True) -> PadHopf:
+    """The first Lyapunov coefficient with the pads' true tangential dynamics
+    (:func:`brakesqueal.nonlinear.implicit.exact_lyapunov`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    name : str
+        The path parameter.
+    p0 : float
+        A stability crossing.
+    omega : float, optional
+        Select the eigenvalue pair with imaginary part closest to ``omega``.
+    use_cache : bool, optional
+        Use the on-disk code cache.
+
+    Returns
+    -------
+    PadHopf
+    """
+    from .nonlinear.implicit import exact_lyapunov as _exact_lyapunov
+
+    return _exact_lyapunov(_engine(space, use_cache), space, name, p0, omega=omega, use_cache=use_cache)
+
+
+def model_flow(space: ParameterSpace, name: str, *, system: SmoothSystem | None = None, use_cache: bool = True,
+               rtol: float = 1e-11) -> CompiledFlow:
+    """The compiled flow of a model with its exact Jacobian (:func:`brakesqueal.nonlinear.compiled.model_flow`).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    name : str
+        The continuation parameter.
+    system : SmoothSystem, optional
+        The system the flow belongs to (default :func:`model_system` ``(space, name)``).
+    use_cache : bool, optional
+        Use the on-disk code cache.
+    rtol : float, optional
+        Relative tolerance of the integrator.
+
+    Returns
+    -------
+    CompiledFlow
+    """
+    from .nonlinear.compiled import model_flow as _model_flow
+
+    return _model_flow(_engine(space, use_cache), space, name, system=system, use_cache=use_cache, rtol=rtol)
