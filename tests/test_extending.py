@@ -124,6 +124,7 @@ class _Mpmath(vmod.Route):
         return res
 
 
+@pytest.mark.slow
 def test_a_new_verdict_route_is_one_registration(monkeypatch):
     monkeypatch.setattr(vmod._dispatch, "ROUTES", list(vmod.ROUTES))
     vmod._dispatch.register(_Mpmath(), before="eigen-bounds")

@@ -50,6 +50,7 @@ def _probe(args: list[str], cache: Path, cwd: Path) -> dict[str, object]:
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", sorted(COMMANDS))
 def test_warm_commands_import_no_computer_algebra(command, tmp_path):
     cache = tmp_path / "cache"

@@ -113,6 +113,7 @@ def rel(a: float, b: float) -> float:
 
 
 # ------------------------------------------------------------------ 01
+@pytest.mark.slow
 def test_01_derive_and_linearize(kernel_dir):
     nb = run("01", kernel_dir)
     s = summary(nb)
@@ -136,6 +137,7 @@ def test_01_derive_and_linearize(kernel_dir):
 
 
 # ------------------------------------------------------------------ 02
+@pytest.mark.slow
 def test_02_stability_maps_and_critical_speed(kernel_dir):
     nb = run("02", kernel_dir)
     s = summary(nb)
@@ -173,6 +175,7 @@ def test_02_stability_maps_and_critical_speed(kernel_dir):
 
 
 # ------------------------------------------------------------------ 03
+@pytest.mark.slow
 def test_03_simulation(kernel_dir):
     nb = run("03", kernel_dir)
     s = summary(nb)
@@ -201,6 +204,7 @@ def test_03_simulation(kernel_dir):
 
 
 # ------------------------------------------------------------------ 04
+@pytest.mark.slow
 def test_04_custom_model(kernel_dir):
     from brakesqueal.model import spec_from_dict
 

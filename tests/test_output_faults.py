@@ -47,6 +47,7 @@ def _run(args: list[str], cwd: Path, limit: int | None) -> subprocess.CompletedP
                           text=True, timeout=600, preexec_fn=cap)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_a_full_disk_keeps_the_old_file_and_says_so_in_one_line(tmp_path, case):
     args, option, name = CASES[case]
@@ -64,6 +65,7 @@ def test_a_full_disk_keeps_the_old_file_and_says_so_in_one_line(tmp_path, case):
     assert sorted(p.name for p in tmp_path.iterdir()) == before  # no temporary or partial file left
 
 
+@pytest.mark.slow
 def test_reproduce_on_a_full_disk_keeps_the_whole_previous_set(tmp_path):
     """The figure's files form one set: a write failing part-way (the PNG fits, the NetCDF does not) replaces none."""
     warm = _run(["reproduce", "fig2", "--out", "warm", "--no-progress"], tmp_path, None)

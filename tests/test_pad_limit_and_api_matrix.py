@@ -284,6 +284,7 @@ def test_evaluate_point_agrees_with_the_eigenvalues(name):
     assert pv.frequency == pytest.approx(abs(lead.imag) / (2 * math.pi), rel=1e-6, abs=1e-9)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
 def test_crossings_along_a_path(name):
     space = space_of(name)
@@ -317,6 +318,7 @@ def test_crossings_along_a_path(name):
     assert isinstance(fig, Figure) and fig.axes and fig.axes[0].has_data()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
 def test_critical_speeds(name):
     space = space_of(name)
@@ -375,6 +377,7 @@ MODES_SPLIT = ("modes_along/track_modes fix the number of columns at the first p
                "real eigenvalues -5.82e4 and -6.06e4 are missing from ModeTracks.eigenvalues (6 columns, 8 needed)")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)  # six-dof: a pair splits into two real eigenvalues (was MODES_SPLIT)
 def test_modes_along_the_path(name):
     space = space_of(name)
@@ -445,6 +448,7 @@ def test_export_to_every_target(name):
             assert not missing, (target, what, missing)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
 def test_hopf_points_along_the_path(name):
     space = space_of(name)

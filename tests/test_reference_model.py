@@ -210,6 +210,7 @@ def test_residuals_match_brute_force_numeric_route():
         np.testing.assert_allclose(g, g_bf, rtol=1e-12, atol=1e-18)
 
 
+@pytest.mark.slow
 def test_jacobians_match_finite_differences():
     """Symbolic Jacobians vs. central differences of the 30-digit residual."""
     rng = np.random.default_rng(3)

@@ -764,6 +764,8 @@ class CriticalSpeedResult(CrossingResult):
         Whether every crossing outside ``undecided_ranges`` is guaranteed listed.
     profile : tuple of ndarray or None, optional
         ``(Omega, max_real)`` along the range, drawn by :meth:`plot`.
+    carrier_at_start : str, optional
+        The mode carrying the verdict at ``start`` (``""``: not determined).
     """
 
     @property

@@ -38,6 +38,7 @@ def _boundary(space, x, y, **kw):
                                  evaluator=_ev(space), **kw)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_paper_boundary_vertices_are_exact_crossings(seed):
     rng = np.random.default_rng(seed)
@@ -72,6 +73,7 @@ def _max_real(spec, values):
     return float(np.max(scipy.linalg.eigvals(A).real))
 
 
+@pytest.mark.slow
 def test_built_model_boundary_separates_eigenvalue_signs():
     spec = get_model("six-dof")
     space = ParameterSpace.from_preset("six-dof")
@@ -102,6 +104,7 @@ def test_built_model_boundary_separates_eigenvalue_signs():
     assert checked >= 2
 
 
+@pytest.mark.slow
 def test_map_stores_boundary_and_plots_it(tmp_path):
     space = ParameterSpace.from_preset("paper-fig2")
     x, y = Axis("k_ip", 1e5, 1e10, 40, log=True), Axis("mu", 0.05, 1.0, 30)
@@ -154,6 +157,7 @@ def test_boundary_bad_options():
     assert stability_boundary(space, y, x, st | True, ss, evaluator=_ev(space)).vertices == 0
 
 
+@pytest.mark.slow
 def test_fig3_tips_close_the_squeal_region():
     """At a located tip the onset and the re-stabilisation meet: just inside both exist and are close to the
     tip's speed, just outside the silent motion is stable on the whole range (exact critical speeds)."""

@@ -22,6 +22,7 @@ from brakesqueal import Axis, stability_map
 from brakesqueal.model import ParameterSpace, get_model, model_to_toml, resolve_space
 
 
+@pytest.mark.slow
 def test_minimal_model_critical_speeds_equal_the_paper_preset():
     """The model 'minimal' and the paper model's preset 'minimal-model' are the same physics: same crossings."""
     built = critical_speeds(resolve_space("minimal"), 1.0, 1e5)
@@ -41,6 +42,7 @@ def test_belt_crossing_is_the_negative_slope_threshold():
     assert math.isclose(r.crossings[0][0], threshold, rel_tol=1e-10)
 
 
+@pytest.mark.slow
 def test_built_model_map_agrees_with_pointwise_linearization():
     space = resolve_space("six-dof")
     x, y = Axis("k_c", 1e8, 1e10, 7, log=True), Axis("mu1", 0.3, 0.7, 5)
@@ -57,6 +59,7 @@ def test_built_model_map_agrees_with_pointwise_linearization():
             assert int(ds["status"][j, i]) == expected
 
 
+@pytest.mark.slow
 def test_built_model_simulation_matches_the_linear_growth():
     from brakesqueal.model.options import resolve_parameters
     from brakesqueal import simulate
@@ -75,6 +78,7 @@ def _cli(*args, tmp_path):
                           cwd=tmp_path)  # fmt: skip
 
 
+@pytest.mark.slow
 def test_cli_accepts_model_files(tmp_path):
     f = tmp_path / "belt.toml"
     f.write_text(model_to_toml(get_model("belt")))
@@ -127,6 +131,7 @@ def test_verdict_only_maps_equal_full_maps(model, x, y):
 
 @pytest.mark.parametrize("model,xname,yname,yv,lo,hi", [("paper-2dof", "k_ip1", "k1", 6e6, 1e5, 1e10),
                                                          ("eight-dof", "k_c", "k_cn", 5e7, 1e8, 1e10)])
+@pytest.mark.slow
 def test_verdicts_near_the_boundary(model, xname, yname, yv, lo, hi):
     """Points placed just off a boundary (found by bisection on eigenvalues): certified verdicts are never wrong."""
     from scipy.optimize import brentq

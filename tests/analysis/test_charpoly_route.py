@@ -48,6 +48,7 @@ CASES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("model,outer,inner,ro,ri,least", CASES)
 def test_charpoly_verdicts_agree_with_lapack(model, outer, inner, ro, ri, least):
     space = resolve_space(model)

@@ -67,6 +67,7 @@ def _exact_verdict(charpoly, values: dict[str, str], omega: float) -> str:
 
 @pytest.mark.parametrize("name,value", [("k_ip", "1e100"), ("k_t", "1e100"), ("N0", "1e100"), ("Phi", "1e100"),
                                         ("d1", "1e100"), ("Phi", "2e-100"), ("N0", "1e-100"), ("k_ip", "1e-100")])
+@pytest.mark.slow
 def test_critical_speeds_at_the_magnitude_bound_agree_with_exact_hurwitz(charpoly, name, value):
     values = {**BASE, name: value}
     space = ParameterSpace.from_preset("paper-fig3", {name: float(value)})
@@ -85,6 +86,7 @@ def test_critical_speeds_at_the_magnitude_bound_agree_with_exact_hurwitz(charpol
             expected = "unstable" if expected == "stable" else "stable"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("preset,hi", [("paper-fig3", 1e300), ("paper-fig2", 1e150)])
 def test_a_range_past_omegas_bound_is_undecided_there_and_agrees_with_crossings(preset, hi):
     # |Omega| <= 1e100 (the parameter table): a verdict beyond it would be on invalid parameter sets.  Both
@@ -113,6 +115,7 @@ def test_a_range_past_omegas_bound_is_undecided_there_and_agrees_with_crossings(
     assert (status_in == int(PointStatus.OK)).all()
 
 
+@pytest.mark.slow
 def test_verdict_line_and_listed_eigenvalues_agree_at_extreme_values():
     """``linearize`` printed "UNSTABLE: max Re = 0.0" beside a listed 1.29e30 (mu = 1e90, k_ip = inf), and a
     verdict max Re of 1.55e11 beside a listed 0.0 (mu = 1e30): double-precision eigenvalues of matrices whose

@@ -178,6 +178,7 @@ def test_descriptor_eigenvalues_match_60_digit_arithmetic():
             assert abs(nearest - z) <= 1e-5 * abs(z) and np.sign(nearest.real) == np.sign(z.real)
 
 
+@pytest.mark.slow
 def test_descriptor_eigenvalue_table_agrees_with_the_verdict_at_random_tilted_silent_motions():
     """The eigenvalue table and the certified verdict of one linear model never contradict each other.
 

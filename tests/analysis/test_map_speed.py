@@ -183,6 +183,7 @@ def _modules_after(args, env):
     return json.loads(r.stderr.strip().splitlines()[-1])
 
 
+@pytest.mark.slow
 def test_lazy_imports(tmp_path):
     """``--help`` and warm ``linearize`` import none of numba/xarray/dask/matplotlib; ``map`` (no plot) only numba."""
     env = dict(os.environ, PYTHONPATH=os.path.abspath(SRC))
@@ -224,6 +225,7 @@ def _random_quartics(rng, n):
     return A, R
 
 
+@pytest.mark.slow
 def test_pure_python_twin_bit_for_bit():
     """The plain-Python twin of the interval kernels gives exactly the compiled results (random, extreme input)."""
     from brakesqueal.analysis import _compiled

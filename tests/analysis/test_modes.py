@@ -68,6 +68,7 @@ def test_modes_command_json_and_bad_input(tmp_path, capsys):
     assert rc == 2 and "did you mean 'k_ip'" in err
 
 
+@pytest.mark.slow
 def test_a_path_on_which_the_pads_states_come_and_go():
     """paper-fig3 with h10 = 0.012 along mu1 in [0, 1.2] (the explorer's slider range): at mu1 = 0 the silent
     motion keeps no pad state, elsewhere both pads' rates are kept (2n + 2 first-order states).  The tracking

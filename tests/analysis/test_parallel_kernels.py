@@ -11,6 +11,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 import numba
 import numpy as np
 
@@ -23,6 +25,7 @@ from brakesqueal.model import ParameterSpace, resolve_space
 from brakesqueal.codegen import build
 
 
+@pytest.mark.slow
 def test_critical_speeds_parallel_equals_serial_and_exact():
     n = _compiled.PARALLEL_MIN + 123
     rng = np.random.default_rng(5)
@@ -53,6 +56,7 @@ def test_critical_speeds_parallel_equals_serial_and_exact():
             assert dirs[i, k] == (1 if d == "stabilizing" else -1)
 
 
+@pytest.mark.slow
 def test_charpoly_blocks_equal_serial_sweep_for_any_thread_count():
     space = resolve_space("eight-dof")
     tab = build(space.model).charpoly_table(space, "k_cn", "k_c")

@@ -53,6 +53,7 @@ def _route_codes(space, points):
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name,sets,ax1,ax2,grid", CASES)
 def test_routes_never_contradict(name, sets, ax1, ax2, grid):
     import zlib

@@ -121,6 +121,7 @@ def _routes_used(ds):
     return {names[int(i)] for i in np.unique(ds["route"].values) if int(i) > 0}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("model", list(CASES))
 def test_map_and_sweep_against_eigenvalues(model):
     from brakesqueal.sweep import sweep
@@ -192,6 +193,7 @@ def _check_path(space, r, name, log):
     assert grid_p.size > 10 and np.all(np.isfinite(prof) | np.isnan(prof))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("model", list(CASES))
 def test_crossings_against_eigenvalues(model):
     _, _, path, route = CASES[model]
@@ -201,6 +203,7 @@ def test_crossings_against_eigenvalues(model):
     _check_path(space, r, path.name, path.log)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("model", list(CASES))
 def test_critical_speeds_against_eigenvalues(model):
     space = resolve_space(model)
@@ -213,6 +216,7 @@ def test_critical_speeds_against_eigenvalues(model):
     _check_path(space, r, "Omega", True)
 
 
+@pytest.mark.slow
 def test_a_model_file_goes_through_the_same_routes(tmp_path):
     """A TOML model (three Coulomb pads at 120 degrees): closed-form route, verdicts against eigenvalues."""
     from brakesqueal.model import Disk, FrictionLaw, ModelSpec, Pad, model_to_toml
@@ -275,6 +279,7 @@ def test_grouped_validity_equals_the_roles_table(model):
         np.testing.assert_array_equal(got, want)
 
 
+@pytest.mark.slow
 def test_critical_speeds_many_batches_trivial_sets_and_routes_the_others_point_by_point():
     """Sets with a trivial silent motion go through the compiled kernel, the others through critical_speeds."""
     from brakesqueal import critical_speeds_many

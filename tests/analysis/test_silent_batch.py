@@ -49,6 +49,7 @@ def _same(a, b) -> float:
     return float(np.max(np.where(size > 0, err / np.where(size > 0, size, 1.0), err)))
 
 
+@pytest.mark.slow
 def test_paper_model_random_grids_cross_failures_and_hand_over():
     spec = get_model("paper")
     cm = compile_model(spec)
@@ -71,6 +72,7 @@ def test_paper_model_random_grids_cross_failures_and_hand_over():
     assert not a.trivial.any()
 
 
+@pytest.mark.slow
 def test_paper_fig3_map_grid_untied():
     space = resolve_space(preset="paper-fig3", sets={"h10": 0.012})
     mu = np.linspace(0.05, 1.0, 23)
@@ -83,6 +85,7 @@ def test_paper_fig3_map_grid_untied():
     assert np.count_nonzero(a.handover == 0) >= 0.9 * P.shape[0]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("model,n", [("six-dof", 60), ("eight-dof", 40), ("in-plane-pad", 120)])
 def test_built_models_with_nontrivial_silent_motions(model, n):
     space = resolve_space(model)
@@ -97,6 +100,7 @@ def test_built_models_with_nontrivial_silent_motions(model, n):
     assert np.count_nonzero((a.status == int(PointStatus.OK_NONTRIVIAL)) & (a.handover == 0)) > n // 4
 
 
+@pytest.mark.slow
 def test_accepted_points_satisfy_the_independent_equations():
     """Silent motions accepted by the compiled stage are roots of the independent Newton-Euler residuals."""
     spec = get_model("paper")
@@ -161,6 +165,7 @@ def _per_point_reference(spec, values):
     ("minimal", None, {"h10": 0.012}, (("mu", 0.1, 0.9), ("k_t", 1e5, 1e8))),
     ("eight-dof", None, {"h10": 0.012}, (("mu1", 0.1, 0.9), ("k_c", 1e7, 1e9))),
 ])
+@pytest.mark.slow
 def test_evaluate_arrays_batched_equals_per_point(model, preset, sets, axes, monkeypatch):
     """Map points through the batched route: status and verdict as the per-point route's, max_real to its
     conditioning (the huge pad modes ~1/(c_ip mu d q2) at tilted silent motions carry ~1e-6 relative noise)."""
@@ -213,6 +218,7 @@ def test_silent_motion_of_parameters_equals_vector_route():
 
 @pytest.mark.parametrize("mu1,h20", [(0.3150568181818182, 0.007998557518932563),
                                      (0.3152462121212122, 0.008001442134358851)])
+@pytest.mark.slow
 def test_near_the_trivial_line_no_false_failure(mu1, h20):
     """Next to mu1 h10 = mu2 h20 (points a map's boundary refinement visits) the tilt q1 ~ 1e-17 rad is fixed by a
     small difference of large terms and Newton ends in a 2-cycle at that noise: once reported as a solver failure."""
@@ -235,6 +241,7 @@ def test_near_the_trivial_line_no_false_failure(mu1, h20):
     assert np.max(np.abs(g)) <= 1e-12
 
 
+@pytest.mark.slow
 def test_why_no_warm_start_from_the_neighbour():
     """Along k_t the branch of a neighbour continues where the homotopy from the trivial state folds (no silent
     motion on that branch, an established status): a Newton warm-started from the neighbour's solution would

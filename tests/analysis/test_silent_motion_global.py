@@ -59,6 +59,7 @@ def _reference_silent_motion(pr: dict[str, float]) -> np.ndarray:
     return x
 
 
+@pytest.mark.slow
 def test_the_issue_instance_and_its_neighbour_have_the_same_silent_motion():
     a = silent_motion(_params())
     b = silent_motion(_params(mu1=0.25 + 1e-9))

@@ -40,6 +40,7 @@ def test_real_roots_against_numpy():
     assert real_roots(np.array([1.0, 0.0, 1.0]), -5, 5).size == 0  # x^2 + 1
 
 
+@pytest.mark.slow
 def test_map_kernel_matches_eigenvalues_on_random_points():
     kern = build(FIG2.model).map_kernel(FIG2, "k_ip", "mu")
     assert kern is not None
@@ -54,6 +55,7 @@ def test_map_kernel_matches_eigenvalues_on_random_points():
         assert code == (1 if expected else 0)  # certified: never 2 (uncertain) away from the boundary
 
 
+@pytest.mark.slow
 def test_points_just_off_the_boundary():
     """Place points at relative distance 1e-7 on both sides of boundary points found by eigen bisection."""
     for mu in (0.3, 0.5, 0.8):
@@ -88,6 +90,7 @@ def test_map_dataset_consistent_with_linearize():
             np.testing.assert_allclose(float(pt["frequency"]), abs(top.imag) / (2 * np.pi), rtol=1e-6)
 
 
+@pytest.mark.slow
 def test_nontrivial_silent_motion_and_invalid_points_are_flagged():
     space = ParameterSpace.from_parameters(FIG2.resolve({}))
     m = stability_map(space, Axis("mu1", 0.3, 0.7, 3), Axis("k_t", 1e3, 1.88e7, 3, True), eigen=True)

@@ -13,6 +13,8 @@ reported crossing and at the set's own spin, checked against ``linearize``'s ver
 
 from __future__ import annotations
 
+import pytest
+
 from fractions import Fraction
 
 import numpy as np
@@ -57,6 +59,7 @@ def test_float_equal_sets_get_the_same_answer_from_every_command():
         assert v.stable == expected, (sets, omega, cs.crossings)
 
 
+@pytest.mark.slow
 def test_sets_off_the_tie_by_more_than_rounding_are_not_trivial():
     """The rule is a rounding tolerance, not a wide one: 1e-9 relative off the tie is a tilted silent motion,
     and the exact route is refused (the numeric route decides, marked not exhaustive)."""

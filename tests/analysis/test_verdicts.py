@@ -182,6 +182,7 @@ def cases(seed, n):
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("preset,values,tied,x,y", cases(101, 16))
 def test_map_and_sweep_verdicts_against_reference(preset, values, tied, x, y):
     from brakesqueal.sweep import sweep
@@ -258,6 +259,7 @@ def test_exact_crossings_against_reference(preset, values, tied, x, y):
     _check_crossings(space, r, x.name, x.log)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(5))
 def test_critical_speeds_against_reference(seed):
     rng = np.random.default_rng(300 + seed)
@@ -301,6 +303,7 @@ def test_critical_speed_batch_kernel_equals_exact_isolation():
     ("six-dof", Axis("k_c", 1e7, 1e11, 5, True), Axis("mu2", 0.3, 0.7, 3)),
     ("eight-dof", Axis("k_c", 1e8, 1e10, 4, True), Axis("k_cn", 1e6, 1e9, 3, True)),
 ])
+@pytest.mark.slow
 def test_built_model_maps_against_mpmath_eigenvalues(model, x, y):
     """Every built-in model: certified verdicts vs mpmath eigenvalues of the model's own M, D, K (40 digits)."""
     from brakesqueal import linearize
@@ -380,6 +383,7 @@ def test_issue5_axis_starting_at_zero():
     assert 0.3 < a["stable"].values[1:].mean() < 0.5
 
 
+@pytest.mark.slow
 def test_issue6_exact_crossings_over_huge_ranges():
     space = ParameterSpace.from_preset("paper-fig2", {"mu": 0.5})
     narrow = crossings(space, Axis("k_ip", 1e5, 1e10, 2, True))
@@ -603,6 +607,7 @@ def test_map_kernel_has_no_axis_sign_assumption(preset, tied, x, y, xr, yr):
     ("paper-fig3", (("k_ip2", "8e7"),), "mu1", 0.05, 0.95, False, {"Omega": 100.0}),
     ("paper-fig3", (("N0", "60*Omega"),), "Omega", 1e-3, 1e7, True, {}),  # Omega tied: crossings() route
 ])
+@pytest.mark.slow
 def test_known_crossings_against_reference(preset, tied, name, lo, hi, log, fixed):
     space = build_space(preset, tuple(fixed.items()), tied)
     r = critical_speeds(space, lo, hi) if name == "Omega" else crossings(space, Axis(name, lo, hi, 2, log))

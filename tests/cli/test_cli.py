@@ -53,6 +53,7 @@ def test_linearize_from_toml_file(tmp_path, cache):
     assert p["Theta"] == pytest.approx(0.16 + 0.32 / 0.045 * (p["h10"] - p["h20"]) ** 2)  # eq. (63)
 
 
+@pytest.mark.slow
 def test_cache_is_written_where_told_and_bypassed_on_request(tmp_path):
     a, b = tmp_path / "a", tmp_path / "b"
     assert run("linearize", cache=a).returncode == 0
@@ -136,6 +137,7 @@ def test_negative_thickness_sum_is_rejected(tmp_path, cache):
     assert res.returncode == 2 and "h10" in res.stderr and "h20" in res.stderr
 
 
+@pytest.mark.slow
 def test_bench_derive_script_prints_one_json_array_with_the_required_keys(cache):
     script = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_derive.py"
     res = subprocess.run([sys.executable, str(script), "--no-baseline"], capture_output=True, text=True,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 import re
 
 import typer.main
@@ -36,6 +38,7 @@ def test_no_arguments_prints_the_help(capsys):
     assert "Commands:" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_long_commands_report_progress_on_a_non_terminal(tmp_path):
     """simulate, map, sweep and cycles print one-line progress on a pipe (here every update: the interval set to 0)."""
     import os

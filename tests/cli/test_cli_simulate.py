@@ -10,6 +10,7 @@ import pytest
 from brakesqueal.cli import main
 
 
+@pytest.mark.slow
 def test_simulate_json_outputs(tmp_path, capsys):
     nc, png, wav = tmp_path / "sim.nc", tmp_path / "sim.png", tmp_path / "sq.wav"
     rc = main(["simulate", "--t-end", "0.02", "--q0", "1e-5,0", "--out", str(nc), "--plot", str(png),
@@ -25,6 +26,7 @@ def test_simulate_json_outputs(tmp_path, capsys):
         assert w.getframerate() == 44100 and w.getnframes() > 800
 
 
+@pytest.mark.slow
 def test_simulate_event_written(tmp_path, capsys):
     nc = tmp_path / "ev.nc"
     rc = main(["simulate", "--set", "mu=1", "--set", "h=0.05", "--t-end", "1", "--q0", "2e-3,0",
@@ -51,6 +53,7 @@ def test_simulate_event_written(tmp_path, capsys):
         (["--format", "xml"], "format"),
     ],
 )
+@pytest.mark.slow
 def test_simulate_bad_input(args, match, capsys):
     rc = main(["simulate", "--t-end", "0.01", "--no-progress", *args])
     err = capsys.readouterr().err
@@ -58,6 +61,7 @@ def test_simulate_bad_input(args, match, capsys):
     assert err.count("\n") == 1 and match in err
 
 
+@pytest.mark.slow
 def test_solver_failure_writes_partial(tmp_path, capsys, monkeypatch):
     import brakesqueal.simulation as sim
 

@@ -136,6 +136,7 @@ def test_crossings_plot_draws_the_stored_profile(tmp_path, capsys):
     assert png.stat().st_size > 1000 and "k_ip =" in out
 
 
+@pytest.mark.slow
 def test_reproduce_fig3_small(tmp_path, monkeypatch):
     from brakesqueal import reproduce
 

@@ -104,6 +104,7 @@ def test_locus_lines_hold_every_mode_between_nans(origin):
     assert all(v.size == 0 for v in locus_lines(np.empty(0), np.empty((0, 0))).values())
 
 
+@pytest.mark.slow
 def test_audio_equals_the_wav_file(tmp_path):
     from brakesqueal import simulate
 
@@ -123,6 +124,7 @@ def test_cli_refuses_bad_input_with_status_2(capsys):
     assert main(["explore", "--port", "70000", "--no-browser"]) == 2
 
 
+@pytest.mark.slow
 def test_non_loopback_host_warns():
     import subprocess
     import sys

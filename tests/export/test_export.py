@@ -54,6 +54,8 @@ from brakesqueal.model.library import get_model, resolve_model
 from brakesqueal.model.options import resolve_space
 from brakesqueal.model.parameters import Parameters
 
+pytestmark = pytest.mark.slow  # module fixtures dominate: the whole module runs in `make test-slow`
+
 RTOL = 1e-12
 BUILT_IN = ("paper", "minimal", "in-plane-pad", "six-dof", "eight-dof", "four-pad", "belt")
 ANGLED = "angled"

@@ -231,6 +231,7 @@ def tilt_springs(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(model_io, "ModelSpec", SpecWithTiltSprings)
 
 
+@pytest.mark.slow
 def test_a_new_kind_with_physics_reaches_the_equations_the_linearization_and_the_energy(
         tilt_springs: None) -> None:
     """A kind written with hooks only (``TiltSpring``) changes the rows, ``K``, ``D`` and the energy as its closed

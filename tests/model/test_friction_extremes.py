@@ -178,6 +178,7 @@ def _draws(rng, n: int) -> list[tuple[float, float]]:
         (float(10 ** rng.uniform(0, 6)), float(10 ** rng.uniform(lo + 1e-9, 3))) for _ in range(n)]
 
 
+@pytest.mark.slow
 def test_stribeck_at_any_slip_speed_matches_mpmath(models, rng) -> None:
     space, twin = _space(models, "stribd"), _space(models, "lind")
     r = space.value("r")

@@ -100,6 +100,7 @@ def models(draw: st.DrawFn) -> dict:
 
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.filter_too_much,
                                                                    HealthCheck.too_slow])
+@pytest.mark.slow
 @given(models())
 def test_every_model_reads_back_exactly(d):
     try:

@@ -66,6 +66,7 @@ def bautin_hopf():
     return s, first_lyapunov(s, [0.0, 0.0], 0.0)
 
 
+@pytest.mark.slow
 def test_continue_cycles_reports_the_running_maximum_through_a_fold(bautin_hopf):
     """r' = r (mu + r^2 - r^4): subcritical Hopf at mu = 0, the branch heads for mu = -0.5, turns at the fold
     mu = -1/4 and ends at mu = +0.5: after the fold the distance towards -0.5 shrinks, the fraction does not."""
@@ -114,6 +115,7 @@ def shooting_run():
     return space, b, calls
 
 
+@pytest.mark.slow
 def test_shooting_branch_reports_its_points_and_the_location(shooting_run):
     _, b, calls = shooting_run
     p = b.data["p"].values
@@ -128,6 +130,7 @@ def test_shooting_branch_reports_its_points_and_the_location(shooting_run):
     assert len(calls) >= p.size + 3 and set(calls[p.size:]) == {1.0}
 
 
+@pytest.mark.slow
 def test_shooting_branch_stops_when_progress_raises(shooting_run):
     space, b, calls = shooting_run
     seen: list[float] = []

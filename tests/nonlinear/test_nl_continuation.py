@@ -20,6 +20,7 @@ def bautin_branch():
     return h, continue_cycles(s, h, (-0.5, 0.5), ds_max=0.1)
 
 
+@pytest.mark.slow
 def test_bautin_subcritical_hopf_fold_of_cycles_and_hysteresis(bautin_branch):
     """r' = r (mu + r^2 - r^4): subcritical Hopf at mu = 0 (l1 = 2 in MatCont's normalisation, see
     test_nl_hopf), cycles r^2 = (1 +- sqrt(1 + 4 mu)) / 2, fold at mu = -1/4 with r^2 = 1/2; the stable

@@ -80,6 +80,7 @@ def test_pad_options_and_paths_decide_the_route():
             cycle_route(fig3, **bad)
 
 
+@pytest.mark.slow
 def test_cycles_default_is_the_exact_pads_route(capsys):
     assert main(["cycles", *FIG3, "--max-points", "6", "--format", "json"]) == 0
     auto = json.loads(capsys.readouterr().out)
@@ -134,6 +135,7 @@ def test_turning_points_locate_a_parabolic_fold():
     assert len(turning_points(two)) == 2
 
 
+@pytest.mark.slow
 def test_harmonic_balance_folds_agree_with_shooting():
     # six-dof: massive pads, so shooting integrates the exact equations too; the subcritical branch turns at a
     # fold past the contact loss (the bilateral equations continued on both routes)
@@ -229,6 +231,7 @@ def test_hill_pencil_equals_the_complex_companion_form(seed):
             assert abs(np.vdot(a, b)) / (np.linalg.norm(a) * np.linalg.norm(b)) > 1 - 1e-8
 
 
+@pytest.mark.slow
 def test_a_nonlinear_simulation_says_when_its_pads_are_quasi_static():
     from brakesqueal import simulate
 

@@ -29,6 +29,7 @@ def branches():
     return space, [squeal_branch(space, axis, **opts) for axis, opts in RUNS]
 
 
+@pytest.mark.slow
 def test_contact_loss_does_not_depend_on_range_or_steps(branches):
     _, runs = branches
     losses = np.array([b.contact_loss for b in runs], dtype=float)
@@ -36,7 +37,7 @@ def test_contact_loss_does_not_depend_on_range_or_steps(branches):
     assert np.ptp(losses) < 1e-6, losses  # rad/s (measured spread 3e-9)
     onset = runs[0].hopf.branch_start.p0  # the branch continues the simulated (quasi-static pad) equations
     for k, b in enumerate(runs):
-        assert b.summary.onset == onset
+        assert b.summary.onset == pytest.approx(onset, rel=1e-13)  # the Hopf point, refined from range-dependent brackets
         # stable squeal from the onset up to the located contact loss, whatever the range (was (35.74, 35.74))
         assert b.summary.squeal_range == pytest.approx((onset, b.contact_loss), abs=1e-12)
         p = b.data["p"].values
@@ -44,6 +45,7 @@ def test_contact_loss_does_not_depend_on_range_or_steps(branches):
             assert np.count_nonzero((p > onset) & (p < b.contact_loss)) >= 4
 
 
+@pytest.mark.slow
 def test_contact_loss_against_shooting_and_hopf_prediction(branches):
     """Independent: orbits shot at fixed Omega on either side of the loss (their raw smallest normal force over
     512 samples changes sign there), and the normal-form prediction F_min = F0 - k sqrt(Omega - Omega0)."""

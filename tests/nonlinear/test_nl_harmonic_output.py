@@ -107,6 +107,7 @@ def test_no_unstable_verdict_next_to_a_supercritical_onset(name):
         assert worst < 0 or (d["stability_from"] == "normal form" and worst <= d["hill_accuracy"]), d
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["six-dof", "eight-dof"])
 def test_subcritical_onsets_of_the_larger_models_agree_with_shooting(name):
     """The 6- and 8-DOF models (pads with mass: no pad unknowns, so harmonic balance and shooting solve the same

@@ -52,6 +52,7 @@ def _ode_l1(space, p0, omega):
     return first_lyapunov(system, y0, p0, refine=True, omega=omega)
 
 
+@pytest.mark.slow
 def test_implicit_normal_form_equals_the_ode_route_for_regular_pads(rising_friction_model):
     space = resolve_space(rising_friction_model, None, None, [f"k_ip1={K_IP}", f"k_ip2={K_IP}", "s=-1e-3"])
     ex = exact_lyapunov(space, "Omega", 4.19).hopf
@@ -65,6 +66,7 @@ def test_implicit_normal_form_equals_the_ode_route_for_regular_pads(rising_frict
     np.testing.assert_allclose(ex.amplitude_coefficients, ode.amplitude_coefficients, rtol=1e-4)
 
 
+@pytest.mark.slow
 def test_coulomb_pads_are_the_limit_of_vanishing_friction_slope(rising_friction_model):
     coulomb = resolve_space(None, None, None, [f"k_ip={K_IP}"])
     pts = hopf_points(coulomb, Axis("Omega", 1.0, 10.0))
@@ -119,6 +121,7 @@ def test_bad_parameter_is_named():
         exact_lyapunov(space, "Omega", math.nan)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(MODELS))
 def test_every_built_in_model_against_the_ode_route(name):
     """Where the simulated equations are exact (no quasi-static pad with a finite k_ip), both routes agree."""
@@ -159,6 +162,7 @@ def test_crossings_and_critical_speed_gain_the_hopf_fields(capsys):
     assert "hopf" not in json.loads(capsys.readouterr().out)["crossings"][0]  # unchanged without --hopf
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(4))
 def test_random_regular_pad_models_against_the_ode_route(rising_friction_model, seed):
     """Random asymmetric parameter sets with rising friction: the implicit route equals the explicit ODE's."""
@@ -182,6 +186,7 @@ def test_random_regular_pad_models_against_the_ode_route(rising_friction_model, 
         np.testing.assert_allclose(ex.amplitude_coefficients, ode.amplitude_coefficients, rtol=rtol)
 
 
+@pytest.mark.slow
 def test_limit_cycles_of_the_regularised_pads_follow_the_exact_prediction(rising_friction_model):
     """Third route: periodic orbits shot on the explicit ODE of a slightly rising friction law (the pads' rates
     regularised, s = 1e-4 s/m) have the amplitude the exact Coulomb normal form predicts, not the quasi-static one.
@@ -201,6 +206,7 @@ def test_limit_cycles_of_the_regularised_pads_follow_the_exact_prediction(rising
     assert np.all(quasi.amplitude(quasi.p0 + dp)[:2] > 3 * tilt)
 
 
+@pytest.mark.slow
 def test_branch_of_regularised_pads(rising_friction_model):
     """The documented how-to: `cycles` on the regularised model continues past the stiff orbits where a
     sampling run of the explicit integrator failed (it used to end the command), and its first points have
@@ -232,6 +238,7 @@ def test_tilted_silent_motion_with_rigid_pads():
     np.testing.assert_allclose(ex.amplitude_coefficients[:4], sim.amplitude_coefficients, rtol=1e-3)
 
 
+@pytest.mark.slow
 def test_pad_slope_option_equals_the_model_file_route(rising_friction_model, capsys):
     """`squeal_branch(pad_slope=...)` / `cycles --pad-slope` build the same regularised model as the how-to's
     model file (an independent construction: TOML text vs. the spec rewritten in code)."""
@@ -251,6 +258,7 @@ def test_pad_slope_option_equals_the_model_file_route(rising_friction_model, cap
         assert "--pad-slope" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_simulate_with_regularised_pads(capsys):
     """`simulate --pad-slope`: the pads' deformations become integrator states (their rates are kept)."""
     assert main(["simulate", "--set", "k_ip=1e6", "--set", "Omega=90", "--t-end", "0.005", "--pad-slope", "1e-4",

@@ -27,6 +27,7 @@ from brakesqueal import hopf_points, model_system
 from brakesqueal import simulation_model
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(MODELS))
 def test_vector_field_jacobian_is_exact(name):
     space = ParameterSpace.from_preset(name)
@@ -88,6 +89,7 @@ def test_predicted_amplitude_matches_periodic_orbits(fig3_onset):
 
 @pytest.mark.parametrize("name,along", [("six-dof", "Omega=1:1e3:log"), ("minimal", "Omega=1:1e4:log"),
                                         ("belt", "slope=0:0.02")])
+@pytest.mark.slow
 def test_hopf_command_on_built_models(name, along, capsys):
     assert main(["hopf", "--model", name, "--along", along, "--format", "json"]) == 0
     d = json.loads(capsys.readouterr().out)
@@ -111,6 +113,7 @@ def test_hopf_text_and_bad_parameter(capsys):
     assert "did you mean 'Omega'" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_squeal_branch_finds_contact_loss(tmp_path, capsys):
     """The branch's contact loss is where a periodic orbit (shooting, independent of the branch) grazes F_n = 0."""
     from brakesqueal import squeal_branch

@@ -26,6 +26,8 @@ from brakesqueal import simulate
 
 from _disk_energy import disk_work
 
+pytestmark = pytest.mark.slow  # module fixtures dominate: the whole module runs in `make test-slow`
+
 SETS = ["mu1=0.5", "mu2=0.5", "k_ip=1e6"]
 AXIS = Axis("Omega", 30.0, 140.0)
 

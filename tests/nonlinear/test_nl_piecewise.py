@@ -193,6 +193,7 @@ def test_impact_oscillator_reset_map_and_saltation():
     assert o.trivial_multiplier_error < 1e-8
 
 
+@pytest.mark.slow
 def test_hopf_then_grazing_contact():
     """Van der Pol with a one-sided spring at x = g: the cycle born at the Hopf point grows until it grazes
     the contact; the GR point is located where the orbit's maximum reaches g."""

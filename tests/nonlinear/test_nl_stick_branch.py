@@ -34,6 +34,7 @@ def branches():
     return rising, stick
 
 
+@pytest.mark.slow
 def test_stick_branch_agrees_with_the_rising_law_to_order_v_reg_squared(branches):
     rising, stick = branches
     assert stick.data.attrs["stick_slip"] == "regularised" and rising.data.attrs["stick_slip"] == "none"
@@ -49,6 +50,7 @@ def test_stick_branch_agrees_with_the_rising_law_to_order_v_reg_squared(branches
     assert stick.summary.validity_end is None
 
 
+@pytest.mark.slow
 def test_a_sliding_reversal_ends_validity_only_without_stick_regularisation(branches):
     for br, ends in zip(branches, (True, False)):
         ds = br.data.copy()
@@ -71,6 +73,7 @@ def test_stick_speed_needs_pad_slope(capsys):
     assert "give --pad-slope too" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_cycles_command_with_stick_speed(capsys):
     assert main(["cycles", "--preset", "paper-fig3", *[a for s in SETS for a in ("--set", s)], "--along",
                  "Omega=29:40", "--pad-slope", "1e-4", "--stick-speed", "1e-2", "--max-points", "4",

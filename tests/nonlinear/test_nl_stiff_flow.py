@@ -104,6 +104,7 @@ def _orbit_start(system):
     return x
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("jacobian", ["block", "full"])
 @pytest.mark.parametrize("method", ["Radau", "BDF"])
 def test_implicit_flows_agree_with_dop853_end_state_and_monodromy(method, jacobian):
@@ -123,6 +124,7 @@ def test_implicit_flows_agree_with_dop853_end_state_and_monodromy(method, jacobi
     assert r.nfev < ref.nfev  # the explicit method pays for the stiffness
 
 
+@pytest.mark.slow
 def test_radau_through_events_agrees_with_dop853():
     system = stiff_vdp_stop()
     x0 = _orbit_start(system.modes[0])
@@ -179,6 +181,7 @@ def test_the_flow_choice_follows_the_stiffness():
         squeal_branch(rigid, Axis("Omega", 30.0, 40.0), flow_method="RK4")
 
 
+@pytest.mark.slow
 def test_a_stiffly_damped_unilateral_branch_lifts_off_where_harmonic_balance_loses_contact():
     """d_ip = 3 N s/m (pad modes at -3.3e5 1/s, stiffness ratio 30: the relaxed monodromy tolerance): the unilateral
     shooting branch's first lift-off (the GR point, located with the piecewise flow, and the contact loss) equals

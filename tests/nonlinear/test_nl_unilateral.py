@@ -39,6 +39,7 @@ def lifting_orbit():
     return space, pw, o
 
 
+@pytest.mark.slow
 def test_orbit_through_contact_loss_matches_event_driven_simulation(lifting_orbit):
     space, pw, o = lifting_orbit
     names = sorted(e.name for e in o.events)

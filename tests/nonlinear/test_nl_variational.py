@@ -64,11 +64,13 @@ def _check_jacobian(params, what):
     return sim
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("preset, overrides, _name", CASES)
 def test_compiled_jacobian_is_exact(preset, overrides, _name):
     _check_jacobian(ParameterSpace.from_preset(preset, overrides).resolve({}), preset)
 
 
+@pytest.mark.slow
 def test_compiled_jacobian_with_a_dynamic_pad():
     """A coulomb pad (quasi-static) and a falling-friction pad (its deformation a state) at a tilted silent motion."""
     pads = tuple(Pad(n, face, radius="r", k=f"k{n}", d=f"d{n}", preload="N0", k_ip=f"k_ip{n}",

@@ -86,6 +86,7 @@ def test_contact_loss_stops_with_partial_trajectory():
         assert tr.event_pad == ("1", "2")[int(np.argmin(c[:, 0]))]
 
 
+@pytest.mark.slow
 def test_scipy_event_agrees_with_compiled_event():
     params = get_preset("paper-fig2").resolve({"mu": 1.0, "h": 0.05})
     # the compiled integrator also looks inside each step (dense output), so it agrees with a

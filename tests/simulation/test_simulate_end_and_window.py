@@ -26,6 +26,7 @@ def test_end_time_is_where_the_integration_ended_not_the_last_sample(params):
     assert tr.t_end_reached == 0.0105
 
 
+@pytest.mark.slow
 def test_end_time_of_a_contact_loss_is_the_event_time(capsys):
     """The run of the defect: the message says t = 33.4809 s, t_end_reached said 33.0 (the last sample)."""
     rc = main(["simulate", "--t-end", "40", "--sample-rate", "1", "--format", "json", "--no-progress"])

@@ -74,6 +74,7 @@ def check_estimate(s, lam: complex, rel: float = 1e-8, sigmas: float = 1.0) -> N
 
 
 # ----------------------------------------------------------------------------- every built-in model
+@pytest.mark.slow
 @pytest.mark.parametrize("name", MODELS)
 def test_growth_and_frequency_are_the_leading_eigenvalue(name):
     params = resolve_parameters(name)
@@ -106,6 +107,7 @@ ZERO = {  # no friction, no damping
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", MODELS)
 def test_energy_is_conserved_without_friction_and_damping(name):
     """E = T2 + V_support + V_pads: conserved to quadratic order in the tilt (exactly without a tilting disk)."""
@@ -125,6 +127,7 @@ def test_energy_is_conserved_without_friction_and_damping(name):
     assert np.abs(er["E"] - er["E"][0]).max() > 1e-2 * er["T2"].max()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", MODELS)
 def test_compiled_integrator_agrees_with_solve_ivp(name):
     """The compiled DOP853 and SciPy's solve_ivp on the same generated right-hand side."""
@@ -154,6 +157,7 @@ def _paper_like(laws, name, **values):
     return Parameters(spec, {**par, **values})
 
 
+@pytest.mark.slow
 def test_falling_friction_pad_mode_grows_in_the_simulation():
     """A massless pad with falling friction keeps its first-order dynamics: its mode lambda = -k_ip/(N0 mu')."""
     params = _paper_like(("linear", "linear"), "falling")
@@ -178,6 +182,7 @@ def test_falling_friction_pad_mode_grows_in_the_simulation():
     assert abs(s.growth_rate - quasi.real) > 10.0
 
 
+@pytest.mark.slow
 def test_mixed_pads_match_their_own_linearization():
     """A coulomb pad (quasi-static) with a falling-friction pad (dynamic) at a tilted silent motion.
 
@@ -233,6 +238,7 @@ def _large_start(name, factor):
     return m, params, factor * (tr.y_start - tr.silent_state)
 
 
+@pytest.mark.slow
 def test_contact_loss_of_one_of_four_pads():
     m, params, pert = _large_start("four-pad", 300)  # 3e-3 rad along the leading (whirling) mode
     tr = simulate(params, 2.0, perturbation=pert, sample_rate=20000)
@@ -419,6 +425,7 @@ def warm_paper():
     assert res.returncode == 0, res.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("terminal", [True, False], ids=["tty-progress-bar", "pipe"])
 def test_ctrl_c_stops_within_a_second(terminal, warm_paper, tmp_path):
     """SIGINT to a long run: exit 130 within a second, no crash, the existing output file untouched.

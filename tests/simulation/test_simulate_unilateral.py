@@ -99,6 +99,7 @@ def test_lifted_pad_forcing_matches_the_equations_without_its_contact_force(ref)
         assert np.abs(a - b).max() > 1e2 * 1e-9 * np.abs(a).max()  # far above the tolerance of the comparison
 
 
+@pytest.mark.slow
 def test_unilateral_run_matches_an_independent_event_loop(ref):
     """Lift-offs and re-contacts of the compiled run = an independent solve_ivp event loop on the symbolic equations."""
     params = _params()

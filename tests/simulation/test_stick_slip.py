@@ -68,6 +68,7 @@ def _run(vs, omega, t_end, perturbation):
                     events="continue", sample_rate=200_000.0)
 
 
+@pytest.mark.slow
 def test_without_sticking_the_law_differs_from_the_rising_law_by_v_reg_squared():
     """Omega = 90 rad/s (Omega r = 11.7 m/s), a small vibration: the pads never come near stick."""
     kick = [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
@@ -81,6 +82,7 @@ def test_without_sticking_the_law_differs_from_the_rising_law_by_v_reg_squared()
     assert 3.5 < diffs[0] / diffs[1] < 4.5, diffs  # O(V^2)
 
 
+@pytest.mark.slow
 def test_a_pad_that_would_stick_creeps_at_the_regularisation_speed_and_the_runs_converge():
     """Omega = 10 rad/s (Omega r = 1.3 m/s) and a kick of 20 rad/s: the pads' tangential rate reaches the
     sliding speed once per period.  With the rising law alone a pad's sliding velocity then sweeps through
@@ -110,6 +112,7 @@ def test_a_pad_that_would_stick_creeps_at_the_regularisation_speed_and_the_runs_
     assert np.all(d1 / d2 > 1.8), d1 / d2
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("vs", [None, 1e-3])
 def test_the_pad_solve_converges_from_any_warm_start(vs):
     """Near stick a pad's balance is nearly a step in its rate and Newton from a far warm start overshoots
@@ -143,6 +146,7 @@ def test_the_pad_solve_converges_from_any_warm_start(vs):
             assert side[0] * side[1] < 0, (y, root)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["DOP853-jit", "RK45"])
 def test_with_stick_slip_events_stop_only_at_contact_loss(method):
     """events="stop" (the default): the rising-law pads' run stops at its first sliding reversal (at a near

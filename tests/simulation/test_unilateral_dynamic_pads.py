@@ -24,6 +24,8 @@ from brakesqueal.errors import ParameterError
 from brakesqueal.model.options import regularised_pads, resolve_space
 from brakesqueal import simulate, simulation_model
 
+pytestmark = pytest.mark.slow  # module fixtures dominate: the whole module runs in `make test-slow`
+
 SETS = ["mu1=0.5", "mu2=0.5", "k_ip1=1e6", "k_ip2=1e6"]
 
 

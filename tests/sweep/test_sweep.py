@@ -136,6 +136,7 @@ def test_samples_lhs_and_random(tmp_path):
     assert not np.allclose(rnd["mu"].values, mu)
 
 
+@pytest.mark.slow
 def test_critical_speed_with_study_tie():
     study = {"preset": "paper-fig3", "parameters": {"k_ip": 1e8}, "tied": {"mu2": "1 - mu1"},
              "axes": {"mu1": {"values": [0.3, 0.5, 0.9]}},
@@ -293,6 +294,7 @@ def test_bad_study_one_line_exit_2(tmp_path, capsys, text, needle):
     assert not (tmp_path / "bad.zarr").exists()
 
 
+@pytest.mark.slow
 def test_unreachable_scheduler_fails_fast(tmp_path, capsys):
     f = write(tmp_path / "s.toml", STUDY3.format(q='["stable"]'))
     t0 = time.perf_counter()

@@ -28,6 +28,7 @@ def assert_same(a, b) -> None:
     assert {k: v for k, v in a.attrs.items() if k != "created"} == {k: v for k, v in b.attrs.items() if k != "created"}
 
 
+@pytest.mark.slow
 def test_local_cluster_two_workers_identical_to_in_process(tmp_path):
     grid = {"name": "cluster", "preset": "paper-fig2",
             "axes": {"Omega": {"values": [20.0, 60.0]}, "mu": "0.05:1:20", "k_ip": "1e5:1e10:30:log"},
@@ -76,6 +77,7 @@ def _markers(store: Path) -> dict[str, int]:
     return {p.name: p.stat().st_mtime_ns for p in d.glob("[0-9]*.json")} if d.is_dir() else {}
 
 
+@pytest.mark.slow
 def test_sigkill_then_resume_loses_nothing(tmp_path):
     f = tmp_path / "study.toml"
     f.write_text(STUDY.format(store="killed.zarr"))

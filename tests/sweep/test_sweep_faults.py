@@ -197,6 +197,7 @@ def kill(proc: subprocess.Popen) -> None:
 
 
 # ---------------------------------------------------------------- SIGKILL
+@pytest.mark.slow
 def test_sigkill_during_creation_and_computation_then_resume_bit_identical(ref, tmp_path, capsys):
     rng = np.random.default_rng(11)
     f, reference = ref["grid"]
@@ -234,6 +235,7 @@ def test_sigkill_during_creation_and_computation_then_resume_bit_identical(ref, 
 
 
 # ---------------------------------------------------------------- concurrent runs
+@pytest.mark.slow
 def test_two_runs_on_a_fresh_store_exactly_one_runs(ref, tmp_path):
     f, reference = ref["grid"]
     store = tmp_path / "c.zarr"
@@ -248,6 +250,7 @@ def test_two_runs_on_a_fresh_store_exactly_one_runs(ref, tmp_path):
     assert_bit_identical(store, reference)
 
 
+@pytest.mark.slow
 def test_two_resumes_of_a_partial_store_exactly_one_computes(ref, tmp_path, monkeypatch, capsys):
     f, reference = ref["grid"]
     store = tmp_path / "p.zarr"
@@ -366,6 +369,7 @@ CASES = [("grid", k) for k in KINDS + ["data-array", "markers-dir"]] + \
         [("samples", k) for k in ("coord-metadata", "coord-chunk", "data-chunk", "marker", "record")]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("tag", "kind"), CASES)
 def test_damaged_file_status_then_resume(ref, tmp_path, monkeypatch, capsys, tag, kind):
     rng = np.random.default_rng(zlib.crc32(f"{tag}/{kind}".encode()))
@@ -469,6 +473,7 @@ def _completed_are_correct(f, store: Path, reference: Path) -> list[int]:
     return s.completed
 
 
+@pytest.mark.slow
 def test_enospc_at_random_writes_then_resume(ref, tmp_path, monkeypatch, capsys):
     f, reference = ref["grid"]
     count = FailingWrites()

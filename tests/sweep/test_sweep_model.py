@@ -20,6 +20,7 @@ from brakesqueal.errors import ParameterError
 from brakesqueal.sweep import sweep
 
 
+@pytest.mark.slow
 def test_model_study_matches_pointwise_linearization(tmp_path):
     ds = sweep({"model": "six-dof", "parameters": {"d_c": 40.0},
                 "axes": {"k_c": "1e8:1e10:5:log", "mu1": "0.4:0.6:3"},

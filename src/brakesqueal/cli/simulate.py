@@ -19,7 +19,7 @@ from ._options import (PLOT_SUFFIXES, ContactLaw, ModelOpt, OutFormat, PadDampin
 
 if TYPE_CHECKING:
     from ..model.parameters import Parameters
-    from ..simulation._integrate import EventMode
+    from ..simulation import EventMode
     from ..simulation.trajectory import Trajectory
 
 __all__ = ["register"]

@@ -71,7 +71,6 @@ GENERATOR_MODULES: tuple[str, ...] = (
     "analysis/_compiled.py",  # numba root isolation linked with the stability kernels
     "export/*.py",  # exported code and LaTeX
     "render.py",  # the rendered closed forms cached by ``derive``
-    "nonlinear/*.py",  # compiled flows of the continuation (numba) and what they import
     "fingerprint.py",  # the fingerprint itself
     "status.py",  # the triviality rule (TRIVIAL_NOISE_FLOOR) decides the cached closed-route tables
 )

@@ -250,13 +250,13 @@ def model_flow(engine: Engine, space: ParameterSpace, name: str, *, system: Smoo
         system = model_system(engine, space, name, use_cache=use_cache)
     sim = simulation_model(engine, use_cache=use_cache)
     mod = sim.variational_kernels()
-    cache: dict[float, np.ndarray] = {}
+    thetas: dict[float, np.ndarray] = {}
 
     def theta_of(p: float) -> np.ndarray:
-        th = cache.get(p)
+        th = thetas.get(p)
         if th is None:
-            if len(cache) > 16:
-                cache.clear()
+            if len(thetas) > 16:
+                thetas.clear()
             params = space.resolve({name: p})
             h = 1e-3 * max(abs(p), 1e-300)
             v = [sim.parameter_vector(space.resolve({name: p + k * h})) for k in (-2, -1, 1, 2)]
@@ -266,7 +266,7 @@ def model_flow(engine: Engine, space: ParameterSpace, name: str, *, system: Smoo
             dp = np.where(same, 0.0, dp)
             if not np.all(np.isfinite(dp)):
                 raise ParameterError(f"the model parameters are not differentiable along {name!r} at {p:.12g}")
-            th = cache[p] = sim.variational_theta(params, dp)
+            th = thetas[p] = sim.variational_theta(params, dp)
         return th
 
     return CompiledFlow(system, kernels=(mod.nl_f, mod.nl_jac, mod.nl_dfdp), theta=np.empty(0), rtol=rtol,
