@@ -48,6 +48,10 @@ API_DIR = "api"
 
 
 # ------------------------------------------------------------------ API pages
+#: Packages of kernel source templates (``codegen/templates``): the code generator reads them as text and
+#: fills them in; on their own they neither import (numba types their free names) nor form an API.
+TEXT_PACKAGES = ("brakesqueal.codegen.templates.",)
+
 def public_modules(package: str = PACKAGE) -> tuple[list[str], dict[str, str]]:
     """Names of the public modules of ``package`` and ``{module: import error}``."""
     pkg = importlib.import_module(package)
@@ -58,6 +62,8 @@ def public_modules(package: str = PACKAGE) -> tuple[list[str], dict[str, str]]:
 
     for info in pkgutil.walk_packages(pkg.__path__, f"{package}.", onerror=onerror):
         if any(part.startswith("_") for part in info.name.split(".")):
+            continue
+        if info.name.startswith(TEXT_PACKAGES):  # numba source read as text by the code generator
             continue
         try:
             importlib.import_module(info.name)

@@ -10,18 +10,18 @@ the type and attributes given here, so a new quantity is one
 
 Built-in quantities (``stable`` and ``status`` are always stored):
 
-========== ===== ================================================================
-name       type  meaning
-========== ===== ================================================================
-stable     bool  certified asymptotically stable silent motion
-status     int8  :class:`~brakesqueal.status.PointStatus` code
-max_real   f8    largest real part of the eigenvalues [1/s]
-frequency  f8    frequency of the least-stable mode [Hz]
-margin     f8    damping ratio of the least-stable mode, ``-Re λ/|λ|``
-carrier    int8  the mode carrying the verdict (flags: the model's components)
-route      int8  the route of the dispatcher that decided (flags: the routes)
-critical_speed f8 first destabilising Ω of the searched range [rad/s]
-========== ===== ================================================================
+============== ===== ================================================================
+name           type  meaning
+============== ===== ================================================================
+stable         bool  certified asymptotically stable silent motion
+status         int8  :class:`~brakesqueal.status.PointStatus` code
+max_real       f8    largest real part of the eigenvalues [1/s]
+frequency      f8    frequency of the least-stable mode [Hz]
+margin         f8    damping ratio of the least-stable mode, ``-Re λ/|λ|``
+carrier        int8  the mode carrying the verdict (flags: the model's components)
+route          int8  the route of the dispatcher that decided (flags: the routes)
+critical_speed f8    first destabilising Ω of the searched range [rad/s]
+============== ===== ================================================================
 """
 
 from __future__ import annotations

@@ -624,7 +624,7 @@ def _omega_terms(form: ModelForm) -> list[list[tuple[Any, dict[int, int]]]]:
 
 
 def omega_slots(form: ModelForm) -> list[list[tuple[float, dict[int, int]]]]:
-    """Coefficients of ``Ω · entry`` in ``Ω^0 .. Ω^3`` for the 12 entries (48 slots), term by term.
+    """Coefficients of ``Ω · entry`` in ``Ω^0``–``Ω^3`` for the 12 entries (48 slots), term by term.
 
     Raises
     ------
