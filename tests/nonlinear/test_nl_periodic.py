@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -130,3 +131,33 @@ def test_bad_inputs(vdp):
         find_periodic_orbit(vdp, [0.0, 0.0], period=6.0, p=1.0)
     with pytest.raises(ShootingError):
         find_periodic_orbit(vdp, [1e-3, 0.0], period=6.3, p=-0.5, max_iter=6)  # no cycle: the focus is stable
+
+
+
+class _NoisyFlow:
+    """A flow whose end state carries relative noise of its ``rtol`` (as event location leaves in a piecewise flow)."""
+
+    def __init__(self, inner: ScipyFlow) -> None:
+        self.inner, self.system, self.rtol = inner, inner.system, inner.rtol
+        self.rng = np.random.default_rng(20261129)
+
+    def __call__(self, x0, T, p, **kw):
+        r = self.inner(x0, T, p, **kw)
+        return dataclasses.replace(r, x=r.x * (1 + self.rtol * self.rng.uniform(-1, 1, r.x.shape)))
+
+
+@pytest.mark.parametrize("rtol", [1e-6, 1e-8])
+@pytest.mark.parametrize("mu", [-0.2, 0.3])
+def test_newton_stops_at_the_flows_noise_floor_on_the_closed_form_cycle(rtol, mu):
+    """Noise of the flow's rtol in every end state and a tol it cannot reach (1e-13): Newton stops once the
+    residual is at that noise floor and the update no longer shrinks, on the Bautin circle (closed form as
+    above) to the accuracy the flow allows; it does not stop there after two iterations from 1 % away."""
+    s = bautin()
+    r = math.sqrt((1 + math.sqrt(1 + 4 * mu)) / 2)  # the stable (outer) circle
+    flow = _NoisyFlow(ScipyFlow(s, rtol=rtol))
+    o = find_periodic_orbit(s, [r * 1.01, 0.02], period=6.2, p=mu, flow=flow, tol=1e-13)
+    assert o.residual <= 10 * rtol
+    assert o.period == pytest.approx(2 * math.pi, rel=1e3 * rtol)
+    assert np.max(np.abs(np.hypot(o.samples[:, 0], o.samples[:, 1]) - r)) < 1e3 * rtol
+    with pytest.raises(ShootingError):
+        find_periodic_orbit(s, [r * 1.01, 0.02], period=6.2, p=mu, flow=flow, tol=1e-13, max_iter=2)
