@@ -39,7 +39,7 @@ def _engine(model: ModelSpec | str | Parameters | ParameterSpace, use_cache: boo
     from .model.parameters import Parameters, ParameterSpace
 
     spec = model.model if isinstance(model, (Parameters, ParameterSpace)) else model
-    return build(spec, use_cache=use_cache)
+    return build(spec, use_cache=use_cache).require_nonlinear("nonlinear analysis")
 
 
 def simulate(params: Parameters, t_span: float | Sequence[float] = 0.5,

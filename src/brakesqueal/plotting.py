@@ -363,13 +363,18 @@ def save(fig: Figure, path: str, dpi: int = 300) -> str:
     return path
 
 
+#: Modes drawn in colour with a legend in a mode-coupling diagram (a larger model: its least stable ones).
+MODES_LABELLED = 8
+
+
 @styled
 def plot_modes(tracks: ModeTracks, fig: Figure | None = None) -> Figure:
     """Mode-coupling diagram of :class:`~brakesqueal.analysis.modes.ModeTracks`: frequency and Re λ vs the parameter.
 
     Coalescences are marked with circles on the frequency panel, stability
     crossings with vertical dashed lines (red: destabilizing, green:
-    stabilizing).  Returns the figure.
+    stabilizing).  A model with more than :data:`MODES_LABELLED` modes shows its least stable modes (those that
+    become unstable, else the three of largest real part) in colour and the others in grey.  Returns the figure.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -380,11 +385,22 @@ def plot_modes(tracks: ModeTracks, fig: Figure | None = None) -> Figure:
     ax_f, ax_r = fig.subplots(2, 1, sharex=True)
     x = tracks.values
     f, re = tracks.frequencies, tracks.eigenvalues.real
+    many = f.shape[1] > MODES_LABELLED
+    with np.errstate(invalid="ignore"):
+        peak = np.nanmax(np.where(np.isfinite(re), re, -np.inf), axis=0)
+    order = np.argsort(-peak)
+    shown = set(order[:MODES_LABELLED].tolist()) if not many else set(
+        [int(k) for k in order if peak[k] > 0][:MODES_LABELLED] or order[:3].tolist())
     for k in range(f.shape[1]):
-        line, = ax_f.plot(x, f[:, k], lw=1.3, label=f"mode {k}")
-        ax_r.plot(x, re[:, k], lw=1.3, color=line.get_color())
+        if k not in shown:  # a large model: every other mode in grey, unlabelled
+            ax_f.plot(x, f[:, k], lw=0.6, color="0.75", zorder=1)
+            ax_r.plot(x, re[:, k], lw=0.6, color="0.75", zorder=1)
+    for k in sorted(shown):
+        line, = ax_f.plot(x, f[:, k], lw=1.3, label=f"mode {k}", zorder=3)
+        ax_r.plot(x, re[:, k], lw=1.3, color=line.get_color(), zorder=3)
     for c in tracks.coalescences:
-        ax_f.plot([c["value"]], [c["frequency_hz"]], "o", mfc="none", mec="k", ms=7)
+        if not many or set(c["modes"]) & shown:
+            ax_f.plot([c["value"]], [c["frequency_hz"]], "o", mfc="none", mec="k", ms=7, zorder=4)
     for c in tracks.crossings:
         color = "tab:red" if c["direction"] == "destabilizing" else "tab:green"
         for ax in (ax_f, ax_r):
@@ -397,7 +413,17 @@ def plot_modes(tracks: ModeTracks, fig: Figure | None = None) -> Figure:
     ax_r.set_xlabel(axis_label(tracks.parameter, tracks.units or ""))
     ax_f.set_ylabel(axis_label("frequency"))
     ax_r.set_ylabel(r"Re $\lambda$ [1/s]")
-    ax_r.set_yscale("symlog", linthresh=max(1e-3, float(np.nanmax(np.abs(re))) * 1e-3))
-    ax_f.legend(loc="lower left", bbox_to_anchor=(0.0, 1.02), ncols=3, frameon=False, borderaxespad=0.0)
-    ax_f.set_title(f"mode coupling ({tracks.model})", loc="right", fontsize="medium", pad=24)
+    if many:  # the labelled modes' real parts, near zero, where squeal starts
+        sel = re[:, sorted(shown)]
+        span = float(np.nanmax(np.abs(sel))) if np.isfinite(sel).any() else 1.0
+        ax_r.set_ylim(-3 * span, 3 * span)
+        ax_r.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3))
+    else:
+        ax_r.set_yscale("symlog", linthresh=max(1e-3, float(np.nanmax(np.abs(re))) * 1e-3))
+    ax_f.legend(loc="lower left", bbox_to_anchor=(0.0, 1.02), ncols=3, frameon=False, borderaxespad=0.0,
+                fontsize="small")
+    title = f"mode coupling ({tracks.model})" + (f"\nthe least stable {len(shown)} of {f.shape[1]} modes in colour"
+                                                 if many else "")
+    fig.suptitle(title, fontsize="medium")
     return fig
+

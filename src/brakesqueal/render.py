@@ -58,6 +58,10 @@ def _unit(coord: str) -> str:
     return "rad" if coord.startswith("q") else "m"
 
 
+#: Largest model whose matrices the text output of ``linearize`` prints.
+MAX_PRINTED_DOF = 12
+
+
 def render_linear_model(lm: LinearModel, fmt: str) -> str:
     """Render a :class:`~brakesqueal.analysis.linear.LinearModel` (any model) as text or JSON.
 
@@ -76,12 +80,19 @@ def render_linear_model(lm: LinearModel, fmt: str) -> str:
     lines = [f"Model '{lm.model.name}' ({lm.n} DOF: {', '.join(lm.coords)})", "Parameters:"]
     for k, val in lm.params.to_json_dict().items():
         lines.append(f"  {k:8s} = {val}")
-    kind = "trivial" if sm.trivial else f"non-trivial ({sm.method}, {sm.iterations} iterations)"
-    lines.append("Silent motion (eq. 46): " + ", ".join(f"{c} = {x:.6e} {_unit(c)}" for c, x in zip(lm.coords, lm.q0))
-                 + f"  [{kind}]")
-    pads = [p.name for p in lm.model.pads]
-    lines.append("  normal forces: " + ", ".join(f"pad {n}: {f:.6g} N" for n, f in zip(pads, sm.normal_forces)))
-    lines += _fmt_matrix("M", lm.M) + _fmt_matrix("D", lm.D) + _fmt_matrix("K", lm.K)
+    if sm.method == "matrices":
+        lines[0] = f"Model '{lm.model.name}' ({lm.n} DOF, given by coefficient matrices)"
+        lines.append("Linearization: the model's matrices at these parameters (silent motion x = 0)")
+    else:
+        kind = "trivial" if sm.trivial else f"non-trivial ({sm.method}, {sm.iterations} iterations)"
+        lines.append("Silent motion (eq. 46): " + ", ".join(f"{c} = {x:.6e} {_unit(c)}"
+                                                            for c, x in zip(lm.coords, lm.q0)) + f"  [{kind}]")
+        pads = [p.name for p in lm.model.pads]
+        lines.append("  normal forces: " + ", ".join(f"pad {n}: {f:.6g} N" for n, f in zip(pads, sm.normal_forces)))
+    if lm.n <= MAX_PRINTED_DOF:
+        lines += _fmt_matrix("M", lm.M) + _fmt_matrix("D", lm.D) + _fmt_matrix("K", lm.K)
+    else:
+        lines.append(f"M, D, K: {lm.n} x {lm.n} (not printed above {MAX_PRINTED_DOF} DOF; --format json lists them)")
     if lm.pad_states:
         lines.append(f"Pads kept as first-order states (tangential rates matter here): {', '.join(lm.pad_states)}")
     lines.append("Eigenvalues [1/s]          frequency [Hz]   damping ratio")

@@ -442,7 +442,7 @@ def omega_name(space: ParameterSpace) -> str:
     Returns
     -------
     str
-        ``spec.disk.Omega`` (``"Omega"`` for the built-in models).
+        ``spec.spin`` (``"Omega"`` for the built-in models).
 
     Raises
     ------
@@ -450,7 +450,10 @@ def omega_name(space: ParameterSpace) -> str:
         If the spin is a fixed number of the model, or tied / not settable in ``space``.
     """
     spec = space.model
-    name = spec.disk.Omega
+    name = spec.spin
+    if isinstance(name, str) and not name:
+        raise ParameterError(f"model '{spec.name}' names no spin parameter; critical speeds need one (a matrix "
+                             "model's spin is its parameter 'Omega', or the one its file names with spin = ...)")
     if not isinstance(name, str):
         raise ParameterError(f"model '{spec.name}': the disk's spin Omega is the number {name!r}, not a parameter; "
                              "critical speeds need it as a parameter")

@@ -365,7 +365,16 @@ def silent_motion(engine: Engine, params: Any) -> SilentMotion:
     disk's spin (``Omega > 0``) and stays in contact; both are checked.
     """
     params = as_parameters(params)
+    if engine.caps.kind == "matrices":  # the matrices are the linearization about x = 0
+        return matrix_silent_motion(engine.caps.coords)
     return silent_motion_vector(engine.compiled, list(map(float, params.vector())))
+
+
+def matrix_silent_motion(coords: tuple[str, ...]) -> SilentMotion:
+    """The silent motion ``x = 0`` of a model given by coefficient matrices (no pads, no contact to check)."""
+    z = np.zeros(0)
+    return SilentMotion(coords=tuple(coords), q0=np.zeros(len(coords)), l0=z, normal_forces=z, sliding_speeds=z,
+                        trivial=True, iterations=0, method="matrices")
 
 
 def silent_motion_vector(model: CompiledModel, p: list[float]) -> SilentMotion:

@@ -24,6 +24,7 @@ approximation of earlier versions; exact only in the first case).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -36,7 +37,7 @@ if TYPE_CHECKING:
     from ..codegen.engine import Engine
 
 __all__ = ["ModalMixin", "LinearModel", "linearize", "state_matrix", "jacobian_blocks_at", "pad_rate_eigenvalues",
-           "PAD_RATES", "accurate_jacobian", "eliminate_algebraic", "descriptor_eigenvalues"]
+           "PAD_RATES", "accurate_jacobian", "eliminate_algebraic", "descriptor_eigenvalues", "qep_eigenvalues"]
 
 #: Treatments of the pads' tangential rates (see the module docstring).
 PAD_RATES = ("kept", "quasi-static")
@@ -50,6 +51,36 @@ def state_matrix(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
     top = np.concatenate([np.zeros((n, n)), np.eye(n)], axis=1)
     bottom = np.concatenate([-Minv_K, -Minv_D], axis=1)
     return np.concatenate([top, bottom], axis=0)
+
+
+def qep_eigenvalues(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
+    """Every eigenvalue of ``λ² M + λ D + K`` by QZ of the first companion pencil after the scaling of Fan, Lin &
+    Van Dooren (SIAM J. Matrix Anal. Appl. 26 (2004) 252-256): ``λ = γ μ`` with ``γ = sqrt(‖K‖/‖M‖)`` and the
+    coefficients divided by ``δ = 2/(‖K‖ + γ‖D‖)``.  For models of many DOF it keeps the smallest eigenvalues
+    about ten times closer than the eigenvalues of ``[[0, I], [-M⁻¹K, -M⁻¹D]]`` (disk_brake100: 3e-10 against
+    3e-9 relative between formulations).
+
+    Parameters
+    ----------
+    M, D, K : ndarray, shape (n, n)
+        Dense coefficient matrices.
+
+    Returns
+    -------
+    ndarray of complex, shape (2n,)
+        The eigenvalues (infinite ones where ``M`` is singular are dropped).
+    """
+    import scipy.linalg
+
+    n = M.shape[0]
+    nM, nD, nK = (float(np.linalg.norm(X, 2)) for X in (M, D, K))
+    g = math.sqrt(nK / nM) if nM > 0 and nK > 0 else 1.0
+    d = 2.0 / (nK + g * nD) if nK + g * nD > 0 else 1.0
+    I, Z = np.eye(n), np.zeros((n, n))
+    A = np.block([[Z, I], [-K * d, -D * (d * g)]])
+    B = np.block([[I, Z], [Z, M * (d * g * g)]])
+    mu = scipy.linalg.eigvals(A, B)
+    return np.asarray(mu[np.isfinite(mu)] * g)
 
 
 def pencil_eigenvalues(E: np.ndarray, A: np.ndarray, sweeps: int = 20) -> np.ndarray:
@@ -371,7 +402,9 @@ class LinearModel(ModalMixin):
     def eigenvalues(self) -> np.ndarray:
         """Finite eigenvalues [1/s] of the linear model, sorted by decreasing real part, then imaginary part."""
         if not self._eig:
-            if not self.pad_states and 2 * self.n > EXTENDED_MAX_SIZE:
+            if self.silent.method == "matrices":  # a model given by coefficient matrices (often many DOF)
+                lam = qep_eigenvalues(self.M, self.D, self.K)
+            elif not self.pad_states and 2 * self.n > EXTENDED_MAX_SIZE:
                 lam = np.linalg.eigvals(self.A)
             else:  # every scale right at once (extreme parameters, huge pad modes): extended precision
                 lam = descriptor_eigenvalues(*self.reduced_descriptor)
@@ -518,8 +551,13 @@ def linearize(engine: Engine, params: Any, *, pad_rates: str = "kept") -> Linear
     if pad_rates not in PAD_RATES:
         raise ParameterError(f"pad_rates must be one of {', '.join(PAD_RATES)}; got {pad_rates!r}")
     params = as_parameters(params)
-    cm = engine.compiled
     sm = silent_motion(engine, params)
+    if engine.caps.kind == "matrices":  # a model given by coefficient matrices: they are the linearization
+        engine.require_dense("linearize")  # type: ignore[attr-defined]
+        Ms, Ds, Ks = (X.toarray() if hasattr(X, "toarray") else np.array(X, dtype=float)
+                      for X in engine.linear_at(params))  # type: ignore[attr-defined]
+        return LinearModel(params=params, silent=sm, engine=engine, M=Ms, D=Ds, K=Ks, pad_rates=pad_rates)
+    cm = engine.compiled
     p = parameter_vector(params)
     b = _blocks(cm, None if sm.trivial else sm.state(), p)
     m = cm.m

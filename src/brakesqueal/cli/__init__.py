@@ -226,6 +226,13 @@ def show(name: Annotated[str, typer.Argument(help="A preset or a model (built-in
     sys.stdout.write(pr.describe() + "\n")
     if pr.name == pr.bound_model.name:
         spec = pr.bound_model
+        from ..model.matrices import MatrixSpec
+
+        if isinstance(spec, MatrixSpec):
+            sys.stdout.write(f"  given by coefficient matrices: {spec.n} DOF{' (sparse)' if spec.sparse else ''}, "
+                             f"matrices {', '.join(spec.matrices)}\n"
+                             + "".join(f"  {c} = {spec.coefficients[c]}\n" for c in ("M", "D", "K")))
+            return
         sys.stdout.write(f"  components: {len(spec.pads)} pad(s) ({', '.join(p.name for p in spec.pads)})"
                          + (f", caliper(s) {', '.join(c.name for c in spec.calipers)}" if spec.calipers else "")
                          + f"; presets: {', '.join(spec.preset_names())}\n")
@@ -235,7 +242,7 @@ def _register_plugins() -> None:
     """Add the command groups that live in their own modules."""
     import importlib
 
-    for name in (".stability", ".modes", ".sweep", ".cache", ".simulate", ".export", ".explore"):
+    for name in (".stability", ".modes", ".sweep", ".cache", ".simulate", ".export", ".explore", ".fe_import"):
         mod = importlib.import_module(name, __package__)
         mod.register(app)
 
@@ -260,6 +267,7 @@ SUMMARIES: dict[str, str] = {
     "sweep": "Resumable N-D parameter study into a Zarr store.",
     "simulate": "Integrate the nonlinear equations; summary, NetCDF, WAV.",
     "export": "Write equations as LaTeX, Octave, C, Julia or Python.",
+    "import": "A model file from finite-element coefficient matrices.",
     "cache": "Inspect or clear the code cache.",
     "explore": "The squeal explorer in the browser (live, offline).",
 }

@@ -16,7 +16,8 @@ if TYPE_CHECKING:
     from ..model.parameters import ParameterSpace
 
 __all__ = ["PLOT_SUFFIXES", "ContactLaw", "ModelOpt", "PresetOpt", "ParamsOpt", "SetOpt", "FormatOpt", "OutFormat",
-           "NoCacheOpt", "ProgressOpt", "Modes", "ModesOpt", "space_from", "note", "refuse_set_of_axes"]
+           "NoCacheOpt", "ProgressOpt", "Modes", "ModesOpt", "space_from", "note", "refuse_set_of_axes",
+           "with_equations"]
 
 
 class OutFormat(str, Enum):
@@ -72,6 +73,15 @@ ModesOpt = Annotated[Modes, typer.Option(
                     "judged).")]
 ProgressOpt = Annotated[Optional[bool], typer.Option(
     "--progress/--no-progress", help="Progress on stderr (default: a bar on a terminal, periodic lines otherwise).")]
+
+
+def with_equations(space: ParameterSpace, command: str) -> ParameterSpace:
+    """``space``, or the one-line refusal of a command that needs a model's nonlinear equations (a model given
+    by coefficient matrices has none: :meth:`~brakesqueal.codegen.engine.Engine.require_nonlinear`)."""
+    from ..codegen import build
+
+    build(space.model).require_nonlinear(command)
+    return space
 
 
 def note(message: str) -> None:

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Annotated, cast
 
 import typer
 
-from ._options import ModelOpt, ParamsOpt, PresetOpt, SetOpt, space_from
+from ._options import ModelOpt, ParamsOpt, PresetOpt, SetOpt, space_from, with_equations
 
 if TYPE_CHECKING:
     from ..export import Target as _Target
@@ -84,7 +84,7 @@ def _export_cmd(
     name = "brakesqueal_model" if path is None else path.stem
     check_name(name, to.value)
     sets = list(set_ or [])
-    space = space_from(model, preset, params, sets)
+    space = with_equations(space_from(model, preset, params, sets), "export")
     source = describe_source(space, model, params, sets)
     # the enums' values are the literals export_code takes
     text = export_code(cast("_Target", to.value), cast("_What", what.value), space.resolve({}), name=name,

@@ -15,7 +15,8 @@ import typer
 
 from ..errors import ParameterError
 from ._options import (PLOT_SUFFIXES, ContactLaw, ModelOpt, OutFormat, PadDampingOpt, PadSlopeOpt, ParamsOpt,
-                       PresetOpt, SetOpt, StickSpeedOpt, pads_option, space_from)
+                       PresetOpt, SetOpt, StickSpeedOpt, pads_option, space_from,
+                       with_equations)
 
 if TYPE_CHECKING:
     from ..model.parameters import Parameters
@@ -123,7 +124,8 @@ def _simulate_cmd(
         init["perturbation"] = _floats(q0, "--q0")
     _check_outputs(out, plot, wav)
     from ..interrupts import interrupt_guard
-    p = pads_option(space_from(model, preset, params, set_), pad_slope, stick_speed, pad_damping).resolve({})
+    p = pads_option(with_equations(space_from(model, preset, params, set_), "simulate"), pad_slope, stick_speed,
+                    pad_damping).resolve({})
     with interrupt_guard():  # nested in the program's guard (brakesqueal.cli.main), which ends a stuck run
         tr = _run(p, t_end, method, rtol, atol, events.value, sample_rate, progress, no_cache,
                   {**init, "contact": contact.value})

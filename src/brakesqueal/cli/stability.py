@@ -20,7 +20,7 @@ import typer
 from ..errors import ParameterError
 from ._options import (PLOT_SUFFIXES, ContactLaw, FormatOpt, ModelOpt, Modes, ModesOpt, OutFormat, PadDampingOpt,
                        PadSlopeOpt, ParamsOpt, PresetOpt, ProgressOpt, SetOpt, StickSpeedOpt, pads_option,
-                       refuse_set_of_axes, space_from)
+                       refuse_set_of_axes, space_from, with_equations)
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -259,7 +259,7 @@ def hopf(
 
     axis = parse_axis(along, with_num=False)
     refuse_set_of_axes(set_, {axis.name: "--along"})
-    space = pads_option(space_from(model, preset, params, set_), None, None, pad_damping)
+    space = pads_option(with_equations(space_from(model, preset, params, set_), "hopf"), None, None, pad_damping)
     engine = build(space.model)  # the entry point's engine, passed down
     r: CrossingResult = _crossings(engine, space, axis)
     pts = hopf_points(engine, space, axis, result=r)
@@ -322,7 +322,7 @@ def cycles(
     if pads == "quasi-static" and (pad_damping is not None or pad_slope is not None):
         raise ParameterError("The option '--pads quasi-static' cannot be combined with --pad-damping or --pad-slope "
                              "(they keep the pads' rates)")
-    base = space_from(model, preset, params, set_)
+    base = with_equations(space_from(model, preset, params, set_), "cycles")
     space = pads_option(base, pad_slope, stick_speed, pad_damping)  # checked before anything is computed
     route = cycle_route(space, axis, contact=contact, pads=pads)
     options: dict[str, Any] = {}

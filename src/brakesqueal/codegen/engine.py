@@ -66,6 +66,9 @@ class Capabilities:
         it: the compiled critical-speed kernel applies.
     tilting : bool
         The disk tilts (``q1``, ``q2`` are coordinates).
+    kind : str
+        ``"components"`` (a model of disk, pads and calipers: equations derived and generated) or ``"matrices"``
+        (coefficient matrices, :mod:`.matrices`: linear, silent motion ``x = 0``).
     """
 
     n: int
@@ -77,6 +80,7 @@ class Capabilities:
     closed_form: bool
     omega_kernel: bool
     tilting: bool
+    kind: str = "components"
 
     @property
     def dynamic_pads(self) -> bool:
@@ -116,6 +120,17 @@ class Engine:
         if key not in self._memo:
             self._memo[key] = make()
         return self._memo[key]
+
+    def require_nonlinear(self, what: str) -> Engine:
+        """This engine, or a one-line :class:`~brakesqueal.errors.ParameterError` where the model has no nonlinear
+        equations (a model given by coefficient matrices) and ``what`` needs them."""
+        if self.caps.kind != "components":
+            from ..errors import ParameterError
+
+            raise ParameterError(f"{what}: model '{self.spec.name}' is given by coefficient matrices, a linear model "
+                                 "with no known nonlinear terms; use linearize, eigen, map, crossings, "
+                                 "critical-speed, modes or sweep")
+        return self
 
     # ---------------------------------------------------------------- closed forms (SymPy on a cache miss)
     def closed_form(self) -> ModelForm | None:
@@ -453,9 +468,14 @@ def build(spec: ModelSpec | str, *, use_cache: bool = True) -> Engine:
     -------
     Engine
     """
+    from ..model.matrices import MatrixSpec
     from ..model.parameters import as_model_spec
 
     spec = cast("ModelSpec", as_model_spec(spec))
+    if isinstance(spec, MatrixSpec):
+        from .matrices import build_matrix_engine
+
+        return build_matrix_engine(spec, use_cache=use_cache)
     key = model_key(spec)
     eng = _ENGINES.get((key, use_cache))
     if eng is None:

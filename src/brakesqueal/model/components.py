@@ -857,6 +857,11 @@ class ModelSpec:
                         add(x)
         return out
 
+    @property
+    def spin(self) -> Value:
+        """The disk's spin Ω: a parameter name, or the number written in the model (``disk.Omega``)."""
+        return self.disk.Omega
+
     def stiffness_names(self) -> set[str]:
         """Parameter names used as tangential stiffnesses ``k_ip`` (they may be ``inf``)."""
         return {p.k_ip for p in self.pads if isinstance(p.k_ip, str)}

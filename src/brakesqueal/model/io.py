@@ -50,7 +50,7 @@ from .expressions import evaluate
 from .parameters import Parameters, Preset, Value
 
 __all__ = ["spec_from_dict", "spec_to_dict", "load_model", "model_to_toml", "read_toml", "load_parameter_file",
-           "parameters_to_toml", "MAX_FILE_BYTES", "read_toml_text"]
+           "parameters_to_toml", "MAX_FILE_BYTES", "read_toml_text", "presets_from_dict"]
 
 #: Largest model, parameter or study file read.
 MAX_FILE_BYTES = 1 << 20
@@ -166,7 +166,8 @@ def _table(data: Mapping[str, Any], key: str, where: str, *, kind: type = dict, 
     return v
 
 
-def _presets(data: Mapping[str, Any], source: str) -> tuple[Preset, ...]:
+def presets_from_dict(data: Mapping[str, Any], source: str) -> tuple[Preset, ...]:
+    """The ``[presets.NAME]`` tables of a model file (unbound :class:`Preset` objects)."""
     out = []
     for name, raw in _table(data, "presets", source).items():
         where = f"{source}: presets.{name}"
@@ -249,7 +250,7 @@ def spec_from_dict(data: Mapping[str, Any], *, source: str = "model") -> ModelSp
         return ModelSpec(
             name=str(data.get("name", "model")), **held,
             parameters=params, description=str(data.get("description", "")),
-            reference=str(data.get("reference", "")), presets=_presets(data, source),
+            reference=str(data.get("reference", "")), presets=presets_from_dict(data, source),
         )  # fmt: skip
     except ParameterError as exc:
         msg = str(exc)
@@ -329,7 +330,15 @@ def load_model(path: str) -> ModelSpec:
         If the file cannot be read, is too large, not UTF-8, not valid TOML,
         or describes an invalid model.
     """
-    return spec_from_dict(read_toml(path, "model file"), source=f"model file '{path}'")
+    import os
+
+    data = read_toml(path, "model file")
+    source = f"model file '{path}'"
+    from .matrices import is_matrix_model_data, matrix_spec_from_dict
+
+    if is_matrix_model_data(data):  # a model given by coefficient matrices (imported finite-element models)
+        return matrix_spec_from_dict(data, source=source, base=os.path.dirname(os.path.abspath(path)))  # type: ignore[return-value]
+    return spec_from_dict(data, source=source)
 
 
 def _toml_string(text: str) -> str:

@@ -250,11 +250,16 @@ def get_model(name: str) -> ModelSpec:
     """
     from ..suggest import did_you_mean
 
+    from .fe_library import FE_MODELS, fe_model
+
     key = ALIASES.get(name, name) if isinstance(name, str) else name
     if isinstance(key, str) and key in MODELS:
         return _built(key)
-    raise ParameterError(f"Unknown model {name!r}{did_you_mean(str(name), list(MODELS))}; built-in models: "
-                         f"{', '.join(MODELS)}")
+    if isinstance(key, str) and key in FE_MODELS:  # the finite-element benchmarks (coefficient matrices)
+        return fe_model(key)  # type: ignore[return-value]  # the parameter interface of a model
+    names = [*MODELS, *FE_MODELS]
+    raise ParameterError(f"Unknown model {name!r}{did_you_mean(str(name), names)}; built-in models: "
+                         f"{', '.join(names)}")
 
 
 def resolve_model(arg: str) -> ModelSpec:

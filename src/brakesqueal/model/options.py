@@ -69,7 +69,10 @@ def resolve_space(model: ModelSpec | str | None = None, preset: str | None = Non
 
         f_model, f_preset, entries = load_parameter_file(params)
         source = f"parameter file '{params}'"
-    spec = model if isinstance(model, ModelSpec) else (resolve_model(model) if model is not None else None)
+    from .matrices import MatrixSpec
+
+    spec = (model if isinstance(model, (ModelSpec, MatrixSpec)) else
+            (resolve_model(model) if model is not None else None))
     if f_model is not None:
         f_spec = resolve_model(f_model)
         if spec is not None and spec.name != f_spec.name:

@@ -98,9 +98,12 @@ def as_model_spec(model: ModelSpec | str) -> ModelSpec:
     """
     from .components import ModelSpec
     from .library import resolve_model
+    from .matrices import MatrixSpec
 
     if isinstance(model, ModelSpec):
         return model
+    if isinstance(model, MatrixSpec):  # the same parameter interface (name, parameters, presets, roles, unit)
+        return cast("ModelSpec", model)
     if isinstance(model, str):
         return resolve_model(model)
     raise ParameterError(f"model must be a ModelSpec or a model name; got {model!r}")

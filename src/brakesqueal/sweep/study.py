@@ -641,7 +641,7 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
         from ..codegen import build
         from ..model.expressions import names_in
 
-        spin = space.model.disk.Omega
+        spin = space.model.spin
         # a study file is an entry point: its model's engine is built where the file is read
         if not isinstance(spin, str) or not build(space.model).caps.omega_kernel:
             raise ctx.err("compute.quantities", f"'critical_speed' in sweeps needs the certified critical-speed "

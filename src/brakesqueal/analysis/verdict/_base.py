@@ -236,6 +236,8 @@ def carrier_labels(engine: Engine) -> tuple[tuple[str, ...], np.ndarray, np.ndar
     pad_label : ndarray of int, shape (m,)
         Index into ``labels`` of each pad deformation's rate state.
     """
+    if engine.caps.kind == "matrices":  # one structure: no component owns a coordinate
+        return ("structure",), np.zeros(engine.caps.n, dtype=np.int64), np.zeros(0, dtype=np.int64)
     spec = engine.spec
     labels: list[str] = ["disk"]
     owner: dict[str, int] = {"q1": 0, "q2": 0}

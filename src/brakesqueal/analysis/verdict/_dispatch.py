@@ -133,10 +133,45 @@ def decide(engine: Engine, space: ParameterSpace, points: Points, *, eigen: bool
         Arrays of ``points.shape``.
     """
     _check_modes(modes)
+    chunk = batch_points(engine)
+    if points.size > chunk:  # large systems: bounded memory, the points decided in flat chunks
+        return _decide_chunks(engine, space, points, chunk, eigen=eigen, modes=modes, carriers=carriers)
     ctx = Context(engine, space, points, points.size, eigen=eigen, modes=modes, carriers_wanted=carriers)
     ctx.closed = bool(engine.closed_route(space, points.names)) if engine.caps.closed_form else False
     operating_points(ctx)
     return _choose(ctx).reshape(points.shape)
+
+
+#: Memory the linear systems of one batch of points may take (a model's batch size follows from its size).
+BATCH_BYTES = 256 << 20
+
+
+def batch_points(engine: Engine) -> int:
+    """How many points one batch of :func:`decide` holds: every point's ``M, D, K`` and its state matrices
+    (about ``20 (2n)^2`` doubles with the eigenvectors) within :data:`BATCH_BYTES`; unbounded for small models."""
+    m = 2 * engine.caps.n + engine.caps.m
+    if m <= 32:
+        return 1 << 62
+    return max(1, BATCH_BYTES // (8 * 20 * m * m))
+
+
+def _decide_chunks(engine: Engine, space: ParameterSpace, points: Points, chunk: int, **kw: Any) -> Verdicts:
+    """:func:`decide` on flat slices of ``points`` (no grid route applies to such large systems)."""
+    shape = points.shape
+    flat = {k: np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for k, v in points.arrays.items()}
+    sett = {k: np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for k, v in points.settable.items()}
+    valid = np.broadcast_to(points.valid, shape).reshape(-1)
+    parts = []
+    for s0 in range(0, points.size, chunk):
+        sl = slice(s0, s0 + chunk)
+        sub = Points(space, {k: v[sl] for k, v in flat.items()}, points.names, valid=valid[sl],
+                     settable={k: v[sl] for k, v in sett.items()})
+        parts.append(decide(engine, space, sub, **kw))
+    def cat(f: str) -> np.ndarray:
+        return np.concatenate([getattr(p, f) for p in parts]).reshape(shape)
+
+    return Verdicts(cat("status"), cat("code"), cat("max_real"), cat("frequency"), cat("bound"), cat("carrier"),
+                    cat("method"), parts[0].carriers, parts[0].methods)
 
 
 def decide_model(lm: Any, *, eigen: bool = True, modes: str = "all") -> Verdicts:

@@ -51,6 +51,9 @@ def operating_points(ctx: Context) -> None:
     if ctx.closed:
         ctx.trivial[flat] = True  # identically trivial on the axes, every pad provably touching and sliding
         return
+    if engine.caps.kind == "matrices":
+        ctx.trivial[flat] = True  # coefficient matrices: the linearization about x = 0 at every point
+        return
     cm = engine.compiled
     P = pts.rows(flat)
     triv, _ = trivial_rows(cm, P)
@@ -174,8 +177,12 @@ def _zero_state(ctx: Context, idx: np.ndarray) -> list[int]:
     assert ctx.engine is not None and ctx.points is not None
     engine = ctx.engine
     cm = engine.compiled
-    n = cm.n
+    n = engine.caps.n
     P = ctx.points.rows(idx)
+    if engine.caps.kind == "matrices":
+        M, D, K = engine.linear_batch(P)  # type: ignore[attr-defined]
+        _cache(ctx, LinearGroup(idx, n, 0, M=M, D=D, K=K))
+        return []
     cols = [np.ascontiguousarray(P[:, k]) for k in range(P.shape[1])]
     if not engine.caps.dynamic_pads and all(cm.rate_free_at_zero):
         M, D, K = cm.zero_linear(cols)
