@@ -212,9 +212,12 @@ def spec_from_dict(data: Mapping[str, Any], *, source: str = "model") -> ModelSp
         message names ``source`` and the key.
     """
     from ..suggest import did_you_mean
+    from .matrices import is_matrix_model_data, matrix_spec_from_dict
 
     if not isinstance(data, Mapping):
         raise ParameterError(f"{source}: must be a table")
+    if is_matrix_model_data(data):  # a model given by coefficient matrices (file paths absolute or from here)
+        return matrix_spec_from_dict(data, source=source)  # type: ignore[return-value]
     top = ("name", "description", "reference", "parameters", *(k.table for k in COMPONENTS.values()), "presets")
     unknown = sorted(set(data) - set(top))
     if unknown:
@@ -285,6 +288,10 @@ def spec_to_dict(spec: ModelSpec, *, presets: bool = True) -> dict[str, Any]:
         field that is not ``None`` is present, infinite numbers are written
         ``"inf"`` and tuples as lists (plain JSON/TOML types).
     """
+    from .matrices import MatrixSpec, matrix_spec_to_dict
+
+    if isinstance(spec, MatrixSpec):  # a model given by coefficient matrices: its files, law and a checksum
+        return matrix_spec_to_dict(spec, checksum=True)
 
     def comp(obj: Component) -> dict[str, Any]:
         out = {}

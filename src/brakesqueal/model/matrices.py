@@ -57,7 +57,7 @@ from .expressions import RESERVED_NAMES, _checked_tree, evaluate, evaluate_array
 from .parameters import Preset
 
 __all__ = ["MatrixSpec", "Term", "COEFFICIENTS", "parse_coefficient", "matrix_spec_from_dict",
-           "is_matrix_model_data", "matrix_spec_to_dict", "matrix_model_toml", "import_matrices"]
+           "is_matrix_model_data", "matrix_spec_to_dict", "matrix_model_toml", "import_matrices", "write_matrix_model"]
 
 #: The coefficients of ``λ² M + λ D + K``.
 COEFFICIENTS = ("M", "D", "K")
@@ -154,7 +154,8 @@ def parse_coefficient(expr: str, matrices: Sequence[str], parameters: Sequence[s
                              f"matrices: {', '.join(matrices)}; parameters: {', '.join(parameters) or '(none)'}")
     d = _decompose(tree, frozenset(matrices), expr, where)
     if "" in d:
-        raise ParameterError(f"{where}: the term '{d['']}' of {expr!r} multiplies no matrix")
+        raise ParameterError(f"{where}: the term '{d['']}' of {expr!r} multiplies no matrix (matrices: "
+                             f"{', '.join(matrices)})")
     if not d:
         raise ParameterError(f"{where}: {expr!r} has no matrix term")
     return tuple(Term(factor=v, matrix=k) for k, v in d.items())
@@ -413,7 +414,8 @@ def is_matrix_model_data(data: Mapping[str, Any]) -> bool:
     return isinstance(data, Mapping) and "matrices" in data
 
 
-_TOP = ("name", "description", "reference", "spin", "matrices", "coefficients", "parameters", "presets", "dofs")
+_TOP = ("name", "description", "reference", "spin", "matrices", "coefficients", "parameters", "presets", "dofs",
+        "checksum")
 _SOURCE_KEYS = ("file", "format", "variables")
 
 
@@ -529,7 +531,7 @@ def matrix_spec_from_dict(data: Mapping[str, Any], *, source: str = "model", bas
     if not isinstance(spin, str):
         raise ParameterError(f"{source}: spin must be a parameter name")
     try:
-        return MatrixSpec(name=str(data.get("name", "model")), matrices=mats,
+        spec = MatrixSpec(name=str(data.get("name", "model")), matrices=mats,
                           coefficients={k: v for k, v in coeffs.items()}, parameters=values, ranges=ranges,
                           units=units, descriptions=descs, dofs=dofs or (), spin=spin,
                           presets=presets_from_dict(data, source), description=str(data.get("description", "")),
@@ -537,10 +539,18 @@ def matrix_spec_from_dict(data: Mapping[str, Any], *, source: str = "model", bas
     except ParameterError as exc:
         msg = str(exc)
         raise ParameterError(msg if msg.startswith(source) else f"{source}: {msg}") from None
+    if "checksum" in data and data["checksum"] != spec.key():
+        raise ParameterError(f"{source}: the matrix files changed since this model was recorded (checksum "
+                             f"{data['checksum']}, now {spec.key()}); start anew (e.g. sweep --overwrite)")
+    return spec
 
 
-def matrix_spec_to_dict(spec: MatrixSpec) -> dict[str, Any]:
-    """The model file's table of a :class:`MatrixSpec` read from files (its ``sources``)."""
+def matrix_spec_to_dict(spec: MatrixSpec, *, checksum: bool = False) -> dict[str, Any]:
+    """The model file's table of a :class:`MatrixSpec` read from files (its ``sources``); with ``checksum`` also
+    the hash of its matrices (:meth:`MatrixSpec.key`), which reading it back checks (a sweep's record)."""
+    if not spec.sources:
+        raise ParameterError(f"model '{spec.name}' was built in Python: write it first (write_matrix_model) so that "
+                             "its matrices are in a file")
     params: dict[str, Any] = {}
     for k, v in spec.parameters.items():
         entry: dict[str, Any] = {"value": v}
@@ -561,6 +571,12 @@ def matrix_spec_to_dict(spec: MatrixSpec) -> dict[str, Any]:
     d["matrices"] = [dict(s) for s in spec.sources]
     d["coefficients"] = dict(spec.coefficients)
     d["parameters"] = params
+    if spec.presets:
+        d["presets"] = {p.name: {"description": p.description, "reference": p.reference, "free": dict(p.free),
+                                 "fixed": dict(p.fixed), "tied": dict(p.tied), "auxiliary": dict(p.auxiliary)}
+                        for p in spec.presets}
+    if checksum:
+        d["checksum"] = spec.key()
     return d
 
 
@@ -665,3 +681,34 @@ def import_matrices(files: Sequence[str], coefficients: Mapping[str, str], *, pa
     return MatrixSpec(name=name or stem, matrices=mats, coefficients=dict(coefficients), parameters=params,
                       dofs=dofs or (), spin=spin, sources=tuple(sources),
                       description=f"imported from {', '.join(os.path.basename(f) for f in files)}")
+
+
+def write_matrix_model(spec: MatrixSpec, path: str) -> MatrixSpec:
+    """Write a matrix model: its matrices to ``<stem>.mat`` beside the model file ``path`` (``.toml``).
+
+    Parameters
+    ----------
+    spec : MatrixSpec
+        The model (e.g. built in Python, or a reduced model).
+    path : str
+        The model file to write (``.toml``); the matrices go to the same folder and stem with ``.mat``.
+
+    Returns
+    -------
+    MatrixSpec
+        The model with its ``sources`` naming the written matrix file.
+    """
+    import dataclasses
+
+    from ..outputs import atomic_write, check_output
+    from .matrix_files import write_matrix_file
+
+    target = check_output(path, what="model file", suffixes=(".toml",))
+    mat = str(target.with_suffix(".mat"))
+    check_output(mat, what="matrix file", suffixes=(".mat",))
+    write_matrix_file(mat, spec.matrices, "mat", dofs=None)
+    out = dataclasses.replace(spec, sources=({"file": os.path.abspath(mat), "format": "mat"},), _terms={})
+    text = matrix_model_toml(out, base=os.path.dirname(os.path.abspath(str(target))))
+    with atomic_write(target, what="model file") as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return out

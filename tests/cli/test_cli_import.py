@@ -1,0 +1,157 @@
+"""``brakesqueal import`` and every linear command on the model file it writes (the issue's command forms).
+
+References: a dense QZ of the companion pencil of NLEVP ``disk_brake100`` assembled in the test from
+``scipy.io.loadmat`` (independent of brakesqueal's reader and coefficient grammar).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+
+import numpy as np
+import pytest
+import scipy.io
+import scipy.linalg
+
+from brakesqueal.cli import main
+
+DB100 = os.path.join(os.path.dirname(__file__), "..", "..", "src", "brakesqueal", "data", "fe",
+                     "nlevp-disk-brake-100", "disk_brake100.mat")
+
+
+def cli(capsys, *args: str) -> tuple[int, str, str]:
+    rc = main(list(args))
+    out = capsys.readouterr()
+    return rc, out.out, out.err
+
+
+def _qz(w: float, s: float = 1.0) -> np.ndarray:
+    d = scipy.io.loadmat(DB100)
+    r = {k: np.asarray(d[k], dtype=float) for k in ("M", "D1", "DR", "DG", "K1", "KR")}
+    n = 100
+    D, K = r["D1"] + s * r["DR"] / w + w * r["DG"], r["K1"] + s * r["KR"]
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-K, -D]])
+    B = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), r["M"]]])
+    return scipy.linalg.eig(A, B, right=False)
+
+
+@pytest.fixture()
+def model(tmp_path, capsys, monkeypatch):
+    """The issue's import form, in a fresh folder: ``model.toml`` beside ``disk_brake100.mat``."""
+    shutil.copy(DB100, tmp_path / "disk_brake100.mat")
+    monkeypatch.chdir(tmp_path)
+    rc, out, err = cli(capsys, "import", "disk_brake100.mat", "--coefficient", "M=M", "--coefficient",
+                       "D=D1 + DR/Omega + Omega*DG", "--coefficient", "K=K1 + KR", "--out", "model.toml")
+    assert rc == 0, err
+    assert "100 DOF" in out and "model.toml" in out
+    return tmp_path / "model.toml"
+
+
+def test_import_then_linearize_json_lists_every_eigenvalue(model, capsys):
+    rc, out, err = cli(capsys, "linearize", "--model", "model.toml", "--set", "Omega=4*pi", "--format", "json")
+    assert rc == 0, err
+    d = json.loads(out)
+    lam = np.array([complex(a, b) for a, b in d["eigenvalues"]])
+    ref = _qz(4 * math.pi)
+    assert lam.size == 200
+    for z in ref:  # every eigenvalue of the dense QZ is listed (QZ's own accuracy, see test_matrix_models)
+        assert np.min(np.abs(lam - z)) <= 1e-8 * abs(z)
+    assert d["verdict"]["status"] == "unstable" and d["verdict"]["carrier"] == "structure"
+
+
+def test_the_model_file_moves_with_its_matrices(model, tmp_path, capsys):
+    """Paths in the model file are relative to it: the pair can be moved and the file read from elsewhere."""
+    dst = tmp_path / "moved"
+    dst.mkdir()
+    shutil.move(str(model), dst / "model.toml")
+    shutil.move(str(tmp_path / "disk_brake100.mat"), dst / "disk_brake100.mat")
+    rc, out, err = cli(capsys, "linearize", "--model", str(dst / "model.toml"), "--set", "Omega=2")
+    assert rc == 0, err
+    assert "Model 'disk_brake100' (100 DOF, given by coefficient matrices)" in out
+
+
+def test_eigen_map_crossings_modes_take_the_model(model, tmp_path, capsys):
+    rc, out, err = cli(capsys, "eigen", "--model", "model.toml", "--set", "Omega=2*pi", "--format", "json")
+    assert rc == 0, err
+    e = json.loads(out)
+    assert len(e["modes"]) == 200 and e["verdict"]["status"] == "unstable"
+    rc, out, err = cli(capsys, "import", "disk_brake100.mat", "-c", "M=M", "-c", "D=D1 + s*DR/Omega + Omega*DG",
+                       "-c", "K=K1 + s*KR", "-c", "s=1", "--parameter", "Omega=2*pi", "--out", "m2.toml")
+    assert rc == 0, err
+    rc, out, err = cli(capsys, "map", "--model", "m2.toml", "--x", "Omega=6.28:25.1:3", "--y", "s=0:1:3",
+                       "--out", "m.nc")
+    assert rc == 0, err
+    import xarray as xr
+
+    with xr.open_dataset(tmp_path / "m.nc") as ds:
+        for i, s in enumerate(ds["s"].values):
+            for j, w in enumerate(ds["Omega"].values):
+                assert bool(ds["stable"].values[i, j]) == (_qz(float(w), float(s)).real.max() < 0)
+    rc, out, err = cli(capsys, "modes", "--model", "m2.toml", "--along", "s=0:0.2", "--num", "5", "--format", "json")
+    assert rc == 0, err
+    tracks = json.loads(out)
+    assert tracks["parameter"] == "s" and tracks["model"] == "disk_brake100"
+
+
+@pytest.mark.slow
+def test_crossings_and_critical_speed_take_the_model(model, capsys):
+    rc, out, err = cli(capsys, "import", "disk_brake100.mat", "-c", "M=M", "-c", "D=D1 + s*DR/Omega + Omega*DG",
+                       "-c", "K=K1 + s*KR", "-c", "s=1", "--out", "m2.toml")
+    assert rc == 0, err
+    rc, out, err = cli(capsys, "crossings", "--model", "m2.toml", "--set", "Omega=2*pi", "--along", "s=0:0.3",
+                       "--format", "json")
+    assert rc == 0, err
+    r = json.loads(out)
+    (c,) = r["crossings"]
+    assert _qz(2 * math.pi, c["value"] * 0.999).real.max() < 0 < _qz(2 * math.pi, c["value"] * 1.001).real.max()
+    rc, out, err = cli(capsys, "critical-speed", "--model", "m2.toml", "--set", "s=1", "--range", "1:100",
+                       "--format", "json")
+    assert rc == 0, err
+    cs = json.loads(out)
+    assert cs["stable_at_start"] is False  # the published brake squeals at every speed of the range (dense scan)
+    assert all(_qz(w).real.max() > 0 for w in (1.0, 10.0, 100.0))
+
+
+def test_sweep_takes_the_model(model, tmp_path, capsys):
+    study = tmp_path / "study.toml"
+    study.write_text('name = "fe"\nmodel = "model.toml"\n[axes]\nOmega = { values = [2, 20] }\n'
+                     '[compute]\nquantities = ["stable", "max_real"]\n[output]\nstore = "fe.zarr"\n')
+    rc, out, err = cli(capsys, "sweep", str(study))
+    assert rc == 0, err
+    import xarray as xr
+
+    ds = xr.open_zarr(tmp_path / "fe.zarr")
+    for k, w in enumerate(ds["Omega"].values):
+        ref = _qz(float(w)).real.max()
+        assert float(ds["max_real"].values[k]) == pytest.approx(ref, rel=1e-6)
+        assert bool(ds["stable"].values[k]) == (ref < 0)
+
+
+@pytest.mark.parametrize("args, words", [
+    (["import", "nothere.mat", "-c", "M=M", "-c", "D=D1", "-c", "K=K1", "--out", "x.toml"], "nothere.mat"),
+    (["import", "disk_brake100.mat", "-c", "M=M", "-c", "D=D1", "--out", "x.toml"], "--coefficient for K"),
+    (["import", "disk_brake100.mat", "-c", "M=M", "-c", "D=D1", "-c", "K=K1*KR", "--out", "x.toml"],
+     "product of two matrices"),
+    (["import", "disk_brake100.mat", "-c", "M=M", "-c", "D=D1", "-c", "K=K9", "--out", "x.toml"],
+     "multiplies no matrix (matrices: D1, DG, DR, K1, KR, M)"),
+    (["import", "disk_brake100.mat", "-c", "M=M", "-c", "D=D1", "-c", "K=K1", "--out", "x.txt"], ".toml"),
+    (["import", "disk_brake100.mat", "-c", "M=M", "-c", "D=D1", "-c", "K=K1", "--format", "xyz", "--out", "x.toml"],
+     "xyz"),
+    (["import", "disk_brake100.mat", "-c", "M=M", "-c", "D=D1", "-c", "K=K1", "--out", "disk_brake100.mat"],
+     "--out"),
+    (["hopf", "--model", "model.toml", "--along", "Omega=1:2"], "coefficient matrices"),
+    (["simulate", "--model", "model.toml"], "coefficient matrices"),
+    (["cycles", "--model", "model.toml", "--along", "Omega=1:2"], "coefficient matrices"),
+    (["export", "--model", "model.toml", "--to", "python", "--out", "x.py"], "coefficient matrices"),
+    (["linearize", "--model", "model.toml", "--set", "Omega=-1"], "Omega"),
+    (["linearize", "--model", "disk_brake4669"], "dense eigenvalues are limited"),
+])
+def test_bad_input_is_one_line_exit_2(model, capsys, args, words):
+    rc, out, err = cli(capsys, *args)
+    assert rc == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("brakesqueal: error: ") and "Traceback" not in err, err
+    assert words in lines[0]
