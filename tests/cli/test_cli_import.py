@@ -155,3 +155,51 @@ def test_bad_input_is_one_line_exit_2(model, capsys, args, words):
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("brakesqueal: error: ") and "Traceback" not in err, err
     assert words in lines[0]
+
+
+def test_box_counts_the_unstable_modes_of_a_dense_qz(capsys):
+    w = 2 * math.pi
+    rc, out, err = cli(capsys, "box", "--model", "disk_brake100", "--set", f"Omega={w!r}", "--re=-0.05:1",
+                       "--freq", "0:0.2", "--format", "json", "--no-progress")
+    assert rc == 0, err
+    r = json.loads(out)
+    ref = _qz(w)
+    f = ref.imag / (2 * math.pi)
+    inside = ref[(ref.real >= -0.05) & (ref.real <= 1) & (f >= 0) & (f <= 0.2)]
+    assert r["complete"] and len(r["eigenvalues"]) == inside.size
+    assert r["unstable"] == int(np.sum(inside.real > 0)) == 1
+    for e in r["eigenvalues"]:
+        z = complex(e["re"], e["im"])
+        assert np.min(np.abs(inside - z)) <= max(e["bound"], 1e-8 * abs(z))
+
+
+def test_reduce_writes_a_model_every_command_takes(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    rc, out, err = cli(capsys, "reduce", "--model", "disk_brake100", "--along", "Omega=2*pi:8*pi:3", "--re=-0.05:1",
+                       "--freq", "0:0.2", "--out", "r.toml", "--format", "json", "--no-progress")
+    assert rc == 0, err
+    r = json.loads(out)
+    assert r["dimension"] < 100 and r["max_rel_error"] < 1e-4
+    assert (tmp_path / "r.mat").exists()
+    w = 9.0  # not a sample: the reduced model's box eigenvalues against the full dense QZ
+    rc, out, err = cli(capsys, "linearize", "--model", "r.toml", "--set", f"Omega={w}", "--format", "json")
+    assert rc == 0, err
+    lam = np.array([complex(a, b) for a, b in json.loads(out)["eigenvalues"]])
+    ref = _qz(w)
+    f = ref.imag / (2 * math.pi)
+    for z in ref[(ref.real >= -0.05) & (f >= 0) & (f <= 0.2)]:
+        assert np.min(np.abs(lam - z)) <= 1e-4 * abs(z)
+
+
+@pytest.mark.parametrize("args, words", [
+    (["box", "--preset", "paper-fig2", "--re=-1:1", "--freq", "0:2000"], "coefficient matrices"),
+    (["box", "--model", "disk_brake100", "--re", "1:-1", "--freq", "0:1"], "--re needs LO < HI"),
+    (["box", "--model", "disk_brake100", "--re=-1:1", "--freq", "-5:1"], "freq"),
+    (["reduce", "--model", "disk_brake100", "--along", "Omega=1:2:2", "--re=-1:1", "--freq", "0:1", "--out", "r.txt"],
+     ".toml"),
+])
+def test_box_and_reduce_bad_input_is_one_line(capsys, args, words):
+    rc, out, err = cli(capsys, *args)
+    lines = err.strip().splitlines()
+    assert rc == 2 and len(lines) == 1 and "Traceback" not in err, err
+    assert words in lines[0]

@@ -242,7 +242,7 @@ def _register_plugins() -> None:
     """Add the command groups that live in their own modules."""
     import importlib
 
-    for name in (".stability", ".modes", ".sweep", ".cache", ".simulate", ".export", ".explore", ".fe_import"):
+    for name in (".stability", ".modes", ".sweep", ".cache", ".simulate", ".export", ".explore", ".fe"):
         mod = importlib.import_module(name, __package__)
         mod.register(app)
 
@@ -268,6 +268,8 @@ SUMMARIES: dict[str, str] = {
     "simulate": "Integrate the nonlinear equations; summary, NetCDF, WAV.",
     "export": "Write equations as LaTeX, Octave, C, Julia or Python.",
     "import": "A model file from finite-element coefficient matrices.",
+    "box": "Eigenvalues of a large matrix model in a box, with bounds.",
+    "reduce": "Reduce a large matrix model along Omega (POD).",
     "cache": "Inspect or clear the code cache.",
     "explore": "The squeal explorer in the browser (live, offline).",
 }
