@@ -224,3 +224,22 @@ def test_nonlinear_analyses_refuse_a_matrix_model(db100):
         simulation_model(space)
     with pytest.raises(ParameterError, match="coefficient matrices"):
         engine.silent_kernel()
+
+
+def test_a_mass_matrix_whose_determinant_underflows_is_not_singular():
+    """A 172-DOF reduced model's M (entries ~1e-3) has det 1e-516 = 0.0 in double precision: singularity is a
+    zero pivot, not a vanishing determinant (every point of such a model was undecided before)."""
+    from brakesqueal.analysis.robust import descriptor_states, state_matrices
+
+    rng = np.random.default_rng(1)
+    n = 172
+    A = rng.standard_normal((n, n))
+    M = 1e-3 * (A @ A.T / n + np.eye(n))
+    assert np.linalg.det(M) == 0.0  # the premise
+    S, good = state_matrices(M[None], np.eye(n)[None], np.eye(n)[None])
+    assert good[0] and np.all(np.isfinite(S))
+    E = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), M]])
+    assert descriptor_states(E[None], np.eye(2 * n)[None])[1][0]
+    Z = M.copy()
+    Z[:, 0] = 0.0  # truly singular
+    assert not state_matrices(Z[None], np.eye(n)[None], np.eye(n)[None])[1][0]

@@ -407,8 +407,9 @@ def state_matrices(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> tuple[np.ndar
     with np.errstate(all="ignore"):
         good = np.all(np.isfinite(M), axis=(1, 2)) & np.all(np.isfinite(D), axis=(1, 2)) & \
             np.all(np.isfinite(K), axis=(1, 2))
-        detM = np.linalg.det(np.where(good[:, None, None], M, np.eye(n)))
-        good &= np.abs(detM) > 0
+        # singular means a zero pivot (slogdet's sign 0), not a determinant that underflows (a 172-DOF M of
+        # entries 1e-3 has det 1e-516 = 0.0 in double precision)
+        good &= np.linalg.slogdet(np.where(good[:, None, None], M, np.eye(n)))[0] != 0
         idx = np.flatnonzero(good)
         if idx.size:
             S[idx] = _state(M[idx], D[idx], K[idx])
@@ -430,7 +431,7 @@ def descriptor_states(E: np.ndarray, A: np.ndarray) -> tuple[np.ndarray, np.ndar
     S = np.zeros((N, m, m))
     with np.errstate(all="ignore"):
         good = np.all(np.isfinite(E), axis=(1, 2)) & np.all(np.isfinite(A), axis=(1, 2))
-        good &= np.abs(np.linalg.det(np.where(good[:, None, None], E, np.eye(m)))) > 0
+        good &= np.linalg.slogdet(np.where(good[:, None, None], E, np.eye(m)))[0] != 0  # not det: it underflows
         idx = np.flatnonzero(good)
         if idx.size:
             try:
