@@ -4,17 +4,15 @@ An imported brake-squeal model is the quadratic eigenvalue problem
 :math:`(\lambda^2 M + \lambda D + K)\,x = 0`; its matrices come out of a
 finite-element program in one of these formats (:data:`FORMATS`):
 
-============ ===================================================== ===============================================
-format       files                                                 matrices, DOF labels
-============ ===================================================== ===============================================
-``mat``      MATLAB ``.mat`` (v4 to v7.2; :func:`scipy.io.loadmat`) every 2-D numeric variable by its name; no DOFs
-``mm``       Matrix Market ``.mtx``/``.mm`` (:func:`scipy.io.mmread`) one, named after the file stem; no DOFs
-``hb``       Harwell–Boeing ``.hb``/``.rua``/``.rsa``/``.rb``        one, named after the file stem; no DOFs
-``abaqus``   ABAQUS ``*MATRIX GENERATE`` text ``.mtx``               one (``job_STIF1``, ``job_MASS1`` …); ``node:dof``
-``calculix`` CalculiX ``*FREQUENCY, SOLVER=MATRIXSTORAGE``           ``K`` (``.sti``) and ``M`` (``.mas``); ``node:dof``
-``dmig``     Nastran DMIG bulk data (``.bdf``/``.pch``/``.nas`` …)   every DMIG by its name; ``grid:component``
-``op4``      Nastran OUTPUT4 ``.op4`` (binary or text)              every matrix by its (upper-case) name; no DOFs
-============ ===================================================== ===============================================
+* ``mat`` — MATLAB ``.mat`` (v4 to v7.2; :func:`scipy.io.loadmat`): every 2-D numeric variable by its name;
+  no DOFs.
+* ``mm`` — Matrix Market ``.mtx``/``.mm`` (:func:`scipy.io.mmread`): one, named after the file stem; no DOFs.
+* ``hb`` — Harwell–Boeing ``.hb``/``.rua``/``.rsa``/``.rb``: one, named after the file stem; no DOFs.
+* ``abaqus`` — ABAQUS ``*MATRIX GENERATE`` text ``.mtx``: one (``job_STIF1``, ``job_MASS1`` …); ``node:dof``.
+* ``calculix`` — CalculiX ``*FREQUENCY, SOLVER=MATRIXSTORAGE``: ``K`` (``.sti``) and ``M`` (``.mas``);
+  ``node:dof``.
+* ``dmig`` — Nastran DMIG bulk data (``.bdf``/``.pch``/``.nas`` …): every DMIG by its name; ``grid:component``.
+* ``op4`` — Nastran OUTPUT4 ``.op4`` (binary or text): every matrix by its (upper-case) name; no DOFs.
 
 Format references and the rules this module follows:
 
