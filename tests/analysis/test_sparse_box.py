@@ -98,7 +98,7 @@ def test_brake100_box_matches_dense_qz(omega: float) -> None:
     assert n_unstable == 1
     assert res.unstable == n_unstable and res.undecided == 0
     f = ref[ref.real > 0][0].imag / (2 * math.pi)
-    assert res.verdict == f"1 unstable modes in [{f:.6g}, {f:.6g}] Hz"
+    assert res.verdict == f"1 unstable mode in [{f:.6g}, {f:.6g}] Hz"
     assert res.vectors is not None and res.vectors.shape == (100, ref.size)
 
 

@@ -624,14 +624,15 @@ def _verdict(lam: np.ndarray, bound: np.ndarray, complete: bool, notes: list[str
     unst = lam.real - bound > 0
     straddle = np.abs(lam.real) <= bound
     band = (f"[{f[unst].min():.6g}, {f[unst].max():.6g}] Hz" if unst.any() else "")
+    modes = "mode" if int(unst.sum()) == 1 else "modes"
     if not complete:
-        head = f"at least {int(unst.sum())} unstable modes in {band}; " if unst.any() else ""
+        head = f"at least {int(unst.sum())} unstable {modes} in {band}; " if unst.any() else ""
         return "undecided: " + head + "; ".join(notes)
     if straddle.any():
         where = ", ".join(f"{v:.6g}" for v in f[straddle][:5])
-        head = f"{int(unst.sum())} unstable modes in {band}; " if unst.any() else ""
+        head = f"{int(unst.sum())} unstable {modes} in {band}; " if unst.any() else ""
         return (f"undecided: {head}{int(straddle.sum())} eigenvalues with |Re λ| within their error bound "
                 f"at {where} Hz")
     if unst.any():
-        return f"{int(unst.sum())} unstable modes in {band}"
+        return f"{int(unst.sum())} unstable {modes} in {band}"
     return "stable in box"
