@@ -203,3 +203,13 @@ def test_box_and_reduce_bad_input_is_one_line(capsys, args, words):
     lines = err.strip().splitlines()
     assert rc == 2 and len(lines) == 1 and "Traceback" not in err, err
     assert words in lines[0]
+
+
+def test_list_models_names_the_fe_benchmarks(capsys):
+    rc, out, err = cli(capsys, "list", "models", "--format", "json")
+    assert rc == 0, err
+    rows = {r["name"]: r for r in json.loads(out)}
+    assert rows["disk_brake100"]["dof"] == 100 and rows["disk_brake4669"]["kind"] == "matrices"
+    from brakesqueal.model import get_model
+
+    assert get_model("disk_brake100").n == rows["disk_brake100"]["dof"]

@@ -28,7 +28,10 @@ from importlib import resources
 from ..errors import ParameterError
 from .matrices import MatrixSpec
 
-__all__ = ["FE_MODELS", "fe_model", "fe_data_dir"]
+__all__ = ["FE_MODELS", "FE_DOF", "fe_model", "fe_data_dir"]
+
+#: Coordinates of each built-in finite-element model (without reading its matrices).
+FE_DOF = {"disk_brake100": 100, "disk_brake4669": 4669}
 
 _FRICTION_SCALE = "friction scale: multiplies the friction matrices (1 = the published model)"
 
