@@ -34,7 +34,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import BenchResult, best_time, emit  # noqa: E402
 
 #: The one full dense QZ of the 9338-wide pencil run on the development machine (2 shared vCPU, one BLAS thread).
-FULL_QZ_ONCE = ("not finished after 80 min wall / 60 min CPU (tests/data/fe/disk_brake4669_omega2pi_box.md); "
+FULL_QZ_ONCE = ("not finished after 88 min wall / 68 min CPU (tests/data/fe/disk_brake4669_omega2pi_box.md); "
                 "dense dgeev of B^-1 A of the same scaled QEP: 586 s")
 
 NAMES = (("M", "BMLL"), ("D1", "BDLL"), ("DG", "BYLL"), ("DR", "BDIWLL"), ("D4", "BHLL"),

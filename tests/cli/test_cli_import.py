@@ -179,7 +179,9 @@ def test_reduce_writes_a_model_every_command_takes(tmp_path, capsys, monkeypatch
                        "--freq", "0:0.2", "--out", "r.toml", "--format", "json", "--no-progress")
     assert rc == 0, err
     r = json.loads(out)
-    assert r["dimension"] < 100 and r["max_rel_error"] < 1e-4
+    assert r["dimension"] < 100 and r["max_rel_error"] < 1e-4 and r["reliable"]
+    # the checks lie between the samples (at a sample the error would be the projection's rounding only)
+    assert all(c["Omega"] not in r["samples"] for c in r["checks"]) and len(r["checks"]) == 2
     assert (tmp_path / "r.mat").exists()
     w = 9.0  # not a sample: the reduced model's box eigenvalues against the full dense QZ
     rc, out, err = cli(capsys, "linearize", "--model", "r.toml", "--set", f"Omega={w}", "--format", "json")
@@ -189,6 +191,14 @@ def test_reduce_writes_a_model_every_command_takes(tmp_path, capsys, monkeypatch
     f = ref.imag / (2 * math.pi)
     for z in ref[(ref.real >= -0.05) & (f >= 0) & (f <= 0.2)]:
         assert np.min(np.abs(lam - z)) <= 1e-4 * abs(z)
+
+
+def test_reduce_says_when_the_reduced_real_parts_are_too_coarse(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    rc, out, err = cli(capsys, "reduce", "--model", "disk_brake100", "--along", "Omega=2*pi:8*pi:3", "--re=-0.05:1",
+                       "--freq", "0:0.2", "--dim", "4", "--out", "r.toml", "--no-progress")
+    assert rc == 0, err
+    assert "4 DOF" in out and "verdicts may differ from the full model's" in err
 
 
 @pytest.mark.parametrize("args, words", [

@@ -89,14 +89,23 @@ class Reduction:
     singular_values : ndarray
         Of the snapshot matrix (the kept ones first).
     checks : tuple of dict
-        Per check speed (between the samples): ``Omega``, ``count_full``, ``count_reduced`` (box eigenvalues)
-        and ``max_rel_error`` (of every full box eigenvalue against the nearest reduced one).
+        Per check speed (midway between samples): ``Omega``, ``count_full``, ``count_reduced`` (box
+        eigenvalues), ``max_rel_error`` and ``max_re_error`` (of every full box eigenvalue against the nearest
+        reduced one: relative, and the absolute error of its real part), ``min_abs_re`` (the smallest
+        ``|Re λ|`` of the full box: the margin a verdict needs).
     """
 
     spec: MatrixSpec
     samples: np.ndarray
     singular_values: np.ndarray
     checks: tuple[dict[str, float], ...]
+
+    @property
+    def reliable(self) -> bool:
+        """Whether every check's real-part error is below the smallest ``|Re λ|`` there: the reduced model's
+        verdicts then say what the full model's do in the box (``False`` without checks)."""
+        return bool(self.checks) and all(c["max_re_error"] < c["min_abs_re"] and c["count_full"] == c["count_reduced"]
+                                         for c in self.checks)
 
     @property
     def max_rel_error(self) -> float:
@@ -107,7 +116,8 @@ class Reduction:
         """JSON-ready summary."""
         return {"model": self.spec.name, "dimension": self.spec.n, "samples": [float(v) for v in self.samples],
                 "singular_values": [float(v) for v in self.singular_values[:self.spec.n]],
-                "checks": [dict(c) for c in self.checks], "max_rel_error": self.max_rel_error}
+                "checks": [dict(c) for c in self.checks], "max_rel_error": self.max_rel_error,
+                "reliable": self.reliable}
 
 
 def reduce_model(engine: Engine, space: ParameterSpace, samples: Sequence[float], *, re: tuple[float, float],
@@ -130,8 +140,8 @@ def reduce_model(engine: Engine, space: ParameterSpace, samples: Sequence[float]
     tol : float
         Relative singular-value cut-off.
     checks : int
-        Spin values between the samples at which the reduced model's box eigenvalues are compared with the full
-        model's (0: none).
+        How many speeds midway between neighbouring samples the reduced model's box eigenvalues are compared
+        with the full model's at (0: none; at most one per gap).
     name : str, optional
         The reduced model's name (default ``<model>-r<r>``).
     progress : callable, optional
@@ -174,7 +184,10 @@ def reduce_model(engine: Engine, space: ParameterSpace, samples: Sequence[float]
                      reference="Graebner, Mehrmann, Quraishi, Schroeder, von Wagner, ZAMM 96(12) (2016) 1388-1405")
     rows = []
     if checks > 0:
-        grid = np.linspace(w[0], w[-1], checks + 2)[1:-1] if w.size > 1 else np.array([w[0] * 1.05])
+        # speeds between the samples (the samples themselves would show only the projection's rounding)
+        mids = (w[:-1] + w[1:]) / 2 if w.size > 1 else np.array([w[0] * 1.05])
+        grid = mids[np.unique(np.linspace(0, mids.size - 1, min(checks, mids.size)).round().astype(int))]
+        total = w.size + grid.size
         for i, v in enumerate(grid):
             full = box_eigenvalues(*qep(float(v)), re=re, freq=freq)
             Mr, Dr, Kr = red.at(space.resolve({spin: float(v)}))
@@ -182,10 +195,18 @@ def reduce_model(engine: Engine, space: ParameterSpace, samples: Sequence[float]
             lo, hi, flo, fhi = full.box
             f = np.abs(lam.imag) / (2 * np.pi)
             inside = lam[(lam.real >= lo) & (lam.real <= hi) & (f >= flo) & (f <= fhi) & (lam.imag >= 0)]
-            err = max((float(np.min(np.abs(inside - z)) / abs(z)) if inside.size else math.inf
-                       for z in full.eigenvalues), default=0.0)
+            rel, dre = 0.0, 0.0
+            for z in full.eigenvalues:
+                if not inside.size:
+                    rel = dre = math.inf
+                    break
+                near = inside[np.argmin(np.abs(inside - z))]
+                rel, dre = max(rel, abs(near - z) / abs(z)), max(dre, abs(near.real - z.real))
             rows.append({"Omega": float(v), "count_full": int(full.eigenvalues.size),
-                         "count_reduced": int(inside.size), "max_rel_error": err, "complete": bool(full.complete)})
+                         "count_reduced": int(inside.size), "max_rel_error": float(rel),
+                         "max_re_error": float(dre),
+                         "min_abs_re": float(np.min(np.abs(full.eigenvalues.real))) if full.eigenvalues.size
+                         else math.inf, "complete": bool(full.complete)})
             if progress is not None:
                 progress(w.size + i + 1, total)
     return Reduction(spec=red, samples=w, singular_values=basis.singular_values, checks=tuple(rows))

@@ -189,7 +189,13 @@ def reduce_cmd(
                      "\n")
     for c in red.checks:
         sys.stdout.write(f"  check at {ax.name} = {c['Omega']:.6g}: {c['count_full']} box eigenvalues (full), "
-                         f"{c['count_reduced']} (reduced), largest relative error {c['max_rel_error']:.1e}\n")
+                         f"{c['count_reduced']} (reduced), largest relative error {c['max_rel_error']:.1e}, "
+                         f"real-part error {c['max_re_error']:.1e} 1/s (smallest |Re| {c['min_abs_re']:.1e})\n")
+    if red.checks and not red.reliable:
+        from ._options import note
+
+        note("the reduced model's real parts are less accurate than the full model's growth rates: its verdicts "
+             "may differ from the full model's; take more samples or a larger --dim")
     sys.stdout.write(f"next: brakesqueal map --model {out} --x {ax.name}=... --y ... --out map.nc\n")
 
 
