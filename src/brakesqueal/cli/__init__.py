@@ -169,15 +169,15 @@ def list_(what: Annotated[ListWhat, typer.Argument(help="models or presets")],
                          "presets": spec.preset_names(), "description": spec.description})
         from ..model.fe_library import FE_DOF, FE_MODELS
 
-        fe = [{"name": name, "kind": "matrices", "dof": FE_DOF[name], "presets": [name],
+        fe: list[dict[str, object]] = [{"name": name, "kind": "matrices", "dof": FE_DOF[name], "presets": [name],
                "description": FE_MODELS[name][3]} for name in FE_MODELS]
         if fmt == OutFormat.json:
-            sys.stdout.write(json.dumps(rows + fe, indent=2) + "\n")
+            sys.stdout.write(json.dumps([*rows, *fe], indent=2) + "\n")
         else:
             for r in rows:
                 sys.stdout.write(f"{r['name']:<13} {len(r['coordinates'])} DOF  {r['description']}\n")
-            for r in fe:
-                sys.stdout.write(f"{r['name']:<13} {r['dof']} DOF  (coefficient matrices) {r['description']}\n")
+            for f in fe:
+                sys.stdout.write(f"{f['name']:<13} {f['dof']} DOF  (coefficient matrices) {f['description']}\n")
         return
     out = []
     for name in preset_names():
