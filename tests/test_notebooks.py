@@ -41,6 +41,7 @@ NOTEBOOKS = {
     "02": "02-stability-maps-and-critical-speed.ipynb",
     "03": "03-simulation.ipynb",
     "04": "04-custom-model.ipynb",
+    "05": "05-fe-matrices.ipynb",
 }
 KERNEL = "brakesqueal-notebook-test"
 CELL_TIMEOUT = 300  # s; a whole notebook takes a few seconds with a warm cache
@@ -244,3 +245,33 @@ def test_04_custom_model(kernel_dir):
     assert three["n_pads"] == 3 and max(abs(q) for q in three["Q0"]) < 1e-12
     assert three["normal_forces"] == pytest.approx([3600.0] * 3, rel=1e-9)
     assert len(outputs_with(nb, "image/png")) >= 2
+
+
+# ------------------------------------------------------------------ 05
+@pytest.mark.slow
+def test_05_fe_matrices(kernel_dir):
+    """Against a dense QZ of the companion pencil (disk_brake100, from scipy.io.loadmat here) and the stored dense
+    reference of the 4669-DOF brake (tests/data/fe/disk_brake4669_omega2pi_box.md)."""
+    import scipy.io
+    import scipy.linalg
+
+    nb = run("05", kernel_dir)
+    s = summary(nb)
+    d = scipy.io.loadmat(EXAMPLES.parent / "src" / "brakesqueal" / "data" / "fe" / "nlevp-disk-brake-100"
+                         / "disk_brake100.mat")
+    r = {k: np.asarray(d[k], dtype=float) for k in ("M", "D1", "DR", "DG", "K1", "KR")}
+    n = 100
+    for w, status, max_real in s["verdicts"]:
+        A = np.block([[np.zeros((n, n)), np.eye(n)], [-(r["K1"] + r["KR"]), -(r["D1"] + r["DR"] / w + w * r["DG"])]])
+        B = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), r["M"]]])
+        ref = scipy.linalg.eig(A, B, right=False).real.max()
+        assert status == "unstable" and max_real == pytest.approx(ref, rel=1e-6)
+    dense = json.load(open(Path(__file__).parent / "data" / "fe" / "disk_brake4669_omega2pi_box.json"))
+    key = next(k for k in ("eigenvalues", "box_eigenvalues") if k in dense)
+    ref = np.array([complex(*z) for z in dense[key]])
+    inbox = ref[(np.abs(ref.real) <= 50) & (ref.imag / (2 * math.pi) <= 20000) & (ref.imag >= 0)]
+    got = np.array([complex(*z) for z in s["box_eigenvalues"]])
+    assert s["box_unstable"] == int(np.sum(inbox.real > 0)) == 3 and got.size == inbox.size
+    for z in inbox:
+        assert np.min(np.abs(got - z)) <= 1e-8 * abs(z)
+    assert s["reduced_dim"] < 100 and s["reduced_max_rel_error"] < 1e-4
