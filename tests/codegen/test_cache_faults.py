@@ -426,6 +426,8 @@ EXEMPT = {
     "suggest.py": "closest-name suggestions in error messages",
     "model/parameters.py": "parameter values and presets: never enter generated code",
     "model/roles.py": "ranges and units of parameters: validation only",
+    "model/matrices.py": "models given by coefficient matrices: nothing is generated for them (their engine is keyed "
+                         "by a hash of the matrices); build() and the nonlinear refusal only test for the kind",
 }  # fmt: skip
 
 

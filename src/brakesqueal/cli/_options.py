@@ -77,10 +77,10 @@ ProgressOpt = Annotated[Optional[bool], typer.Option(
 
 def with_equations(space: ParameterSpace, command: str) -> ParameterSpace:
     """``space``, or the one-line refusal of a command that needs a model's nonlinear equations (a model given
-    by coefficient matrices has none: :meth:`~brakesqueal.codegen.engine.Engine.require_nonlinear`)."""
-    from ..codegen import build
+    by coefficient matrices has none: :func:`~brakesqueal.model.matrices.require_equations`); builds nothing."""
+    from ..model.matrices import require_equations
 
-    build(space.model).require_nonlinear(command)
+    require_equations(space.model, command)
     return space
 
 

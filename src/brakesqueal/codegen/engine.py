@@ -124,12 +124,9 @@ class Engine:
     def require_nonlinear(self, what: str) -> Engine:
         """This engine, or a one-line :class:`~brakesqueal.errors.ParameterError` where the model has no nonlinear
         equations (a model given by coefficient matrices) and ``what`` needs them."""
-        if self.caps.kind != "components":
-            from ..errors import ParameterError
+        from ..model.matrices import require_equations
 
-            raise ParameterError(f"{what}: model '{self.spec.name}' is given by coefficient matrices, a linear model "
-                                 "with no known nonlinear terms; use linearize, eigen, map, crossings, "
-                                 "critical-speed, modes or sweep")
+        require_equations(self.spec, what)
         return self
 
     # ---------------------------------------------------------------- closed forms (SymPy on a cache miss)

@@ -23,16 +23,13 @@ if TYPE_CHECKING:
     from ..model.matrices import MatrixSpec
     from ..model.parameters import ParameterSpace
 
-__all__ = ["MatrixEngine", "build_matrix_engine", "NONLINEAR_REFUSAL", "MAX_DENSE_DOF"]
+__all__ = ["MatrixEngine", "build_matrix_engine", "MAX_DENSE_DOF"]
 
 #: Largest matrix model analysed with dense eigenvalues (``2n`` states: about 10 s per point at this size on
 #: one core; a 4669-DOF model's dense QZ takes tens of minutes).  Larger models: the sparse box route or a
 #: reduced model.
 MAX_DENSE_DOF = 1500
 
-#: Why nonlinear analyses refuse a matrix model.
-NONLINEAR_REFUSAL = ("is given by coefficient matrices (a linear model: no nonlinear terms are known); "
-                     "hopf, cycles and simulate need a model of disk and pads")
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,9 +66,9 @@ class MatrixEngine(Engine):
         return self.matrix_spec.at(values)
 
     def _refuse(self, what: str) -> Any:
-        from ..errors import ParameterError
+        from ..model.matrices import require_equations
 
-        raise ParameterError(f"model '{self.spec.name}' {NONLINEAR_REFUSAL} ({what})")
+        require_equations(self.spec, what)
 
     # component-model artefacts do not exist here
     def closed_form(self) -> Any:

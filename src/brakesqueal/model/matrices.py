@@ -57,10 +57,20 @@ from .expressions import RESERVED_NAMES, _checked_tree, evaluate, evaluate_array
 from .parameters import Preset
 
 __all__ = ["MatrixSpec", "Term", "COEFFICIENTS", "parse_coefficient", "matrix_spec_from_dict",
-           "is_matrix_model_data", "matrix_spec_to_dict", "matrix_model_toml", "import_matrices", "write_matrix_model"]
+           "is_matrix_model_data", "matrix_spec_to_dict", "matrix_model_toml", "import_matrices", "write_matrix_model",
+           "require_equations"]
 
 #: The coefficients of ``λ² M + λ D + K``.
 COEFFICIENTS = ("M", "D", "K")
+
+
+def require_equations(spec: Any, what: str) -> None:
+    """A one-line :class:`~brakesqueal.errors.ParameterError` where ``spec`` is a model given by coefficient
+    matrices (a linear model: no nonlinear terms are known) and ``what`` needs its nonlinear equations."""
+    if isinstance(spec, MatrixSpec):
+        raise ParameterError(f"{what}: model '{spec.name}' is given by coefficient matrices, a linear model with no "
+                             "known nonlinear terms; use linearize, eigen, map, crossings, critical-speed, modes, "
+                             "sweep, box or reduce")
 
 
 @dataclass(frozen=True)
