@@ -53,7 +53,7 @@ def state_matrix(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
     return np.concatenate([top, bottom], axis=0)
 
 
-def qep_eigenvalues(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
+def qep_eigenvalues(M: np.ndarray, D: np.ndarray, K: np.ndarray, *, finite: bool = True) -> np.ndarray:
     """Every eigenvalue of ``λ² M + λ D + K`` by QZ of the first companion pencil after the scaling of Fan, Lin &
     Van Dooren (SIAM J. Matrix Anal. Appl. 26 (2004) 252-256): ``λ = γ μ`` with ``γ = sqrt(‖K‖/‖M‖)`` and the
     coefficients divided by ``δ = 2/(‖K‖ + γ‖D‖)``.  For models of many DOF it keeps the smallest eigenvalues
@@ -64,11 +64,13 @@ def qep_eigenvalues(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
     ----------
     M, D, K : ndarray, shape (n, n)
         Dense coefficient matrices.
+    finite : bool
+        Drop the infinite eigenvalues of a singular ``M`` (default), or keep them.
 
     Returns
     -------
     ndarray of complex, shape (2n,)
-        The eigenvalues (infinite ones where ``M`` is singular are dropped).
+        The eigenvalues.
     """
     import scipy.linalg
 
@@ -79,8 +81,9 @@ def qep_eigenvalues(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
     I, Z = np.eye(n), np.zeros((n, n))
     A = np.block([[Z, I], [-K * d, -D * (d * g)]])
     B = np.block([[I, Z], [Z, M * (d * g * g)]])
-    mu = scipy.linalg.eigvals(A, B)
-    return np.asarray(mu[np.isfinite(mu)] * g)
+    with np.errstate(invalid="ignore"):
+        lam = scipy.linalg.eigvals(A, B) * g
+    return np.asarray(lam[np.isfinite(lam)] if finite else lam)
 
 
 def pencil_eigenvalues(E: np.ndarray, A: np.ndarray, sweeps: int = 20) -> np.ndarray:

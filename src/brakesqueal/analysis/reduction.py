@@ -146,7 +146,8 @@ def project(V: np.ndarray, matrices: Mapping[str, Matrix]) -> dict[str, np.ndarr
 
 
 def dense_qep_eigenvalues(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.ndarray:
-    """All ``2r`` eigenvalues of a small dense QEP ``λ²M + λD + K`` (QZ of the companion pencil).
+    """All ``2r`` eigenvalues of a small dense QEP ``λ²M + λD + K``: QZ of the scaled companion pencil, the
+    routine of :func:`~.linear.qep_eigenvalues` (what ``linearize`` lists for a matrix model).
 
     Parameters
     ----------
@@ -158,11 +159,10 @@ def dense_qep_eigenvalues(M: np.ndarray, D: np.ndarray, K: np.ndarray) -> np.nda
     numpy.ndarray
         Complex eigenvalues (infinite ones where ``M`` is singular).
     """
-    r = M.shape[0]
-    Z, I_ = np.zeros((r, r)), np.eye(r)
-    A = np.block([[Z, I_], [-np.asarray(K), -np.asarray(D)]])
-    B = np.block([[I_, Z], [Z, np.asarray(M)]])
-    return np.asarray(sl.eigvals(A, B, overwrite_a=True, check_finite=False))
+    from .linear import qep_eigenvalues
+
+    return qep_eigenvalues(np.asarray(M, dtype=float), np.asarray(D, dtype=float), np.asarray(K, dtype=float),
+                           finite=False)
 
 
 def reduce_qep(qep: Callable[[float], tuple[Matrix, Matrix, Matrix]], omegas: Sequence[float], *,
