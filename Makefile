@@ -44,6 +44,7 @@ $(DOCS_STAMP): pyproject.toml | $(BIN)/python
 docs: $(DOCS_STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m sphinx -W --keep-going -E -q -b html docs docs/_build/html
 	$(BIN)/python docs/_ext/check_offline.py docs/_build/html
+	$(BIN)/python docs/_ext/check_layout.py docs/_build/html
 	@echo "documentation: docs/_build/html/index.html"
 
 clean:

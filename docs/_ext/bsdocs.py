@@ -16,6 +16,30 @@
 * ``.. brakesqueal-equations::`` is the table "equation of the theory page →
   function" of ``_ext/equations.py``; each module's API page lists its own rows
   under "Theory", linking back to the equations.
+
+Why not sphinx-click and autosummary's generated pages (tried with Sphinx 9.0,
+sphinx-click 6.2, typer 0.28):
+
+* **sphinx-click** documents ``click`` objects, and typer vendors its own copy
+  of click since 0.26 (``typer._click``): ``typer.main.get_command(app)`` is
+  not a ``click.Command``, and sphinx-click refuses it ("is not
+  click.Command or click.Group"); it would also find no options (it tests
+  ``isinstance(param, click.Option)``).  The installed typer is inside the
+  pin ``typer>=0.12,<0.29``, so the CLI reference reads typer's click objects
+  here.
+* **autosummary** (``autosummary_generate`` with ``:recursive:``) imports every
+  submodule, private ones and ``brakesqueal.__main__`` included: importing the
+  latter runs the command line and ends the build ("No such option: -E").
+  With that module stubbed out, ``__all__`` respected and templates giving every
+  function and class its page, it reached 36 of the 117 public modules (a
+  package's submodules not named in its ``__all__`` are not recursed into) and
+  202 objects, against the 677 names documented here; the top-level page listed none
+  of the package's entry points (lazily loaded re-exports), and one class got
+  two descriptions (a ``-W`` error).  What bsdocs adds is the walk over every
+  public module and :func:`canonical_locations`: each object documented once,
+  where it is defined (or, for the 29 defined in private modules, in the public
+  package re-exporting it), the 206 re-exports listed as links to it.  The
+  summary tables are autosummary's; the per-module "Theory" rows are bsdocs'.
 """
 
 from __future__ import annotations

@@ -91,7 +91,7 @@ class GalleryRunDirective(SphinxDirective):
         lines: list[str] = []
         for title, fig, args, what in COMMANDS:
             shown = " ".join(a if " " not in a else repr(a) for a in args)
-            lines += [title, "-" * len(title), "", what, "", ".. code-block:: console", "",
+            lines += [title, "-" * len(title), "", what, "", ".. code-block:: console", "   :class: bs-command", "",
                       f"   $ brakesqueal {shown}", "", f".. image:: /{OUT}/{fig}", "   :width: 100%", ""]
         node_list: list[Any] = []
         from docutils import nodes

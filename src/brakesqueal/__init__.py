@@ -17,7 +17,10 @@ The public API follows the layers of the package:
 * :func:`simulate`, :func:`hopf_points`, :func:`limit_cycles` — the nonlinear
   time simulation and the nonlinear analysis after onset (:mod:`.api_nonlinear`).
 
-Heavy symbolic modules are imported lazily.
+Heavy symbolic modules are imported lazily.  Every public function checks
+its arguments against its type hints before it runs
+(:func:`brakesqueal.validation.validated`): a wrong argument is one
+:class:`ParameterError` line naming it.
 """
 
 from __future__ import annotations
@@ -152,12 +155,22 @@ _LAZY = {
 }
 
 
+_CHECKED: dict[str, Any] = {}
+
+
 def __getattr__(name: str) -> Any:
+    if name in _CHECKED:
+        return _CHECKED[name]
     if name in _LAZY:
         import importlib
+        import types
 
-        mod = importlib.import_module(f".{_LAZY[name]}", __name__)
-        return getattr(mod, name)
+        obj = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        if isinstance(obj, types.FunctionType) and not obj.__dict__.get("__validated__"):
+            from .validation import validated  # every public function checks its arguments against its hints
+
+            obj = _CHECKED[name] = validated(obj)
+        return obj
     raise AttributeError(f"module 'brakesqueal' has no attribute {name!r}")
 
 

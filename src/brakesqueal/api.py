@@ -10,12 +10,20 @@ The same functions are re-exported by :mod:`brakesqueal` (``brakesqueal.lineariz
 Every verdict comes from the one verdict dispatcher
 (:func:`brakesqueal.analysis.verdict.decide`) and names the route that
 decided it and the mode that carries it.
+
+Every function checks its arguments against its type hints before it does
+anything (:func:`brakesqueal.validation.validated`): a wrong type, a NaN or
+infinity where a finite number is needed or a count below one is one
+:class:`~brakesqueal.errors.ParameterError` line naming the argument.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Annotated, Any, cast
+
+from .validation import Range, validated
 
 if TYPE_CHECKING:
     import numpy as np
@@ -27,21 +35,31 @@ if TYPE_CHECKING:
     from .analysis.modes import ModeTracks
     from .analysis.points import PointVerdict, Verdicts
     from .codegen.engine import Engine
+    from .model.components import ModelSpec
+    from .model.matrices import MatrixSpec
     from .model.parameters import Parameters, ParameterSpace
 
 __all__ = ["engine", "silent_motion", "linearize", "pad_rate_eigenvalues", "eigen_analysis", "evaluate",
            "evaluate_point", "stability_map", "write_map", "crossings", "critical_speeds", "critical_speeds_many",
            "modes_along"]
 
+#: A count of at least one (points per block, crossings).
+_Count = Annotated[int, Range(1)]
+#: A speed bound [rad/s], above zero.
+_Speed = Annotated[float, Range(0, open_low=True)]
 
-def engine(model: Any) -> Engine:
-    """The engine of a model (a :class:`~brakesqueal.model.components.ModelSpec`, a built-in model's name, a
-    model file, or anything with a ``model`` attribute: parameters, a parameter space).
+
+@validated
+def engine(model: ModelSpec | MatrixSpec | str | os.PathLike[str] | Parameters | ParameterSpace) -> Engine:
+    """The engine of a model (a :class:`~brakesqueal.model.components.ModelSpec` or
+    :class:`~brakesqueal.model.matrices.MatrixSpec`, a built-in model's name, a model file, or the model of
+    parameters or a parameter space).
 
     Parameters
     ----------
-    model : ModelSpec, str, Parameters or ParameterSpace
-        The model.
+    model : ModelSpec, MatrixSpec, str, os.PathLike, Parameters or ParameterSpace
+        The model; a name that is neither a built-in model nor a model file, or anything else, is refused
+        (:class:`~brakesqueal.errors.ParameterError`).
 
     Returns
     -------
@@ -50,9 +68,13 @@ def engine(model: Any) -> Engine:
     """
     from .codegen import build
 
-    return build(getattr(model, "model", model))
+    from .model.parameters import Parameters, ParameterSpace
+
+    spec = model.model if isinstance(model, (Parameters, ParameterSpace)) else model
+    return build(cast("ModelSpec", os.fspath(spec) if isinstance(spec, os.PathLike) else spec))
 
 
+@validated
 def silent_motion(params: Parameters) -> SilentMotion:
     """The silent motion (eq. 46) of a parameter set (:func:`brakesqueal.analysis.equilibrium.silent_motion`).
 
@@ -72,6 +94,7 @@ def silent_motion(params: Parameters) -> SilentMotion:
     return _silent_motion(engine(params), params)
 
 
+@validated
 def linearize(params: Parameters, *, pad_rates: str = "kept") -> LinearModel:
     """Silent motion and linear model (eqs. 46-48) of a parameter set of any model.
 
@@ -93,6 +116,7 @@ def linearize(params: Parameters, *, pad_rates: str = "kept") -> LinearModel:
     return _linearize(engine(params), params, pad_rates=pad_rates)
 
 
+@validated
 def pad_rate_eigenvalues(params: Parameters) -> np.ndarray:
     """Finite eigenvalues with the pads' tangential rates kept (``linearize(params).eigenvalues``).
 
@@ -109,7 +133,8 @@ def pad_rate_eigenvalues(params: Parameters) -> np.ndarray:
     return linearize(params).eigenvalues
 
 
-def eigen_analysis(model: Any) -> EigenAnalysis:
+@validated
+def eigen_analysis(model: LinearModel | Parameters) -> EigenAnalysis:
     """Eigenvalues, modes, splits, sensitivities and verdict of a linear model or a parameter set.
 
     Parameters
@@ -129,6 +154,7 @@ def eigen_analysis(model: Any) -> EigenAnalysis:
     return _eigen(linearize(model))
 
 
+@validated
 def evaluate(space: ParameterSpace, values: Mapping[str, Any], *, eigen: bool = True, modes: str = "all") -> Verdicts:
     """Statuses and certified verdicts at points of a parameter space (:func:`brakesqueal.analysis.points.evaluate`).
 
@@ -152,7 +178,8 @@ def evaluate(space: ParameterSpace, values: Mapping[str, Any], *, eigen: bool = 
     return _evaluate(engine(space), space, values, eigen=eigen, modes=modes)
 
 
-def evaluate_point(space: ParameterSpace, values: Mapping[str, float] | None = None, *,
+@validated
+def evaluate_point(space: ParameterSpace, values: Mapping[str, Any] | None = None, *,
                    modes: str = "all") -> PointVerdict:
     """Status and certified verdict of one point of a parameter space (default: its current point).
 
@@ -160,8 +187,8 @@ def evaluate_point(space: ParameterSpace, values: Mapping[str, float] | None = N
     ----------
     space : ParameterSpace
         The parameter space.
-    values : Mapping[str, float], optional
-        Settable names → values.
+    values : Mapping[str, float or str], optional
+        Settable names → values (numbers, ``inf`` or expressions).
     modes : {"all", "disk"}
         Judge every eigenvalue, or leave out the modes of a massless pad's own tangential rate.
 
@@ -175,8 +202,9 @@ def evaluate_point(space: ParameterSpace, values: Mapping[str, float] | None = N
     return _evaluate_point(engine(space), space, values, modes=modes)
 
 
+@validated
 def stability_map(space: ParameterSpace, x: Axis, y: Axis, *, force: bool = False, eigen: bool = True,
-                  chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None,
+                  chunk_points: _Count = 1 << 18, progress: Callable[[float], None] | None = None,
                   boundary: bool = True, modes: str = "all", quantities: tuple[str, ...] | None = None) -> Any:
     """A stability map over two settable parameters (:func:`brakesqueal.analysis.maps.stability_map`).
 
@@ -191,7 +219,7 @@ def stability_map(space: ParameterSpace, x: Axis, y: Axis, *, force: bool = Fals
     eigen : bool
         Compute ``max_real`` and ``frequency`` (otherwise only classify).
     chunk_points : int
-        Points per block (bounds the temporary memory).
+        Points per block (bounds the temporary memory; at least 1).
     progress : callable, optional
         Called with the completed fraction after each block.
     boundary : bool
@@ -211,9 +239,10 @@ def stability_map(space: ParameterSpace, x: Axis, y: Axis, *, force: bool = Fals
                 boundary=boundary, modes=modes, quantities=quantities)
 
 
-def write_map(space: ParameterSpace, x: Axis, y: Axis, path: str, *, force: bool = False, eigen: bool = True,
-              chunk_points: int = 1 << 18, progress: Callable[[float], None] | None = None, boundary: bool = True,
-              modes: str = "all", quantities: tuple[str, ...] | None = None) -> MapSummary:
+@validated
+def write_map(space: ParameterSpace, x: Axis, y: Axis, path: str | os.PathLike[str], *, force: bool = False,
+              eigen: bool = True, chunk_points: _Count = 1 << 18, progress: Callable[[float], None] | None = None,
+              boundary: bool = True, modes: str = "all", quantities: tuple[str, ...] | None = None) -> MapSummary:
     """A stability map written to NetCDF block by block (:func:`brakesqueal.analysis.maps.write_map`).
 
     Parameters
@@ -222,7 +251,7 @@ def write_map(space: ParameterSpace, x: Axis, y: Axis, path: str, *, force: bool
         The model, preset and overrides.
     x, y : Axis
         The axes.
-    path : str
+    path : str or os.PathLike
         The NetCDF file.
     force, eigen, chunk_points, progress, boundary, modes, quantities
         As :func:`stability_map`.
@@ -233,10 +262,11 @@ def write_map(space: ParameterSpace, x: Axis, y: Axis, path: str, *, force: bool
     """
     from .analysis.maps import write_map as _write
 
-    return _write(engine(space), space, x, y, path, force=force, eigen=eigen, chunk_points=chunk_points,
+    return _write(engine(space), space, x, y, os.fspath(path), force=force, eigen=eigen, chunk_points=chunk_points,
                   progress=progress, boundary=boundary, modes=modes, quantities=quantities)
 
 
+@validated
 def crossings(space: ParameterSpace, axis: Axis, *, modes: str = "all") -> Any:
     """Every stability change along one settable parameter (:func:`brakesqueal.analysis.crossings.crossings`).
 
@@ -258,7 +288,8 @@ def crossings(space: ParameterSpace, axis: Axis, *, modes: str = "all") -> Any:
     return _crossings(engine(space), space, axis, modes=modes)
 
 
-def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5, *, modes: str = "all") -> Any:
+@validated
+def critical_speeds(space: ParameterSpace, lo: _Speed = 1.0, hi: _Speed = 1e5, *, modes: str = "all") -> Any:
     """All onsets and re-stabilisations along Ω (:func:`brakesqueal.analysis.crossings.critical_speeds`).
 
     Parameters
@@ -279,20 +310,21 @@ def critical_speeds(space: ParameterSpace, lo: float = 1.0, hi: float = 1e5, *, 
     return _critical(engine(space), space, lo, hi, modes=modes)
 
 
-def critical_speeds_many(space: ParameterSpace, changes: dict[str, Any], lo: float = 1.0, hi: float = 1e5,
-                         max_crossings: int = 8, *, return_status: bool = False) -> tuple[Any, ...]:
+@validated
+def critical_speeds_many(space: ParameterSpace, changes: Mapping[str, Any], lo: _Speed = 1.0, hi: _Speed = 1e5,
+                         max_crossings: _Count = 8, *, return_status: bool = False) -> tuple[Any, ...]:
     """Critical speeds of many parameter sets, batched (:func:`brakesqueal.analysis.crossings.critical_speeds_many`).
 
     Parameters
     ----------
     space : ParameterSpace
         The model, preset and overrides.
-    changes : dict of str to array_like
+    changes : Mapping of str to array_like
         Settable names → values (broadcast to one length).
     lo, hi : float
         The Ω range [rad/s].
     max_crossings : int
-        Columns of the outputs.
+        Columns of the outputs (at least 1).
     return_status : bool
         Also return a per-set status.
 
@@ -303,9 +335,10 @@ def critical_speeds_many(space: ParameterSpace, changes: dict[str, Any], lo: flo
     """
     from .analysis.crossings import critical_speeds_many as _many
 
-    return _many(engine(space), space, changes, lo, hi, max_crossings, return_status=return_status)
+    return _many(engine(space), space, dict(changes), lo, hi, max_crossings, return_status=return_status)
 
 
+@validated
 def modes_along(space: ParameterSpace, name: str, start: float, stop: float, *, num: int = 200, log: bool = False,
                 pad_rates: str = "kept") -> ModeTracks:
     """Mode-coupling diagram along one settable parameter (:func:`brakesqueal.analysis.modes.modes_along`).

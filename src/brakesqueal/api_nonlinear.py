@@ -5,13 +5,17 @@ once (:func:`brakesqueal.codegen.build`, memoized per process by the model's
 equations) from its parameters or parameter space and hands it down to
 :mod:`brakesqueal.simulation` or :mod:`brakesqueal.nonlinear`, which never build
 one themselves.  Re-exported by :mod:`brakesqueal` (``brakesqueal.simulate``,
-``brakesqueal.limit_cycles``, ...).  ``docs/simulation.md``, ``docs/nonlinear.md``.
+``brakesqueal.limit_cycles``, ...).  ``docs/simulation.md``, ``docs/nonlinear.md``.  Every function checks its
+arguments against its type hints first (:func:`brakesqueal.validation.validated`).
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Annotated, Any, cast
+
+from .validation import Range, validated
 
 if TYPE_CHECKING:
     import numpy as np
@@ -19,6 +23,7 @@ if TYPE_CHECKING:
     from .analysis.maps import Axis
     from .codegen.engine import Engine
     from .model.components import ModelSpec
+    from .model.matrices import MatrixSpec
     from .model.parameters import Parameters, ParameterSpace
     from .nonlinear.compiled import CompiledFlow
     from .nonlinear.harmonic import HarmonicBranch
@@ -33,16 +38,19 @@ __all__ = ["simulate", "simulation_model", "hopf_points", "limit_cycles", "squea
            "model_system", "model_piecewise_system", "exact_lyapunov", "model_flow"]
 
 
-def _engine(model: ModelSpec | str | Parameters | ParameterSpace, use_cache: bool = True) -> Engine:
+def _engine(model: ModelSpec | MatrixSpec | str | os.PathLike[str] | Parameters | ParameterSpace,
+            use_cache: bool = True) -> Engine:
     from .codegen import build
 
     from .model.parameters import Parameters, ParameterSpace
 
     spec = model.model if isinstance(model, (Parameters, ParameterSpace)) else model
-    return build(spec, use_cache=use_cache).require_nonlinear("nonlinear analysis")
+    spec = os.fspath(spec) if isinstance(spec, os.PathLike) else spec
+    return build(cast("ModelSpec", spec), use_cache=use_cache).require_nonlinear("nonlinear analysis")
 
 
-def simulate(params: Parameters, t_span: float | Sequence[float] = 0.5,
+@validated
+def simulate(params: Parameters, t_span: float | tuple[float, float] = 0.5,
              x0: Sequence[float] | np.ndarray | None = None, *, use_cache: bool = True,
              **options: Any) -> Trajectory:
     """Integrate the nonlinear equations of the model of ``params`` (:func:`brakesqueal.simulation.simulate`).
@@ -52,7 +60,7 @@ def simulate(params: Parameters, t_span: float | Sequence[float] = 0.5,
     params : Parameters
         The model and its parameter values.
     t_span : float or (float, float), optional
-        End time [s] (start 0) or ``(t0, t_end)``.
+        End time [s] (start 0) or ``(t0, t_end)``: finite numbers (the simulation checks their order).
     x0 : array_like, optional
         Absolute initial state ``(Q, Qdot[, L_dynamic])``.
     use_cache : bool, optional
@@ -74,7 +82,8 @@ def simulate(params: Parameters, t_span: float | Sequence[float] = 0.5,
     return _simulate(sim, params, t_span, x0, **options)
 
 
-def simulation_model(model: ModelSpec | str | Parameters | ParameterSpace, *,
+@validated
+def simulation_model(model: ModelSpec | MatrixSpec | str | os.PathLike[str] | Parameters | ParameterSpace, *,
                      use_cache: bool = True) -> SimulationModel:
     """The simulation model of a model (a :class:`~brakesqueal.model.components.ModelSpec`, a built-in model's
     name, a model file, parameters or a parameter space): :func:`brakesqueal.simulation.simulation_model` of
@@ -82,8 +91,8 @@ def simulation_model(model: ModelSpec | str | Parameters | ParameterSpace, *,
 
     Parameters
     ----------
-    model : ModelSpec, str, Parameters or ParameterSpace
-        The model.
+    model : ModelSpec, MatrixSpec, str, os.PathLike, Parameters or ParameterSpace
+        The model (a model given by coefficient matrices is refused: it has no nonlinear equations).
     use_cache : bool, optional
         Use the on-disk code cache.
 
@@ -96,6 +105,7 @@ def simulation_model(model: ModelSpec | str | Parameters | ParameterSpace, *,
     return _simulation_model(_engine(model, use_cache), use_cache=use_cache)
 
 
+@validated
 def hopf_points(space: ParameterSpace, axis: Axis, *, use_cache: bool = True,
                 result: CrossingResult | None = None) -> list[HopfPoint]:
     """Every stability crossing along a path with its Hopf normal form
@@ -121,8 +131,9 @@ def hopf_points(space: ParameterSpace, axis: Axis, *, use_cache: bool = True,
     return _hopf_points(_engine(space, use_cache), space, axis, use_cache=use_cache, result=result)
 
 
+@validated
 def limit_cycles(space: ParameterSpace, axis: Axis, *, contact: str = "bilateral", pads: str = "auto",
-                 max_points: int | None = None, progress: Callable[[float], None] | None = None,
+                 max_points: Annotated[int, Range(1)] | None = None, progress: Callable[[float], None] | None = None,
                  pad_slope: float | None = None, stick_speed: float | None = None, use_cache: bool = True,
                  **options: Any) -> SquealBranch | HarmonicBranch:
     """Limit cycles from the first Hopf point on a path, by the route ``brakesqueal cycles`` takes
@@ -162,6 +173,7 @@ def limit_cycles(space: ParameterSpace, axis: Axis, *, contact: str = "bilateral
                          max_points=max_points, progress=progress, use_cache=use_cache, **options)
 
 
+@validated
 def squeal_branch(space: ParameterSpace, axis: Axis, *, pad_slope: float | None = None,
                   stick_speed: float | None = None, use_cache: bool = True, **options: Any) -> SquealBranch:
     """Limit cycles by shooting from the first Hopf point on a path
@@ -191,6 +203,7 @@ def squeal_branch(space: ParameterSpace, axis: Axis, *, pad_slope: float | None 
     return _squeal_branch(_engine(space, use_cache), space, axis, use_cache=use_cache, **options)
 
 
+@validated
 def harmonic_branch(space: ParameterSpace, axis: Axis, *, use_cache: bool = True, **options: Any) -> HarmonicBranch:
     """Limit cycles of the implicit equations by harmonic balance
     (:func:`brakesqueal.nonlinear.harmonic.harmonic_branch`).
@@ -215,6 +228,7 @@ def harmonic_branch(space: ParameterSpace, axis: Axis, *, use_cache: bool = True
     return _harmonic_branch(_engine(space, use_cache), space, axis, use_cache=use_cache, **options)
 
 
+@validated
 def model_system(space: ParameterSpace, name: str, *, use_cache: bool = True) -> SmoothSystem:
     """A model as a smooth system in the parameter ``name`` (:func:`brakesqueal.nonlinear.models.model_system`).
 
@@ -236,6 +250,7 @@ def model_system(space: ParameterSpace, name: str, *, use_cache: bool = True) ->
     return _model_system(_engine(space, use_cache), space, name, use_cache=use_cache)
 
 
+@validated
 def model_piecewise_system(space: ParameterSpace, name: str, *, use_cache: bool = True) -> PiecewiseSystem:
     """A model with unilateral contact as a piecewise system
     (:func:`brakesqueal.nonlinear.models.model_piecewise_system`).
@@ -258,6 +273,7 @@ def model_piecewise_system(space: ParameterSpace, name: str, *, use_cache: bool 
     return _model_piecewise_system(_engine(space, use_cache), space, name, use_cache=use_cache)
 
 
+@validated
 def exact_lyapunov(space: ParameterSpace, name: str, p0: float, *, omega: float | None = None,
                    use_cache: bool = True) -> PadHopf:
     """The first Lyapunov coefficient with the pads' true tangential dynamics
@@ -285,8 +301,9 @@ def exact_lyapunov(space: ParameterSpace, name: str, p0: float, *, omega: float 
     return _exact_lyapunov(_engine(space, use_cache), space, name, p0, omega=omega, use_cache=use_cache)
 
 
+@validated
 def model_flow(space: ParameterSpace, name: str, *, system: SmoothSystem | None = None, use_cache: bool = True,
-               rtol: float = 1e-11) -> CompiledFlow:
+               rtol: Annotated[float, Range(0, 1, open_low=True, open_high=True)] = 1e-11) -> CompiledFlow:
     """The compiled flow of a model with its exact Jacobian (:func:`brakesqueal.nonlinear.compiled.model_flow`).
 
     Parameters
@@ -300,7 +317,7 @@ def model_flow(space: ParameterSpace, name: str, *, system: SmoothSystem | None 
     use_cache : bool, optional
         Use the on-disk code cache.
     rtol : float, optional
-        Relative tolerance of the integrator.
+        Relative tolerance of the integrator, in (0, 1).
 
     Returns
     -------

@@ -37,6 +37,11 @@ outputs are written to temporary files that are registered with
 atomically.  A second Ctrl-C while the first is pending exits at once (still
 waiting for a critical section).  Library callers (no ``exit_after``) never
 have their process ended.
+
+``SIGTERM`` and ``SIGHUP`` (a ``kill``, a closed terminal) take the same path
+as Ctrl-C inside a guard (:data:`TERMINATION_SIGNALS`): the interrupt is
+raised and unwinds (temporary files removed), or the watchdog ends the
+process; the exit status is then 128 + the signal's number (143, 129).
 """
 
 from __future__ import annotations
@@ -55,14 +60,17 @@ from typing import Any
 _Hook = Callable[["sys.UnraisableHookArgs"], object]
 
 __all__ = ["interrupt_guard", "check_interrupt", "critical", "remove_on_exit", "exit_now", "EXIT_STATUS",
-           "EXIT_AFTER_S"]
+           "EXIT_AFTER_S", "TERMINATION_SIGNALS"]
 
 #: Exit status of an interrupted command (128 + SIGINT).
 EXIT_STATUS = 130
 #: Seconds a command-line run waits for the interrupted code to unwind before it ends the process.
 EXIT_AFTER_S = 0.5
 
-_state: dict[str, Any] = {"depth": 0, "flag": False, "redeliver": 0}
+#: Signals handled like Ctrl-C inside :func:`interrupt_guard` (exit status 128 + the signal's number).
+TERMINATION_SIGNALS: tuple[int, ...] = tuple(getattr(signal, n) for n in ("SIGTERM", "SIGHUP") if hasattr(signal, n))
+
+_state: dict[str, Any] = {"depth": 0, "flag": False, "redeliver": 0, "signum": None}
 _exit_lock = threading.Lock()
 _exit: dict[str, Any] = {"critical": 0, "exiting": False, "paths": {}, "signals": 0, "first": None,
                          "armed": False}
@@ -88,6 +96,27 @@ def _handler(signum: int, frame: FrameType | None) -> None:
         # process if the compilation outlasts exit_after
         return
     raise KeyboardInterrupt
+
+
+def _terminate(signum: int, frame: FrameType | None) -> None:
+    """SIGTERM / SIGHUP: recorded for the exit status, then handled exactly as Ctrl-C."""
+    _state["signum"] = signum
+    _handler(signum, frame)
+
+
+def _install_termination() -> dict[int, Any]:
+    """Handle :data:`TERMINATION_SIGNALS` like Ctrl-C (main thread; only where the default action is active)."""
+    old: dict[int, Any] = {}
+    for sig in TERMINATION_SIGNALS:
+        if signal.getsignal(sig) is signal.SIG_DFL:
+            old[sig] = signal.signal(sig, _terminate)
+    return old
+
+
+def _status() -> int:
+    """Exit status of an interrupted command: 130 for Ctrl-C, 128 + the signal's number for SIGTERM/SIGHUP."""
+    signum = _state["signum"]
+    return EXIT_STATUS if signum is None else 128 + int(signum)
 
 
 def _unraisable(hook: _Hook) -> _Hook:
@@ -176,7 +205,7 @@ def _try_exit() -> bool:
         with contextlib.suppress(OSError):
             # on a terminal: end a progress bar's line and show the cursor it hid
             os.write(2, (b"\n\x1b[?25h" if os.isatty(2) else b"") + b"brakesqueal: interrupted\n")
-        os._exit(EXIT_STATUS)
+        os._exit(_status())
     return False  # pragma: no cover - os._exit does not return
 
 
@@ -199,6 +228,10 @@ def _watchdog(rfd: int, exit_after: float, stop: threading.Event) -> None:
             except OSError:
                 return
             n = data.count(bytes([signal.SIGINT]))
+            for sig in TERMINATION_SIGNALS:  # handled as Ctrl-C (even while the main thread runs native code)
+                if data.count(bytes([sig])):
+                    n += data.count(bytes([sig]))
+                    _state["signum"] = sig
             if n:
                 _exit["signals"] += n
                 if _exit["first"] is None:
@@ -223,6 +256,8 @@ def exit_now(status: int = EXIT_STATUS) -> None:
     status : int, optional
         The exit status (default 130).
     """
+    if status == EXIT_STATUS:
+        status = _status()  # 128 + SIGTERM / SIGHUP when the interrupt was one of those
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(Exception):
             stream.flush()
@@ -256,14 +291,17 @@ def interrupt_guard(*, exit_after: float | None = None) -> Iterator[None]:
     caller is left alone).
     """
     installed = None
+    terminations: dict[int, Any] = {}
     hook: _Hook | None = None
     watchdog: tuple[threading.Thread, threading.Event, int, int, int] | None = None
     if _state["depth"] == 0:
         _state["flag"] = False
         _state["redeliver"] = 0
+        _state["signum"] = None
         if threading.current_thread() is threading.main_thread() \
                 and signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # fmt: skip
             installed = signal.signal(signal.SIGINT, _handler)
+            terminations = _install_termination()
             hook = sys.unraisablehook
             sys.unraisablehook = _unraisable(hook)
             if exit_after is not None:
@@ -279,6 +317,8 @@ def interrupt_guard(*, exit_after: float | None = None) -> Iterator[None]:
                 _stop_watchdog(*watchdog)
             if installed is not None and hook is not None:  # set together
                 signal.signal(signal.SIGINT, installed)
+                for sig, previous in terminations.items():
+                    signal.signal(sig, previous)
                 sys.unraisablehook = hook
             _state["flag"] = False
 

@@ -21,7 +21,8 @@ if TYPE_CHECKING:
 
     from .model.parameters import ParameterSpace
 
-__all__ = ["symbol", "axis_label", "unit", "QUANTITIES", "STYLE"]
+__all__ = ["symbol", "axis_label", "unit", "branch_status_text", "QUANTITIES", "STYLE",
+           "BRANCH_STATUS_TEXT"]
 
 _GREEK = {"alpha", "beta", "gamma", "delta", "epsilon", "zeta", "eta", "theta", "iota", "kappa", "lambda", "mu",
           "nu", "xi", "pi", "rho", "sigma", "tau", "phi", "chi", "psi", "omega", "Gamma", "Delta", "Theta",
@@ -138,3 +139,21 @@ def unit(name: str, space: ParameterSpace | None = None) -> str:
 
     spec = get_model("paper")
     return spec.unit(name) if name in spec.parameters else AUX_UNITS.get(name, "")
+
+
+#: Why a limit-cycle branch ended, in words for figures and tables (the codes are the branches' ``status``).
+BRANCH_STATUS_TEXT = {
+    "max_points": "stopped at the point limit",
+    "range": "end of the range reached",
+    "contact_loss": "stopped where a pad loses contact",
+    "sliding_reversal": "stopped where a pad's sliding reverses",
+    "truncation": "stopped: more harmonics needed",
+    "step_underflow": "stopped: the step became too small",
+    "period": "stopped: the period grew beyond its limit",
+    "equilibrium": "the cycle shrinks back to the silent motion",
+}
+
+
+def branch_status_text(status: str) -> str:
+    """:data:`BRANCH_STATUS_TEXT` of a branch's ``status`` (an unknown code with its underscores as spaces)."""
+    return BRANCH_STATUS_TEXT.get(status, status.replace("_", " "))

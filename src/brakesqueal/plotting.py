@@ -352,14 +352,26 @@ def plot_critical_curves(diff: np.ndarray, curves: dict[str, np.ndarray], ax: Ax
     else:
         ax.set_ylabel(axis_label("Omega_crit"))
     ax.set_xlabel(f"${symbol('mu1')} - {symbol('mu2')}$  (${symbol('mu1')} + {symbol('mu2')} = 1$)")
+    from matplotlib.ticker import MultipleLocator
+
+    # fixed ticks: with the automatic locator the tick set (and with it the constrained layout's margins) can
+    # change from one draw to the next, and the last tick label then overhangs the figure's edge
+    ax.xaxis.set_major_locator(MultipleLocator(0.25))
     ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.02), ncols=2, frameon=False, borderaxespad=0.0)
     _title(fig, ax, title, own)
     return fig
 
 
 def save(fig: Figure, path: str, dpi: int = 300) -> str:
-    """Save a figure (format from the suffix: PNG, SVG, PDF) and return the path."""
-    fig.savefig(path, dpi=dpi)
+    """Save a figure (format from the suffix: PNG, SVG, PDF) atomically and return the path.
+
+    Written through :func:`brakesqueal.outputs.write_with`: a failure (a full
+    disk, in any format's writer) is one :class:`~brakesqueal.errors.OutputError`
+    line and leaves an existing file of that name as it was.
+    """
+    from .outputs import write_with
+
+    write_with(path, lambda tmp: fig.savefig(tmp, dpi=dpi), what="figure")
     return path
 
 

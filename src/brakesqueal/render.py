@@ -55,7 +55,9 @@ def _fmt_matrix(name: str, m: np.ndarray) -> list[str]:
 
 
 def _unit(coord: str) -> str:
-    return "rad" if coord.startswith("q") else "m"
+    from .model.components import coordinate_unit
+
+    return coordinate_unit(coord)
 
 
 #: Largest model whose matrices the text output of ``linearize`` prints.

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, cast, overload
@@ -443,6 +444,10 @@ class StabilityMap:
         """The two axis names ``(outer, inner)``."""
         return cast("tuple[str, str]", tuple(self.data["stable"].dims))  # the two axes' parameter names
 
+    def _repr_html_(self) -> str:
+        """xarray's HTML view of :attr:`data`, for notebooks."""
+        return str(self.data._repr_html_())
+
     def to_xarray(self) -> xr.Dataset:
         """The :class:`xarray.Dataset`."""
         return self.data
@@ -502,12 +507,12 @@ class StabilityMap:
         return plot_map(self, ax=ax, x=x, title=title, color=color)
 
 
-def open_map(path: str) -> StabilityMap:
+def open_map(path: str | os.PathLike[str]) -> StabilityMap:
     """Read a map written by :meth:`StabilityMap.to_netcdf`.
 
     Parameters
     ----------
-    path : str
+    path : str or os.PathLike
         Path of the NetCDF3 file (read with xarray's ``scipy`` engine and
         loaded into memory, so the file is not kept open).
 
@@ -518,14 +523,24 @@ def open_map(path: str) -> StabilityMap:
 
     Raises
     ------
-    FileNotFoundError
-        If ``path`` does not exist.  A file that is not NetCDF3 is rejected by
-        :func:`xarray.open_dataset` with its own exception.
+    ParameterError
+        One line naming the file: missing, not a regular file
+        (:func:`brakesqueal.inputs.check_input_file`), or not a map
+        (not NetCDF3, truncated, or without the ``stable`` variable).
     """
     import xarray as xr
 
-    ds = xr.open_dataset(path, engine="scipy").load()
-    ds["stable"] = ds["stable"].astype(bool)
+    from .inputs import check_input_file
+    from .errors import ParameterError
+
+    path = check_input_file(path, "map file")
+    try:
+        ds = xr.open_dataset(path, engine="scipy").load()
+        ds["stable"] = ds["stable"].astype(bool)
+    except Exception as exc:  # noqa: BLE001 - whatever a damaged file raises deep in SciPy: one line
+        reason = " ".join(str(exc).split())[:120] or type(exc).__name__
+        raise ParameterError(f"map file '{path}' is not a stability map written by brakesqueal (NetCDF3): "
+                             f"{reason}") from None
     return StabilityMap(ds)
 
 
@@ -711,6 +726,12 @@ class CrossingResult:
             lines.append("  note: grid search, crossings closer together than the grid spacing may be missing")
         return "\n".join(lines) + "\n"
 
+    def _repr_html_(self) -> str:
+        """The :meth:`text` of the result, escaped, for notebooks."""
+        import html
+
+        return f"<pre>{html.escape(self.text())}</pre>"
+
     @overload
     def plot(self, ax: None = None) -> Figure: ...
     @overload
@@ -783,16 +804,49 @@ class CriticalSpeedResult(CrossingResult):
         return not any(a < (oc if oc is not None else math.inf) for a, _ in self.undecided_ranges)
 
     @property
+    def unstable_intervals(self) -> tuple[tuple[float, float], ...]:
+        """The Ω intervals [rad/s] where the silent motion was found unstable, in increasing order.
+
+        Read off :attr:`stable_at_start` and the crossings: an interval opens at the range start when the
+        motion is unstable there, or at a destabilizing crossing, and closes at the next stabilizing crossing
+        or the range's end.  Undecided ranges are not in it (see :attr:`undecided_ranges`).
+        """
+        out: list[tuple[float, float]] = []
+        opened: float | None = None if self.stable_at_start else self.start
+        for v, d in self.crossings:
+            if d == "destabilizing" and opened is None:
+                opened = v
+            elif d == "stabilizing" and opened is not None:
+                out.append((opened, v))
+                opened = None
+        if opened is not None:
+            out.append((opened, self.stop))
+        return tuple(out)
+
+    @property
+    def squeal_from(self) -> float | None:
+        """The lowest Ω [rad/s] in the range at which squeal (an unstable silent motion) was found, or None.
+
+        The range start when the motion is unstable there (then :attr:`Omega_crit`, the first destabilizing
+        crossing, lies above a speed range that already squeals), else :attr:`Omega_crit`.
+        """
+        iv = self.unstable_intervals
+        return iv[0][0] if iv else None
+
+    @property
     def outcome(self) -> str:
         """What the result says about squeal onsets, in one word shared by :meth:`text` and :meth:`to_dict`.
 
-        ``"onset"`` (:attr:`Omega_crit` found; :attr:`Omega_crit_certain` says whether a smaller one may be
-        missing); ``"unknown"`` (no onset found, but part of the range is undecided, or a grid search found
-        the motion stable: a pair of crossings closer together than the grid spacing may hide an onset);
-        ``"unstable_throughout"`` / ``"stable_throughout"`` (no stability change found, nothing undecided;
-        a grid search: unstable at every grid point, never "stable throughout");
-        ``"unstable_at_start"`` (unstable at the start, only re-stabilisations found, nothing undecided).
+        ``"onset"`` (stable at the start and :attr:`Omega_crit` found; :attr:`Omega_crit_certain` says
+        whether a smaller one may be missing); ``"unstable_at_start"`` (squeal from the range start; stability
+        changes further up, listed in :attr:`unstable_intervals`); ``"unknown"`` (no onset found, but part of
+        the range is undecided, or a grid search found the motion stable: a pair of crossings closer together
+        than the grid spacing may hide an onset); ``"unstable_throughout"`` / ``"stable_throughout"`` (no
+        stability change found, nothing undecided; a grid search: unstable at every grid point, never "stable
+        throughout").
         """
+        if not self.stable_at_start and self.crossings:
+            return "unstable_at_start"
         if self.Omega_crit is not None:
             return "onset"
         if self.undecided_ranges or (self.stable_at_start and not self.exhaustive):
@@ -806,17 +860,37 @@ class CriticalSpeedResult(CrossingResult):
         d["Omega_crit"] = self.Omega_crit
         d["Omega_crit_certain"] = self.Omega_crit_certain
         d["outcome"] = self.outcome
+        d["squeal_from"] = self.squeal_from
+        d["unstable_intervals"] = [list(iv) for iv in self.unstable_intervals]
         return d
+
+    def _intervals_text(self) -> str:
+        """``"from 1 (the range start) up to 11.56 rad/s, and from 35 rad/s to the range end (1e+05)"``."""
+        parts = []
+        for i, (a, b) in enumerate(self.unstable_intervals):
+            lo = f"{a:.12g} (the range start)" if a == self.start else f"{a:.12g}"
+            hi = f"the range end ({b:.6g} rad/s)" if b == self.stop else f"{b:.12g} rad/s"
+            parts.append(f"from {lo} up to {hi}")
+        return ", and ".join(parts)
 
     def text(self) -> str:
         oc, outcome = self.Omega_crit, self.outcome
         grid = "" if self.exhaustive else " (at every grid point; see the note below)"
-        if oc is not None:
+        if outcome == "unstable_at_start":
+            head = ("Squeal from the range start: unstable already at the start of the range, "
+                    f"{self._intervals_text()}{grid}")
+            if oc is not None:
+                head += f" (the first onset from stable, Omega_crit of the paper's Fig. 3, is at {oc:.12g} rad/s)"
+        elif oc is not None:
             head = f"Omega_crit = {oc:.12g} rad/s ({oc / (2 * math.pi):.6g} rev/s)"
             if not self.Omega_crit_certain:
                 head += " (NOT certain: a smaller onset may lie in an undecided range or between grid points)"
+            if len(self.unstable_intervals) > 1 or self.unstable_intervals[0][1] != self.stop:
+                head += f"; unstable {self._intervals_text()}"
         elif outcome == "unknown" and self.undecided_ranges:
             head = "Omega_crit = UNKNOWN (no destabilizing crossing found, but part of the range is undecided)"
+            if not self.stable_at_start:
+                head = f"Squeal from the range start (unstable at {self.start:.12g} rad/s); " + head
         elif outcome == "unknown":
             head = ("Omega_crit = UNKNOWN (stable at every grid point, but a grid search can miss a pair of crossings "
                     "closer together than its spacing)")
@@ -824,6 +898,6 @@ class CriticalSpeedResult(CrossingResult):
             head = f"Omega_crit = none in the range: unstable throughout the range{grid}"
         elif outcome == "stable_throughout":
             head = "Omega_crit = none (no destabilizing crossing in the range): stable throughout the range"
-        else:
+        else:  # not reached: every outcome is handled above
             head = f"Omega_crit = none in the range: unstable already at the start of the range{grid}"
         return head + "\n" + super().text()

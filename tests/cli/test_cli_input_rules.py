@@ -113,6 +113,10 @@ def test_every_axis_refuses_ranges_finer_than_float_resolution(capsys, tmp_path,
     (True, (), ((10.0, 20.0),), True, "unknown", "UNKNOWN"),
     (False, (), ((10.0, 20.0),), False, "unknown", "UNKNOWN"),
     (True, ((50.0, "destabilizing"),), ((10.0, 20.0),), True, "onset", "NOT certain"),
+    # squeal from the range start, re-stabilised, then a second onset: the head leads with the start, not 35
+    (False, ((11.56, "stabilizing"), (35.0, "destabilizing")), (), True, "unstable_at_start",
+     "Squeal from the range start: unstable already at the start of the range, from 1 (the range start) up to "
+     "11.56 rad/s, and from 35 up to the range end"),
 ])
 def test_critical_speed_text_and_json_agree(stable0, crossings, undecided, exhaustive, outcome, head):
     r = CriticalSpeedResult("Omega", 1.0, 1e3, True, stable0, crossings, "test", undecided_ranges=undecided,
@@ -125,7 +129,25 @@ def test_critical_speed_text_and_json_agree(stable0, crossings, undecided, exhau
     if d["Omega_crit"] is None:
         assert ("undecided" in first) == bool(d["undecided_ranges"])
     assert ("throughout" in first) == (outcome in ("stable_throughout", "unstable_throughout"))
-    assert ("unstable" in first.split(":")[-1]) == (outcome in ("unstable_throughout", "unstable_at_start"))
+    assert ("unstable" in (first.split(":") + [""])[1]) == (outcome in ("unstable_throughout", "unstable_at_start"))
+    # the unstable intervals, read off the start verdict and the crossings, lead the JSON too
+    iv = d["unstable_intervals"]
+    assert d["squeal_from"] == (iv[0][0] if iv else None)
+    assert (d["squeal_from"] == 1.0) == (not stable0) == (first.startswith("Squeal from the range start")
+                                                          or "unstable throughout" in first)
+    assert all(a < b for a, b in iv) and all(iv[i][1] <= iv[i + 1][0] for i in range(len(iv) - 1))
+
+
+def test_critical_speed_leads_with_low_speed_squeal():
+    """A model unstable from the range start up to 11.56 rad/s and again from 35 (the Stribeck case of issue
+    29): text and JSON lead with the start, list both intervals and do not call it an onset at 35."""
+    r = CriticalSpeedResult("Omega", 1.0, 1e5, True, False, ((11.56, "stabilizing"), (35.0, "destabilizing")),
+                            "test", exhaustive=True)
+    d = r.to_dict()
+    assert d["outcome"] == "unstable_at_start" and d["squeal_from"] == 1.0
+    assert d["unstable_intervals"] == [[1.0, 11.56], [35.0, 1e5]]
+    first = r.text().splitlines()[0]
+    assert first.startswith("Squeal from the range start") and first.index("11.56") < first.index("35")
 
 
 def test_critical_speed_of_the_belt_says_unstable_throughout(capsys):

@@ -5,6 +5,10 @@ Playwright from PyPI through ``executable_path`` (no ``playwright install``).
 Every request that does not go to the loopback server is aborted and
 recorded; a test fails on any such request and on any "Failed to load
 resource" console message.
+
+The server serves only requests with its token: :func:`server` reads the URL
+the command prints at start, and :meth:`Page.open` puts the token into every
+link it opens (the page then holds it in a cookie).
 """
 
 from __future__ import annotations
@@ -13,18 +17,17 @@ import json
 import os
 import shutil
 import socket
-import subprocess
-import sys
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
+from urllib.parse import parse_qs, urlsplit
+
+from _served import TIMEOUT, Served
 
 import pytest
 
 CHROMIUM = os.environ.get("BRAKESQUEAL_CHROMIUM") or shutil.which("chromium") or "/usr/bin/chromium"
-#: Seconds to wait for a view (cold numba caches compile on the first request).
-TIMEOUT = float(os.environ.get("BRAKESQUEAL_EXPLORER_TIMEOUT", "240"))
 #: Directory for screenshots (docs/figures when making the docs' gallery), or unset.
 SHOTS = os.environ.get("BRAKESQUEAL_EXPLORER_SCREENSHOTS")
 
@@ -48,35 +51,23 @@ def _free_port() -> int:
 
 
 @pytest.fixture(scope="session")
-def server() -> Iterator[str]:
-    """``brakesqueal explore`` in a subprocess on a free loopback port; yields its URL."""
+def served() -> Iterator[Served]:
+    """``brakesqueal explore`` (with the cancel tests' gates) in a subprocess on a free loopback port."""
     why = browser_missing()
     if why:
         pytest.skip(why)
-    port = _free_port()
     # _gated_server.py is `python -m brakesqueal` plus the cancel test's gate (see its docstring)
-    proc = subprocess.Popen([sys.executable, str(Path(__file__).with_name("_gated_server.py")), "explore",
-                             "--no-browser", "--port", str(port)],
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    deadline = time.monotonic() + 60
+    s = Served(["--port", str(_free_port())], script=str(Path(__file__).with_name("_gated_server.py")))
     try:
-        while time.monotonic() < deadline:
-            if proc.poll() is not None:
-                raise RuntimeError(f"the explorer exited: {proc.stdout.read() if proc.stdout else ''}")
-            try:
-                socket.create_connection(("127.0.0.1", port), timeout=0.5).close()
-                break
-            except OSError:
-                time.sleep(0.1)
-        else:
-            raise RuntimeError("the explorer did not listen within 60 s")
-        yield f"http://127.0.0.1:{port}/"
+        yield s
     finally:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
+        s.stop()
+
+
+@pytest.fixture(scope="session")
+def server(served: Served) -> str:
+    """The served explorer's URL, with its token (``http://127.0.0.1:PORT/?token=...``)."""
+    return served.url
 
 
 @pytest.fixture(scope="session")
@@ -98,15 +89,17 @@ def browser() -> Iterator[Any]:
 class Page:
     """A browser page on the explorer with helpers that wait on the render counter."""
 
-    def __init__(self, page: Any, base: str) -> None:
+    def __init__(self, page: Any, url: str) -> None:
         self.page = page
-        self.base = base
+        parts = urlsplit(url)
+        self.base = f"{parts.scheme}://{parts.netloc}/"
+        self.token = parse_qs(parts.query).get("token", [""])[0]
         self.remote: list[str] = []
         self.failed: list[str] = []
 
     def open(self, query: str = "") -> None:
-        """Load the explorer (``query`` without ``?``) and wait for the first eigenvalues."""
-        self.page.goto(self.base + (f"?{query}" if query else ""))
+        """Load the explorer (``query`` without ``?``; the token is added) and wait for the first eigenvalues."""
+        self.page.goto(self.base + "?" + (f"{query}&" if query else "") + f"token={self.token}")
         self.page.locator("#bs-render").wait_for(state="attached", timeout=TIMEOUT * 1000)
         self.wait(lambda s: "locus" in s)
 

@@ -125,13 +125,15 @@ def test_cli_refuses_bad_input_with_status_2(capsys):
 
 
 @pytest.mark.slow
-def test_non_loopback_host_warns():
+def test_non_loopback_host_with_allow_remote_warns():
+    # without --allow-remote it is refused (tests/explorer/test_server_security.py)
     import subprocess
     import sys
 
     pytest.importorskip("panel")
-    proc = subprocess.Popen([sys.executable, "-m", "brakesqueal", "explore", "--host", "0.0.0.0", "--port", "0",
-                             "--no-browser"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen([sys.executable, "-m", "brakesqueal", "explore", "--host", "0.0.0.0", "--allow-remote",
+                             "--port", "0", "--no-browser"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            text=True)
     lines: list[str] = []
     try:
         while len(lines) < 10 and not (lines and "explorer at" in lines[-1]):
@@ -140,7 +142,7 @@ def test_non_loopback_host_warns():
         proc.terminate()
         proc.wait(10)
     assert lines[0].startswith("brakesqueal: warning: serving on 0.0.0.0, not loopback")
-    assert lines[-1].startswith("brakesqueal: explorer at http://0.0.0.0:")
+    assert lines[-1].startswith("brakesqueal: explorer at http://127.0.0.1:") and "/?token=" in lines[-1]
 
 
 def test_hopf_line_names_the_predicted_lift_off_and_drops_the_amplitude_beyond_it():

@@ -155,6 +155,16 @@ def test_harmonic_balance_folds_agree_with_shooting():
     # describe (the shooting branch itself has one: unstable cycles turn stable at the fold)
     assert shot.branch.hysteresis_range is not None
     assert shot.summary.hysteresis_range is None and hb.summary.hysteresis_range is None
+    # past the contact loss the orbits are not valid: the figure greys them (whatever their stability), as the
+    # explorer does, and the summary's table gives them no duty cycle
+    valid = hb.valid
+    n_bad = valid.count(False)
+    assert valid[0] and n_bad > 0 and valid == sorted(valid, reverse=True)
+    fig = hb.plot()
+    grey = [ln for ax in fig.axes for ln in ax.lines if ln.get_color() == "0.75" and len(ln.get_xdata()) == 2]
+    assert len(grey) == 2 * n_bad  # one segment per invalid orbit, in both panels
+    assert "contact lost (not valid)" in [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert [r["duty_cycle"][0] is None for r in hb.summary.table] == [not v for v in valid]
 
 
 def _hill_complex_companion(J, n, m, H, omega):

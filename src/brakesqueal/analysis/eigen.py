@@ -127,6 +127,10 @@ class EigenAnalysis:
         return (f"EigenAnalysis(model={self.model.model.name!r}, n={self.model.n}, "
                 f"eigenvalues={self.eigenvalues.size}, verdict={v.status!r}, max_real={v.max_real:.6g})")
 
+    def _repr_html_(self) -> str:
+        """The linear model's HTML summary (verdict, carrier, least stable eigenvalues), for notebooks."""
+        return self.model._repr_html_()
+
     # -------------------------------------------------------------- basic quantities
     @property
     def frequencies(self) -> np.ndarray:

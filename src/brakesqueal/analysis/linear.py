@@ -418,6 +418,105 @@ class LinearModel(ModalMixin):
         """Coefficients (highest power first) of ``det(lambda E - A)`` divided by ``det(E)``, from the eigenvalues."""
         return np.real_if_close(np.poly(self.eigenvalues))
 
+    # ---------------------------------------------------------------- views for notebooks and other tools
+    def plot(self, ax: Any = None) -> Any:
+        """Pole map: the eigenvalues in the complex plane with the verdict in the title; returns the figure.
+
+        The same figure as :meth:`EigenAnalysis.plot <brakesqueal.analysis.eigen.EigenAnalysis.plot>`.
+        """
+        from .eigen import eigen_analysis
+
+        return eigen_analysis(self, self.engine).plot(ax)
+
+    def to_xarray(self) -> Any:
+        """Dataset of the linear model: ``M``, ``D``, ``K`` over ``(dof, dof_j)``, and over ``mode`` the eigenvalues'
+        ``real``, ``imag`` [1/s], ``frequency`` [Hz] and ``damping_ratio``; the parameters and the silent motion as
+        attributes (``parameters`` as JSON, ``q0``)."""
+        import json
+
+        import xarray as xr
+
+        lam = self.eigenvalues
+        with np.errstate(invalid="ignore", divide="ignore"):
+            zeta = np.where(np.abs(lam) > 0, -lam.real / np.abs(lam), np.nan)
+        dofs = list(self.coords)
+        mat = ("dof", "dof_j")
+        return xr.Dataset(
+            {"M": (mat, self.M, {"description": "mass matrix (eq. 48)"}),
+             "D": (mat, self.D, {"description": "damping matrix (eq. 48)"}),
+             "K": (mat, self.K, {"description": "stiffness matrix (eq. 48)"}),
+             "real": ("mode", lam.real, {"units": "1/s"}), "imag": ("mode", lam.imag, {"units": "1/s"}),
+             "frequency": ("mode", np.abs(lam.imag) / (2 * math.pi), {"units": "Hz"}),
+             "damping_ratio": ("mode", zeta)},
+            coords={"dof": dofs, "dof_j": dofs, "mode": np.arange(lam.size)},
+            attrs={"model": self.model.name, "parameters": json.dumps(self.params.to_json_dict()),
+                   "q0": [float(v) for v in self.q0], "pad_states": ",".join(self.pad_states),
+                   "pad_rates": self.pad_rates, "max_real": self.max_real})
+
+    def input_matrices(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(A, B, C, D)`` of ``x' = A x + B u``, ``y = C x + D u``: inputs ``u`` are generalized forces on the
+        coordinates (torques [N m] on tilts, forces [N] on displacements), outputs ``y`` the coordinates.
+
+        The state is that of :attr:`A` (``(delta Q, delta Qdot[, pad states])``); with kept pad states the input
+        enters the disk's rows of the descriptor (:attr:`reduced_descriptor`) and ``B = E^-1 B_E``.
+        """
+        n = self.n
+        if not self.pad_states:
+            A = state_matrix(self.M, self.D, self.K)
+            B = np.vstack([np.zeros((n, n)), np.linalg.inv(self.M)])
+        else:
+            E_full, _ = self.descriptor
+            E, A_d = self.reduced_descriptor
+            B_full = np.zeros((E_full.shape[0], n))
+            B_full[n:2 * n] = np.eye(n)
+            if E.shape[0] < E_full.shape[0]:  # eliminate_algebraic dropped the pads' algebraic rows (no input)
+                B_full = B_full[~np.all(E_full == 0.0, axis=1)]
+            A, B = np.linalg.solve(E, A_d), np.linalg.solve(E, B_full)
+        C = np.zeros((n, A.shape[0]))
+        C[:, :n] = np.eye(n)
+        return A, B, C, np.zeros((n, n))
+
+    def to_statespace(self) -> Any:
+        """The linear model as a `python-control <https://python-control.readthedocs.io>`_ ``StateSpace``
+        (optional: ``pip install 'brakesqueal[control]'``), with :meth:`input_matrices` and named signals:
+        inputs ``F_<coord>``, outputs ``<coord>``, states ``<coord>``, ``<coord>_dot`` and the pad states.
+
+        Raises
+        ------
+        ParameterError
+            When python-control is not installed.
+        """
+        try:
+            import control
+        except ImportError:
+            from ..errors import ParameterError
+
+            raise ParameterError("to_statespace needs python-control: pip install 'brakesqueal[control]'") from None
+        A, B, C, D = self.input_matrices()
+        c = list(self.coords)
+        states = c + [f"{q}_dot" for q in c] + list(self.pad_states)
+        if len(states) != A.shape[0]:  # pads eliminated as algebraic: number the remaining states
+            states = [f"x{i}" for i in range(A.shape[0])]
+        return control.ss(A, B, C, D, inputs=[f"F_{q}" for q in c], outputs=c, states=states,
+                          name=self.model.name)
+
+    def _repr_html_(self) -> str:
+        """A short HTML summary for notebooks: model, verdict with its carrier, the least stable eigenvalues."""
+        import html
+
+        from .eigen import eigen_analysis
+
+        v = eigen_analysis(self, self.engine).verdict()
+        lam = self.eigenvalues
+        rows = "".join(f"<tr><td>{z.real:.6g}</td><td>{abs(z.imag) / (2 * math.pi):.6g}</td></tr>"
+                       for z in lam[:min(lam.size, 8)])
+        carrier = f", carried by {html.escape(v.carrier)}" if v.carrier else ""
+        return (f"<div><b>LinearModel</b> of {html.escape(self.model.name)} ({self.n} DOF: "
+                f"{html.escape(', '.join(self.coords))})<br>verdict: <b>{html.escape(v.status)}</b>, "
+                f"max Re λ = {v.max_real:.6g} 1/s{carrier} (route {html.escape(v.method)})"
+                f"<table><tr><th>Re λ [1/s]</th><th>f [Hz]</th></tr>{rows}</table>"
+                f"{'' if lam.size <= 8 else f'<i>{lam.size - 8} more eigenvalues</i>'}</div>")
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary (the ``brakesqueal linearize --format json`` schema).
 

@@ -133,8 +133,27 @@ def _mac(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return num / np.where(den > 0, den, 1.0)
 
 
+class _Ticker:
+    """Reports the completed fraction (monotone, at most every 0.1 s, and 1.0 at the end) to a callback."""
+
+    def __init__(self, callback: Callable[[float], None] | None) -> None:
+        import time
+
+        self.callback, self.clock, self.frac, self.last = callback, time.monotonic, 0.0, -math.inf
+
+    def __call__(self, frac: float, *, force: bool = False) -> None:
+        if self.callback is None:
+            return
+        self.frac = max(self.frac, min(max(float(frac), 0.0), 1.0))
+        now = self.clock()
+        if force or now - self.last >= 0.1:
+            self.last = now
+            self.callback(self.frac)
+
+
 def track_modes(values: Sequence[float] | np.ndarray, linear: Callable[[float], Any], *, parameter: str = "p",
-                log: bool = False, model: str = "", units: str = "", rtol: float = 1e-3) -> ModeTracks:
+                log: bool = False, model: str = "", units: str = "", rtol: float = 1e-3,
+                progress: Callable[[float], None] | None = None) -> ModeTracks:
     """Track every mode along a path (the core of :func:`modes_along`).
 
     Parameters
@@ -149,6 +168,9 @@ def track_modes(values: Sequence[float] | np.ndarray, linear: Callable[[float], 
         Logarithmic path (bisection midpoints are geometric).
     rtol : float
         Relative frequency gap below which two modes count as coalesced.
+    progress : callable, optional
+        Called with the completed fraction in [0, 1] (at most every 0.1 s, and with 1.0 at the end): the
+        points of the path, then the bisections that locate crossings and coalescences.
 
     Returns
     -------
@@ -156,6 +178,7 @@ def track_modes(values: Sequence[float] | np.ndarray, linear: Callable[[float], 
     """
     from scipy.optimize import linear_sum_assignment
 
+    tick = _Ticker(progress)
     vals = np.asarray(values, dtype=float)
     w0, v0 = _first_order(linear(float(vals[0])))
     # at most every eigenvalue real: 2n columns; a complex pair that splits into two real eigenvalues opens a
@@ -168,6 +191,7 @@ def track_modes(values: Sequence[float] | np.ndarray, linear: Callable[[float], 
     active = list(range(w0.size))  # column of each eigenvalue of the previous point
     prev_w, prev_v = w0, v0
     for i in range(1, vals.size):
+        tick(i / (vals.size + 1))  # the bisections after the path take the rest
         w, v = _first_order(linear(float(vals[i])))
         scale = max(float(np.abs(prev_w).max()), float(np.abs(w).max()), 1e-300)
         # the pads' states come and go along a path (kept where the silent motion tilts, not at a point where it
@@ -201,12 +225,30 @@ def track_modes(values: Sequence[float] | np.ndarray, linear: Callable[[float], 
     def unstable(z: complex) -> bool:
         return z.real > tol * abs(z)
 
+    f = np.abs(lam.imag)
+    flags = [np.array([unstable(z) for z in lam[:, k]]) for k in range(n_modes)]
+    jobs = sum(40 * int(np.count_nonzero((fl[1:] != fl[:-1]) & ~np.isnan(lam[1:, k]) & ~np.isnan(lam[:-1, k])))
+               for k, fl in enumerate(flags))
+    for a_ in range(n_modes):
+        for b_ in range(a_ + 1, n_modes):
+            gap = np.abs(f[:, a_] - f[:, b_]) / np.maximum(np.maximum(f[:, a_], f[:, b_]), 1e-300)
+            with np.errstate(invalid="ignore"):
+                close = (gap <= rtol) & (f[:, a_] > 0)
+            jobs += 30 * int(np.count_nonzero(close[1:] != close[:-1]))
+    done = 0
+
+    def bisected() -> None:
+        nonlocal done
+        done += 1
+        tick((vals.size + done) / (vals.size + jobs + 1))
+
     for k in range(n_modes):
-        flag = np.array([unstable(z) for z in lam[:, k]])
+        flag = flags[k]
         exists = ~np.isnan(lam[:, k])
         for i in (int(j) for j in np.flatnonzero((flag[1:] != flag[:-1]) & exists[1:] & exists[:-1])):
             a, b = float(vals[i]), float(vals[i + 1])
             for _ in range(40):
+                bisected()
                 c = mid(a, b)
                 wc, _ = _first_order(linear(c))
                 if unstable(wc[np.argmin(np.abs(wc - lam[i, k]))]) == flag[i]:
@@ -216,7 +258,6 @@ def track_modes(values: Sequence[float] | np.ndarray, linear: Callable[[float], 
             crossings.append({"value": 0.5 * (a + b), "mode": int(k),
                               "direction": "stabilizing" if flag[i] else "destabilizing"})
     coal = []
-    f = np.abs(lam.imag)
 
     def merged_at(c: float, ka: int, kb: int, i: int) -> bool:
         """Past the exceptional point: the frequency gap is smaller than the real-part gap."""
@@ -236,6 +277,7 @@ def track_modes(values: Sequence[float] | np.ndarray, linear: Callable[[float], 
                 lo, hi = float(vals[i]), float(vals[i + 1])
                 entering = bool(close[i + 1])
                 for _ in range(30):
+                    bisected()
                     c = mid(lo, hi)
                     if merged_at(c, a_, b_, i) == entering:
                         hi = c
@@ -245,12 +287,14 @@ def track_modes(values: Sequence[float] | np.ndarray, linear: Callable[[float], 
                 coal.append({"value": 0.5 * (lo + hi), "modes": (int(a_), int(b_)),
                              "frequency_hz": float(f[at, a_] / (2 * math.pi)),
                              "kind": "merge" if entering else "split"})
+    tick(1.0, force=True)
     return ModeTracks(parameter=parameter, values=vals, eigenvalues=lam, continuity=cont, coalescences=coal,
                       crossings=crossings, log=log, model=model, units=units)
 
 
 def modes_along(engine: Any, space: Any, name: str, start: float, stop: float, *, num: int = 200,
-                log: bool = False, pad_rates: str = "kept") -> ModeTracks:
+                log: bool = False, pad_rates: str = "kept",
+                progress: Callable[[float], None] | None = None) -> ModeTracks:
     """Mode-coupling diagram of any model along one parameter of a parameter space.
 
     Parameters
@@ -269,6 +313,9 @@ def modes_along(engine: Any, space: Any, name: str, start: float, stop: float, *
         Logarithmic spacing.
     pad_rates : {"kept", "quasi-static"}
         See :func:`~brakesqueal.analysis.linear.linearize`.
+    progress : callable, optional
+        Called with the completed fraction in [0, 1] (:func:`track_modes`); a
+        path of 100000 points of the eight-DOF model takes a few minutes.
 
     Returns
     -------
@@ -298,4 +345,5 @@ def modes_along(engine: Any, space: Any, name: str, start: float, stop: float, *
         raise ParameterError(f"path '{name}': {problem}", parameter=name)
     values = np.geomspace(start, stop, num) if log else np.linspace(start, stop, num)
     return track_modes(values, lambda v: linearize(engine, space.resolve({name: v}), pad_rates=pad_rates),
-                       parameter=name, log=log, model=space.model.name, units=space.preset.unit(name))
+                       parameter=name, log=log, model=space.model.name, units=space.preset.unit(name),
+                       progress=progress)

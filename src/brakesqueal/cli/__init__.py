@@ -248,7 +248,7 @@ def _register_plugins() -> None:
     """Add the command groups that live in their own modules."""
     import importlib
 
-    for name in (".stability", ".modes", ".sweep", ".cache", ".simulate", ".export", ".explore", ".fe"):
+    for name in (".stability", ".modes", ".sweep", ".plot", ".cache", ".simulate", ".export", ".explore", ".fe"):
         mod = importlib.import_module(name, __package__)
         mod.register(app)
 
@@ -271,6 +271,7 @@ SUMMARIES: dict[str, str] = {
     "reproduce": "Reproduce the paper's Figures 2 and 3.",
     "modes": "Mode-coupling diagram: every mode along a parameter path.",
     "sweep": "Resumable N-D parameter study into a Zarr store.",
+    "plot": "Figure of a sweep store: map, slice or histograms.",
     "simulate": "Integrate the nonlinear equations; summary, NetCDF, WAV.",
     "export": "Write equations as LaTeX, Octave, C, Julia or Python.",
     "import": "A model file from finite-element coefficient matrices.",
@@ -376,13 +377,15 @@ def main(argv: list[str] | None = None) -> int:
     if not args:
         args = ["--help"]
     from ..interrupts import EXIT_AFTER_S, EXIT_STATUS, exit_now, interrupt_guard
+    from ..outputs import guard_inputs
 
     program = argv is None
     try:
         # Ctrl-C within a second: the program (never a caller of main(argv) in its own process) ends a command
         # that does not unwind in EXIT_AFTER_S (not a sweep: its Dask workers must be shut down), and then skips
         # the interpreter's slow teardown
-        with interrupt_guard(exit_after=EXIT_AFTER_S if program and args[:1] != ["sweep"] else None):
+        with interrupt_guard(exit_after=EXIT_AFTER_S if program and args[:1] != ["sweep"] else None), \
+                guard_inputs(args):  # an output never replaces an input of the command (brakesqueal.outputs)
             rv = app(args=args, prog_name="brakesqueal", standalone_mode=False)
     except BrakesquealError as exc:
         print(f"brakesqueal: error: {_with_option_names(exc, args)}", file=sys.stderr)

@@ -8,16 +8,16 @@ from __future__ import annotations
 
 import sys
 from enum import Enum
-from typing import TYPE_CHECKING, Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Any, Optional
 
 import typer
 
 if TYPE_CHECKING:
     from ..model.parameters import ParameterSpace
 
-__all__ = ["PLOT_SUFFIXES", "ContactLaw", "ModelOpt", "PresetOpt", "ParamsOpt", "SetOpt", "FormatOpt", "OutFormat",
-           "NoCacheOpt", "ProgressOpt", "Modes", "ModesOpt", "space_from", "note", "refuse_set_of_axes",
-           "with_equations"]
+__all__ = ["PLOT_SUFFIXES", "number", "NUMBER", "ContactLaw", "ModelOpt", "PresetOpt", "ParamsOpt", "SetOpt",
+           "FormatOpt", "OutFormat", "NoCacheOpt", "ProgressOpt", "Modes", "ModesOpt", "space_from", "note",
+           "refuse_set_of_axes", "with_equations"]
 
 
 class OutFormat(str, Enum):
@@ -57,16 +57,51 @@ SetOpt = Annotated[Optional[list[str]], typer.Option(
     rich_help_panel="Model")]
 FormatOpt = Annotated[OutFormat, typer.Option("--format", help="Output format.")]
 NoCacheOpt = Annotated[bool, typer.Option("--no-cache", help="Derive in-process; do not read or write the cache.")]
+
+
+def number(text: str) -> float:
+    """A number option read as typed: ``1e-400`` (underflows to 0) and ``1e400`` (overflows) are refused with
+    the text the user wrote (:func:`brakesqueal.inputs.number_problem`), never read as 0.0 or inf.
+
+    Parameters
+    ----------
+    text : str
+        The option's value as typed.
+
+    Returns
+    -------
+    float
+    """
+    if isinstance(text, float):
+        return text
+    from ..inputs import number_problem, shown
+
+    value = str(text).strip()
+    problem = number_problem(value)
+    if problem:
+        raise typer.BadParameter(f"the number {shown(value, 40)[1:-1]} {problem}")
+    try:
+        return float(value)
+    except ValueError:
+        raise typer.BadParameter(f"{shown(value, 40)} is not a number") from None
+
+
+#: Keyword arguments of :func:`typer.Option` for a number read as typed (:func:`number`).
+NUMBER: dict[str, Any] = {"parser": number, "metavar": "<float>"}
+
 PadSlopeOpt = Annotated[Optional[float], typer.Option(
-    "--pad-slope", help="Keep the massless Coulomb pads' tangential rates, regularised by mu + S v "
-                        "(S in (0, 0.01] s/m; error O(S), e.g. 1e-4). Default: quasi-static pads.")]
+    "--pad-slope", **NUMBER,
+    help="Keep the massless Coulomb pads' tangential rates, regularised by mu + S v "
+         "(S in (0, 0.01] s/m; error O(S), e.g. 1e-4). Default: quasi-static pads.")]
 StickSpeedOpt = Annotated[Optional[float], typer.Option(
-    "--stick-speed", help="With --pad-slope: regularise stick-slip too, mu v / sqrt(v^2 + V^2) + S v (V in (0, 1] m/s; "
-                          "a sticking pad creeps at speeds of order V; error O(V), e.g. 1e-3).")]
+    "--stick-speed", **NUMBER,
+    help="With --pad-slope: regularise stick-slip too, mu v / sqrt(v^2 + V^2) + S v (V in (0, 1] m/s; "
+         "a sticking pad creeps at speeds of order V; error O(V), e.g. 1e-3).")]
 PadDampingOpt = Annotated[Optional[float], typer.Option(
-    "--pad-damping", help="Give every massless pad a tangential damper d_ip beside its spring (N s/m, in (0, 1e6]; "
-                          "not in the paper): the pads' rates are kept as states, also through lift-off and "
-                          "re-contact (--contact unilateral). Default: none.")]
+    "--pad-damping", **NUMBER,
+    help="Give every massless pad a tangential damper d_ip beside its spring (N s/m, in (0, 1e6]; "
+         "not in the paper): the pads' rates are kept as states, also through lift-off and "
+         "re-contact (--contact unilateral). Default: none.")]
 ModesOpt = Annotated[Modes, typer.Option(
     "--modes", help="What the verdict judges: every eigenvalue (all, the default), or the disk's modes alone "
                     "(disk: a non-oscillatory mode of a massless pad's own tangential rate is reported, not "
@@ -113,9 +148,16 @@ def pads_option(space: ParameterSpace, pad_slope: float | None, stick_speed: flo
 
 
 def space_from(model: str | None, preset: str | None, params: str | None, sets: list[str] | None) -> ParameterSpace:
-    """The :class:`~brakesqueal.model.parameters.ParameterSpace` of the shared options (notes replaced ties)."""
+    """The :class:`~brakesqueal.model.parameters.ParameterSpace` of the shared options (notes replaced ties).
+
+    The options are checked first (:func:`brakesqueal.inputs.check_option`: never empty, never longer than
+    the limits), so that messages name them as typed (``--preset``), not as the library's arguments."""
+    from ..inputs import check_option
     from ..model.options import resolve_space
 
+    check_option(model, "--model")
+    check_option(preset, "--preset", name=True)
+    check_option(params, "--params")
     space = resolve_space(model, preset, params, list(sets or []))
     for name in space.untied:
         note(f"--set {name}=... replaces the tie {name} = {space.preset.tied[name]} of preset '{space.label}'")

@@ -7,7 +7,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from ._options import FormatOpt, ModelOpt, OutFormat, ParamsOpt, PresetOpt, ProgressOpt, SetOpt, space_from
+from ._options import NUMBER, FormatOpt, ModelOpt, OutFormat, ParamsOpt, PresetOpt, ProgressOpt, SetOpt, space_from
 
 __all__ = ["register", "import_cmd", "box_cmd", "reduce_cmd"]
 
@@ -153,7 +153,7 @@ def reduce_cmd(
     dim: Annotated[Optional[int], typer.Option("--dim", "-r", min=1, max=2000,
                                                help="Reduced dimension (default: every singular value above "
                                                     "--tol of the largest).")] = None,
-    tol: Annotated[float, typer.Option("--tol", min=0.0, max=1.0, help="Relative singular-value cut-off.")] = 1e-10,
+    tol: Annotated[float, typer.Option("--tol", **NUMBER, help="Relative singular-value cut-off, in [0, 1].")] = 1e-10,
     checks: Annotated[int, typer.Option("--checks", min=0, max=50, help="Speeds between the samples at which "
                                         "the reduced model is compared with the full one.")] = 2,
     fmt: FormatOpt = OutFormat.text, progress: ProgressOpt = None,
@@ -171,6 +171,10 @@ def reduce_cmd(
     from ..outputs import check_output
     from ._progress import progress as _progress
 
+    from ..errors import ParameterError
+
+    if not 0.0 <= tol <= 1.0:
+        raise ParameterError(f"--tol must be in [0, 1]; got {tol!r}", parameter="--tol")
     check_output(out, what="--out", suffixes=(".toml",))
     ax = parse_axis(along)
     space = space_from(model, preset, params, set_)

@@ -9,8 +9,8 @@ from typing import Annotated, Optional
 import typer
 
 from ..errors import ParameterError
-from ._options import (PLOT_SUFFIXES, FormatOpt, ModelOpt, OutFormat, ParamsOpt, PresetOpt, SetOpt, refuse_set_of_axes,
-                       space_from)
+from ._options import (PLOT_SUFFIXES, FormatOpt, ModelOpt, OutFormat, ParamsOpt, PresetOpt, ProgressOpt, SetOpt,
+                       refuse_set_of_axes, space_from)
 
 __all__ = ["register"]
 
@@ -22,10 +22,11 @@ def modes(
     fmt: FormatOpt = OutFormat.text,
     out: Annotated[Optional[str], typer.Option("--out", help="Write the tracked modes (NetCDF, .nc).")] = None,
     plot: Annotated[Optional[str], typer.Option("--plot", help="Draw the diagram (PNG, SVG or PDF).")] = None,
+    progress: ProgressOpt = None,
 ) -> None:
     """Frequencies and real parts of every mode along a path, tracked by continuity; coalescences and crossings."""
     from ..analysis.maps import parse_axis, resolution_problem
-    from ..api import modes_along
+    from ..analysis.modes import modes_along
     from ..outputs import atomic_write, check_output
 
     axis = parse_axis(along, with_num=False)
@@ -38,7 +39,12 @@ def modes(
     if plot:
         check_output(plot, what="--plot", suffixes=PLOT_SUFFIXES)
     space = space_from(model, preset, params, set_)
-    tr = modes_along(space, axis.name, axis.start, axis.stop, num=num, log=axis.log)
+    from ..codegen import build
+    from ._progress import progress as _progress
+
+    engine = build(space.model)  # the entry point's engine, passed down
+    with _progress("modes", progress) as cb:  # a long path (e.g. 100000 points of eight-dof) takes minutes
+        tr = modes_along(engine, space, axis.name, axis.start, axis.stop, num=num, log=axis.log, progress=cb)
     if out:
         with atomic_write(out, what="--out") as tmp:
             tr.to_xarray().to_netcdf(tmp, engine="scipy")

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Optional, cast
 import typer
 
 from ..errors import ParameterError
-from ._options import (PLOT_SUFFIXES, ContactLaw, ModelOpt, OutFormat, PadDampingOpt, PadSlopeOpt, ParamsOpt,
+from ._options import (NUMBER, PLOT_SUFFIXES, ContactLaw, ModelOpt, OutFormat, PadDampingOpt, PadSlopeOpt, ParamsOpt,
                        PresetOpt, SetOpt, StickSpeedOpt, pads_option, space_from,
                        with_equations)
 
@@ -70,7 +70,7 @@ def _check_outputs(out: str | None, plot: str | None, wav: str | None) -> None:
 
 def _simulate_cmd(
     model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
-    t_end: Annotated[float, typer.Option("--t-end", help="Simulated time [s].")] = 0.5,
+    t_end: Annotated[float, typer.Option("--t-end", **NUMBER, help="Simulated time [s].")] = 0.5,
     q0: Annotated[
         Optional[str],
         typer.Option(
@@ -83,8 +83,9 @@ def _simulate_cmd(
         Optional[str], typer.Option("--x0", help="Absolute initial state: coordinates and rates (instead of --q0).")
     ] = None,
     method: Annotated[str, typer.Option("--method", help="DOP853-jit (default) or a solve_ivp method.")] = "DOP853-jit",
-    rtol: Annotated[float, typer.Option("--rtol", help="Relative tolerance, in [1e-13, 1e-2].")] = 1e-9,
-    atol: Annotated[Optional[float], typer.Option("--atol", help="Absolute tolerance (default from rtol).")] = None,
+    rtol: Annotated[float, typer.Option("--rtol", **NUMBER, help="Relative tolerance, in [1e-13, 1e-2].")] = 1e-9,
+    atol: Annotated[Optional[float], typer.Option(
+        "--atol", **NUMBER, help="Absolute tolerance (default from rtol).")] = None,
     events: Annotated[_Events, typer.Option(
         "--events", help="At a contact loss or sliding reversal: stop, continue (record it) or off.")] = _Events.stop,
     contact: Annotated[ContactLaw, typer.Option(
@@ -93,7 +94,8 @@ def _simulate_cmd(
     pad_slope: PadSlopeOpt = None,
     stick_speed: StickSpeedOpt = None,
     pad_damping: PadDampingOpt = None,
-    sample_rate: Annotated[float, typer.Option("--sample-rate", help="Output samples per second [Hz].")] = 44100.0,
+    sample_rate: Annotated[float, typer.Option(
+        "--sample-rate", **NUMBER, help="Output samples per second [Hz].")] = 44100.0,
     out: Annotated[Optional[str], typer.Option("--out", help="Write the trajectory to this NetCDF file.")] = None,
     plot: Annotated[Optional[str], typer.Option(
         "--plot", help="Write the plot: time history, phase, spectrum (PNG, SVG or PDF).")] = None,
@@ -112,6 +114,9 @@ def _simulate_cmd(
     Every output path is checked first; files are written atomically (an
     interrupted or failed write keeps an existing file).  Ctrl-C stops within
     about 0.1 s, during a first compilation within about 0.5 s (exit status 130).
+    A span the model's stiffness makes infeasible for the explicit integrator
+    (more than 1e8 steps, e.g. --set d_t=1e50) is refused before it starts,
+    with the estimate.
     """
     if not (math.isfinite(t_end) and t_end > 0):
         raise ParameterError(f"The option '--t-end' must be a positive number of seconds; got {t_end!r}")

@@ -409,10 +409,12 @@ def _write_harmonic(b: Any, axis: Any, *, fmt: OutFormat, plot: str | None, out:
     if fmt == OutFormat.json:
         sys.stdout.write(json.dumps(b.to_dict(), indent=2, default=float) + "\n")
         return
+    from ..labels import branch_status_text
+
     h = b.hopf.hopf
     lines = [f"Hopf point {axis.name} = {h.p0:.12g}: {h.criticality} (l1 = {h.l1:.6g} ± {h.l1_error:.2g}), "
              f"{h.frequency0_hz:.6g} Hz (exact pads: tangential rates kept)",
-             f"{len(b.points)} branch points by harmonic balance ({b.status}: {b.message})",
+             f"{len(b.points)} branch points by harmonic balance ({branch_status_text(b.status)}: {b.message})",
              f"stability: {b.stability}"]
     lines += b.summary.text(rows=0).splitlines()
     # the normal forces' range over the period: min (a pad lifts off where it reaches 0) and max (as the
@@ -421,9 +423,11 @@ def _write_harmonic(b: Any, axis: Any, *, fmt: OutFormat, plot: str | None, out:
             + " ".join(f"{'Fn min ' + p:>10} {'Fn max ' + p:>10}" for p in b.pads)
             + f" {'slide min':>10} {'H':>3} {'trunc':>8} {'resid':>8}  stable")
     lines.append(head)
-    for pt in b.points:
+    for pt, ok in zip(b.points, b.valid):
         tilt = f"{pt.tilt_amplitude:11.4g}" if pt.tilt_amplitude is not None else f"{'-':>11}"
         st = "-" if pt.stable is None else ("yes" if pt.stable else "no")
+        if not ok:  # past a contact loss the bilateral equations do not hold (the figure greys these orbits)
+            st = "not valid (contact lost)"
         fmax = [f"{v:10.5g}" for v in pt.F_n_max] if len(pt.F_n_max) == len(pt.F_n_min) else [f"{'-':>10}"] * len(
             pt.F_n_min)
         lines.append(f"{pt.p:12.8g} {pt.frequency_hz:10.6g} {tilt} "

@@ -30,7 +30,9 @@ def sweep(
     out: Annotated[Optional[str], typer.Option("--out", help="Zarr store (default: [output] store, "
                                                              "else STUDY.zarr).")] = None,
     workers: Annotated[Optional[int], typer.Option("--workers", help="Start a local Dask cluster with N "
-                                                                     "worker processes.")] = None,
+                                                                     "worker processes (at most 4 per usable core; "
+                                                                     "BRAKESQUEAL_MAX_WORKERS=N raises the cap).")
+                       ] = None,
     scheduler: Annotated[Optional[str], typer.Option("--scheduler", help="Address of an existing Dask "
                                                                          "scheduler (tcp://host:8786).")] = None,
     overwrite: Annotated[bool, typer.Option("--overwrite", help="Replace an existing store.")] = False,

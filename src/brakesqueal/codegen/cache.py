@@ -8,11 +8,23 @@ editing a generator never reuses stale code.
 
 Integrity
     Every file starts with one header line
-    ``# brakesqueal-cache sha256=<hex> bytes=<n>`` describing the rest of the
-    file (the header is a comment, so a cached ``.py`` file is importable as
-    it is).  Files are written atomically (temporary file + :func:`os.replace`).
-    A file whose header is missing, whose size or checksum does not match, or
-    whose content is not UTF-8 is a miss: it is regenerated and overwritten.
+    ``# brakesqueal-cache sha256=<hex> bytes=<n> entry=<version dir>/<key>/<name>``
+    describing the rest of the file and the place it was written for (the
+    header is a comment, so a cached ``.py`` file is importable as it is).
+    Files are written atomically (temporary file + :func:`os.replace`).  A
+    file whose header is missing, whose size or checksum does not match,
+    whose content is not UTF-8, or that was written for another entry (a
+    file swapped with, or copied from, another entry or version) is a miss:
+    it is regenerated and overwritten.
+
+Ownership
+    Every version directory and every entry directory holds a marker file
+    :data:`MARKER` (``.brakesqueal-cache``, a small JSON: kind, package
+    version, fingerprint, key), written when the directory is made.
+    :func:`clear_cache` removes only marked directories and reports every
+    other item it finds (the user's own folders and files, symbolic links,
+    directories of versions that wrote no marker) as skipped: it never
+    deletes what the cache did not make, and never follows a symbolic link.
 
 Generated modules
     :func:`load_module` executes a cached (or freshly generated) source file
@@ -36,15 +48,19 @@ Adding a code generator
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import json
 import linecache
 import os
 import re
 import shutil
+import stat
 import sys
 import threading
 import types
 import uuid
+from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
 from typing import Any, Callable, Iterable, Mapping
@@ -54,8 +70,8 @@ from ..errors import BrakesquealError
 from ..fingerprint import sources_digest
 
 __all__ = [
-    "GENERATOR_MODULES", "CacheError", "cache_root", "source_fingerprint", "version_dir", "entry_dir",
-    "generator_files", "read_text", "write_text", "cached_text", "load_module", "remove_entry",
+    "GENERATOR_MODULES", "MARKER", "CacheError", "ClearReport", "cache_root", "source_fingerprint", "version_dir",
+    "entry_dir", "generator_files", "read_text", "write_text", "cached_text", "load_module", "remove_entry",
     "guard_numba_caches", "cache_info", "clear_cache",
 ]  # fmt: skip
 
@@ -76,7 +92,12 @@ GENERATOR_MODULES: tuple[str, ...] = (
 )
 
 
-_HEADER = re.compile(rb"# brakesqueal-cache sha256=([0-9a-f]{64}) bytes=([0-9]+)")
+#: Name of the marker file in every directory the cache makes (version and entry directories).
+MARKER = ".brakesqueal-cache"
+_KIND_VERSION = "brakesqueal code cache: version directory"
+_KIND_ENTRY = "brakesqueal code cache: entry"
+
+_HEADER = re.compile(rb"# brakesqueal-cache sha256=([0-9a-f]{64}) bytes=([0-9]+) entry=(\S+)")
 _NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
 _LOCK = threading.RLock()
 
@@ -166,16 +187,23 @@ def entry_dir(key: str) -> Path:
 
 
 # ------------------------------------------------------------------ verified text files
-def _frame(text: str) -> bytes:
+def _place(key: str, name: str) -> bytes:
+    """Where a file belongs: ``<version dir>/<key>/<name>`` (relative, so a relocated cache stays valid)."""
+    return f"{version_dir().name}/{key}/{name}".encode("utf-8")
+
+
+def _frame(text: str, key: str, name: str) -> bytes:
     body = text.encode("utf-8")
-    return b"# brakesqueal-cache sha256=%s bytes=%d\n" % (hashlib.sha256(body).hexdigest().encode(), len(body)) + body
+    return (b"# brakesqueal-cache sha256=%s bytes=%d entry=%s\n"
+            % (hashlib.sha256(body).hexdigest().encode(), len(body), _place(key, name)) + body)
 
 
-def _unframe(data: bytes) -> str | None:
-    """Body of a framed file, or ``None`` if the header is missing or does not describe the body."""
+def _unframe(data: bytes, key: str, name: str) -> str | None:
+    """Body of a framed file, or ``None`` if the header is missing, does not describe the body, or names
+    another entry (a file swapped with or copied from another entry or version)."""
     nl = data.find(b"\n")
     m = _HEADER.fullmatch(data[:nl]) if nl >= 0 else None
-    if m is None:
+    if m is None or m[3] != _place(key, name):
         return None
     body = data[nl + 1:]
     if int(m[2]) != len(body) or hashlib.sha256(body).hexdigest().encode() != m[1]:
@@ -186,11 +214,42 @@ def _unframe(data: bytes) -> str | None:
         return None
 
 
-def _read_verified(path: Path) -> str | None:
+def _read_verified(path: Path, key: str, name: str) -> str | None:
     try:
-        return _unframe(path.read_bytes())
+        return _unframe(path.read_bytes(), key, name)
     except OSError:
         return None
+
+
+def _marker(kind: str, key: str | None = None) -> bytes:
+    body: dict[str, Any] = {"kind": kind, "version": __version__, "fingerprint": source_fingerprint()}
+    if key is not None:
+        body["key"] = key
+    return (json.dumps(body) + "\n").encode("utf-8")
+
+
+def _marked(d: Path, kind: str) -> bool:
+    """Whether directory ``d`` (not a symbolic link) holds a marker of ``kind`` written by the cache."""
+    try:
+        if d.is_symlink() or not d.is_dir():
+            return False
+        m = (d / MARKER).lstat()
+        if not stat.S_ISREG(m.st_mode) or m.st_size > 4096:
+            return False
+        data = json.loads((d / MARKER).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(data, dict) and data.get("kind") == kind
+
+
+def _make_entry(key: str) -> Path:
+    """Create the entry directory of ``key`` (and its version directory), each with its :data:`MARKER`."""
+    d = entry_dir(key)
+    for directory, kind, k in ((d.parent, _KIND_VERSION, None), (d, _KIND_ENTRY, key)):
+        if not (directory / MARKER).is_file():
+            directory.mkdir(parents=True, exist_ok=True)
+            _atomic_write(directory / MARKER, _marker(kind, k))
+    return d
 
 
 def _atomic_write(path: Path, data: bytes) -> None:
@@ -227,7 +286,7 @@ def read_text(key: str, name: str) -> str | None:
         lacks its checksum header, or is not UTF-8.
     """
     _check_name("name", name)
-    return _read_verified(entry_dir(key) / name)
+    return _read_verified(entry_dir(key) / name, key, name)
 
 
 def write_text(key: str, name: str, text: str) -> Path | None:
@@ -248,10 +307,9 @@ def write_text(key: str, name: str, text: str) -> Path | None:
         The file's path, or ``None`` if the cache is not writable.
     """
     _check_name("name", name)
-    d = entry_dir(key)
     try:
-        d.mkdir(parents=True, exist_ok=True)
-        _atomic_write(d / name, _frame(text))
+        d = _make_entry(key)
+        _atomic_write(d / name, _frame(text, key, name))
         return d / name
     except OSError:
         return None
@@ -397,7 +455,7 @@ def load_module(key: str, name: str, generate: Callable[[], str], *, use_cache: 
             return _memory_module(generate(), label, namespace, variant)
         _check_name("name", name)
         path = entry_dir(key) / name
-        source = _read_verified(path)
+        source = _read_verified(path, key, name)
         fresh = source is None
         for attempt in range(2):
             if source is None:
@@ -409,7 +467,7 @@ def load_module(key: str, name: str, generate: Callable[[], str], *, use_cache: 
                 return sys.modules[modname]
             try:
                 # the file's exact text (header included), so line numbers match the file numba reads
-                mod = _exec(modname, _frame(source).decode("utf-8"), str(path), namespace)
+                mod = _exec(modname, _frame(source, key, name).decode("utf-8"), str(path), namespace)
                 mod.__source__ = source  # type: ignore[attr-defined]
                 guard_numba_caches(vars(mod))
                 return mod
@@ -538,19 +596,75 @@ def cache_info() -> dict[str, Any]:
     -------
     dict
         ``root``, ``current`` (this version's directory name) and
-        ``versions``: ``{directory name: {"files": n, "bytes": size}}``.
+        ``versions``: ``{directory name: {"files": n, "bytes": size, "marked": bool}}``
+        for every directory in the root (``marked``: made by the cache, see
+        :data:`MARKER`; unmarked ones are never removed by :func:`clear_cache`).
+        Symbolic links are neither listed nor followed.
     """
     root = cache_root()
     versions: dict[str, dict[str, int]] = {}
     if root.is_dir():
-        for d in sorted(p for p in root.iterdir() if p.is_dir()):
-            files = [f for f in d.rglob("*") if f.is_file()]
-            versions[d.name] = {"files": len(files), "bytes": sum(f.stat().st_size for f in files)}
+        for d in sorted(p for p in root.iterdir() if p.is_dir() and not p.is_symlink()):
+            files = [f for f in d.rglob("*") if f.is_file() and not f.is_symlink()]
+            versions[d.name] = {"files": len(files), "bytes": sum(f.lstat().st_size for f in files),
+                                "marked": _marked(d, _KIND_VERSION)}
     return {"root": str(root), "current": version_dir().name, "versions": versions}
 
 
-def clear_cache(stale_only: bool = False) -> list[Path]:
-    """Delete the cache's version directories.
+@dataclass
+class ClearReport:
+    """What :func:`clear_cache` did.
+
+    Attributes
+    ----------
+    removed : list of Path
+        Directories deleted (a whole version directory, or single entries of a
+        version directory that also holds items the cache did not make).
+    skipped : list of (Path, str)
+        Items left in place and why (not made by the cache, a symbolic link,
+        or a directory that could not be deleted).
+    """
+
+    removed: list[Path] = field(default_factory=list)
+    skipped: list[tuple[Path, str]] = field(default_factory=list)
+
+
+_NOT_OURS = "not made by the brakesqueal cache (no {marker} marker)"
+_OLD = ("no {marker} marker (an older brakesqueal's cache, or not a cache at all): left alone; "
+        "if it is an old cache, delete it by hand")
+_LINK = "a symbolic link: left alone (the cache makes none, and never deletes through one)"
+
+
+def _why_not_ours(p: Path) -> str:
+    if p.is_symlink():
+        return _LINK
+    if p.is_dir() and re.fullmatch(r"[0-9][^/]*-[0-9a-f]{12}", p.name):
+        return _OLD.format(marker=MARKER)
+    return _NOT_OURS.format(marker=MARKER)
+
+
+def _rmtree(d: Path) -> str | None:
+    """Delete a directory tree (never following symbolic links); the reason if it (partly) stays."""
+    errors: list[OSError] = []
+
+    def onerror(func: Any, path: str, exc_info: Any) -> None:
+        errors.append(exc_info[1])
+
+    shutil.rmtree(d, onerror=onerror)  # symbolic links inside are removed as links, their targets stay
+    if os.path.lexists(d):
+        exc = next((e for e in errors if isinstance(e, OSError)), None)
+        return "could not be deleted: " + ((exc.strerror or str(exc)).lower() if exc else "unknown reason")
+    return None
+
+
+def clear_cache(stale_only: bool = False) -> ClearReport:
+    """Delete what the cache made: marked version directories and their marked entries.
+
+    Only directories that carry the cache's :data:`MARKER` are removed.  In a
+    marked version directory every marked entry is removed; anything else
+    found there (or in the root) is left in place and reported, and the
+    version directory itself is then kept.  Symbolic links are never
+    followed: a link is left in place and reported, as is what it points to.
 
     Parameters
     ----------
@@ -559,16 +673,49 @@ def clear_cache(stale_only: bool = False) -> list[Path]:
 
     Returns
     -------
-    list of Path
-        The directories deleted.
+    ClearReport
+        What was deleted and what was left, with the reason.
     """
     root = cache_root()
     current = version_dir().name
-    removed = []
-    if root.is_dir():
-        for d in sorted(p for p in root.iterdir() if p.is_dir()):
-            if stale_only and d.name == current:
+    report = ClearReport()
+    if not root.is_dir():
+        return report
+    for d in sorted(root.iterdir()):
+        if stale_only and d.name == current and not d.is_symlink():
+            continue
+        if not _marked(d, _KIND_VERSION):
+            report.skipped.append((d, _why_not_ours(d)))
+            continue
+        kept = False
+        for e in sorted(d.iterdir()):
+            if e.name == MARKER:
                 continue
-            shutil.rmtree(d, ignore_errors=True)
-            removed.append(d)
-    return removed
+            if not _marked(e, _KIND_ENTRY):
+                report.skipped.append((e, _why_not_ours(e)))
+                kept = True
+                continue
+            why = _rmtree(e)
+            if why is None:
+                report.removed.append(e)
+            else:
+                report.skipped.append((e, why))
+                kept = True
+        if kept:
+            continue
+        try:
+            mark = (d / MARKER).read_bytes()
+            (d / MARKER).unlink()
+        except OSError as exc:
+            report.skipped.append((d, "could not be deleted: " + (exc.strerror or str(exc)).lower()))
+            continue
+        try:
+            d.rmdir()
+        except OSError as exc:  # e.g. a run wrote a new entry meanwhile: the directory stays, marked
+            with contextlib.suppress(OSError):
+                _atomic_write(d / MARKER, mark)
+            report.skipped.append((d, "could not be deleted: " + (exc.strerror or str(exc)).lower()))
+            continue
+        report.removed[:] = [p for p in report.removed if p.parent != d]
+        report.removed.append(d)
+    return report

@@ -8,6 +8,11 @@ every slider move), the map with critical speeds and Hopf criticality
 (recomputed only when their inputs change), and the simulation (on request,
 cancellable).  A hidden element ``#bs-render`` counts the updates applied to
 the page and carries the state they show, for tests and benchmarks.
+
+The simulation and the limit cycles run in a child process of their lane
+(:class:`~.worker.ChildProcess`), which *Cancel* kills.  Every text the page
+shows that can hold a value from a link or an input is escaped into an HTML
+pane (never Markdown), so a link cannot put a link or an image into the page.
 """
 
 from __future__ import annotations
@@ -30,8 +35,10 @@ import numpy as np
 from ..errors import BrakesquealError, ParameterError
 from .state import (
     AUDIO_RATE,
+    LINK_KEYS,
     MAX_MAP_POINTS,
     MAX_T_END,
+    REFUSED_KEY,
     LocusView,
     MapView,
     Origin,
@@ -44,13 +51,14 @@ from .state import (
     format_eigenvalue,
     hopf_scan,
     hopf_text,
+    link_limit_message,
     locus_lines,
     locus_view,
     map_view,
     simulation_view,
     slider_range,
 )
-from .worker import Cancelled, LatestWorker
+from .worker import Cancelled, CannotSend, ChildProcess, LatestWorker
 
 if TYPE_CHECKING:
     from bokeh.document import Document
@@ -86,6 +94,9 @@ URL_DELAY_MS = 400
 INFO_REST_MS = 250
 _LOG_FORMAT = "return Number((10 ** tick).toPrecision(3)).toExponential();"
 _MAP_PALETTE = ["#f3a5a5", "#a9cdf5", "#c8c8c8"]  # unstable, stable, no verdict
+#: Look of the message line (Bootstrap's "danger" alert, as Panel's Alert pane had).
+_ALERT_STYLE = {"background-color": "#f8d7da", "color": "#721c24", "border": "1px solid #f5c6cb",
+                "border-radius": "4px", "padding": "0.5em 1em"}
 #: Render level of what moves with every slider step (the current point, its markers): Bokeh repaints only
 #: the overlay layer of a plot when only overlay renderers changed, not its axes, grids and lines.  They have
 #: no legend entries (an overlay repaint erases their legend glyphs); titles and the map's legend text name them.
@@ -274,7 +285,11 @@ class Explorer:
             self._loop = IOLoop.current()
         self.errors: dict[str, str] = {}
         state = origin.initial_state()
+        refused = query.get(REFUSED_KEY)
+        query = {k: v for k, v in query.items() if k in LINK_KEYS}
         try:
+            if refused is not None:  # the server answered a link beyond the limits with this page
+                raise ParameterError(link_limit_message(refused))  # (names only a key it knows)
             state = origin.complete(ViewState.from_query(query, state)) if query else state
             for key in ("along", "x", "y"):  # a name the link gives is checked, not replaced by the default
                 if query.get(key) and getattr(state, key) != query[key]:
@@ -311,6 +326,9 @@ class Explorer:
         self._make_figures()
         self._rebuild_parameters()
         schedule = self._schedule
+        # the long computations run in child processes that Cancel kills (started on first use)
+        self.sim_child = ChildProcess("explorer-simulation")
+        self.cycles_child = ChildProcess("explorer-cycles")
         self.locus_lane: LatestWorker[ViewState, _Locus] = LatestWorker(
             self._compute_locus, self._show_locus, schedule, name="explorer-locus")
         self.map_lane: LatestWorker[ViewState, dict[str, Any]] = LatestWorker(
@@ -405,11 +423,24 @@ class Explorer:
         return self.pn.io.hold(self.doc)
 
     def stop(self) -> None:
-        """End the session's worker threads."""
+        """End the session's worker threads and child processes."""
         lanes = ("locus_lane", "map_lane", "info_lane", "cycles_lane", "sim_lane")
         for lane in (getattr(self, n, None) for n in lanes):
             if lane is not None:
                 lane.stop()
+        for child in (getattr(self, n, None) for n in ("sim_child", "cycles_child")):
+            if child is not None:
+                child.stop()
+
+    def _in_child(self, child: ChildProcess, lane: LatestWorker[Any, Any], fn: Callable[..., _R],
+                  args: tuple[Any, ...], check: Callable[[float], None]) -> _R:
+        """``fn(*args, progress=check)`` in ``child``, killed when ``lane`` is cancelled; in this thread when
+        the arguments cannot be sent to a process (then only ``check`` can stop it)."""
+        try:
+            return child.call(fn, args, progress=check, cancelled=lambda: lane.cancelled)
+        except CannotSend:  # e.g. a model made in a notebook
+            log.debug("computing in the server's thread: the arguments cannot be sent", exc_info=True)
+            return fn(*args, progress=check)
 
     # ------------------------------------------------------------------------------------------ widgets
     def _make_widgets(self) -> None:
@@ -420,8 +451,8 @@ class Explorer:
                                                value=self.state.preset, width=160)
         self.model_select.param.watch(self._on_model, "value")
         self.preset_select.param.watch(self._on_preset, "value")
-        self.alert = pn.pane.Alert("", alert_type="danger", visible=False, sizing_mode="stretch_width",
-                                   css_classes=["bs-alert"])
+        self.alert = pn.pane.HTML("", visible=False, sizing_mode="stretch_width", css_classes=["bs-alert"],
+                                  styles=_ALERT_STYLE)  # escaped text: never Markdown (a link's value is in it)
         self.params_box = pn.Column(sizing_mode="stretch_width")
         self.fixed_box = pn.Card(title="fixed parameters", collapsed=True, sizing_mode="stretch_width")
         self.fixed_box.param.watch(self._on_fixed_card, "collapsed")
@@ -697,11 +728,13 @@ class Explorer:
         self._url_rest.poke()
 
     def _write_url_now(self) -> None:
+        """Write the state as the page's query, replacing it (the token and other parameters go)."""
+        from urllib.parse import urlencode
+
         loc = self.pn.state.location
         if loc is not None:
             try:
-                # panel annotates every keyword of update_query as a Mapping; they are the query's strings
-                loc.update_query(**self.state.to_query())  # type: ignore[arg-type]
+                loc.search = "?" + urlencode(self.state.to_query())
             except Exception:  # no browser location (tests of the object)
                 log.debug("no location", exc_info=True)
 
@@ -813,7 +846,7 @@ class Explorer:
     def _compute_cycles(self, state: ViewState, check: Callable[[float], None]) -> CyclesView:
         space = self.origin.space_of(state)
         rng = self.ranges.get(state.along) or slider_range(space, state.along)
-        return cycles_view(space, state.along, rng, progress=check)  # Cancel stops the branch at its next point
+        return self._in_child(self.cycles_child, self.cycles_lane, cycles_view, (space, state.along, rng), check)
 
     def _cycles_progress(self, fraction: float) -> None:
         self.cycles_progress.value = int(100 * min(max(fraction, 0.0), 1.0))
@@ -1064,7 +1097,8 @@ class Explorer:
                              "boundary_vertices": int(np.isfinite(mv.boundary_x).sum())}
 
     def _compute_sim(self, state: ViewState, check: Callable[[float], None]) -> SimulationView:
-        return simulation_view(self.origin.space_of(state), state.t_end, progress=check)
+        return self._in_child(self.sim_child, self.sim_lane, simulation_view,
+                              (self.origin.space_of(state), state.t_end), check)
 
     def _sim_progress(self, fraction: float) -> None:
         self.sim_progress.value = int(100 * min(max(fraction, 0.0), 1.0))
@@ -1104,7 +1138,8 @@ def build_page(origin: Origin) -> Viewable:
     import panel as pn
 
     args = pn.state.session_args or {}
-    query = {k: (v[0].decode() if isinstance(v[0], bytes) else str(v[0])) for k, v in args.items() if v}
+    query = {k: (v[0].decode("utf-8", "replace") if isinstance(v[0], bytes) else str(v[0]))
+             for k, v in args.items() if v}
     ex = Explorer(origin, query)
     pn.state.on_session_destroyed(lambda ctx: ex.stop())
     return ex.page

@@ -43,7 +43,8 @@ __all__ = ["MAX_MAP_POINTS", "MAX_T_END", "LOCUS_POINTS", "AUDIO_RATE", "SliderR
            "slider_range", "format_eigenvalue", "leading_eigenvalue", "MapView", "map_view", "LocusView",
            "locus_view", "locus_lines", "critical_speed_text", "hopf_scan", "hopf_text", "SimulationView",
            "simulation_view", "check_map_size", "check_t_end", "Origin", "audio_samples", "default_axes",
-           "stability_names", "CyclesView", "cycles_view"]
+           "stability_names", "CyclesView", "cycles_view", "LINK_KEYS", "MAX_LINK_VALUE", "MAX_LINK_SET",
+           "MAX_LINK_PARAMS", "REFUSED_KEY", "link_problem", "link_limit_message"]
 
 #: Largest number of map points the explorer computes (``brakesqueal map`` has no such cap).
 MAX_MAP_POINTS = 1_000_000
@@ -55,6 +56,65 @@ LOCUS_POINTS = 60
 AUDIO_RATE = 44100
 #: Largest number of points of a drawn time history (min/max per bucket beyond).
 HISTORY_POINTS = 4000
+#: The query parameters of a link that the explorer reads (others are ignored, within the limits below).
+LINK_KEYS = ("model", "preset", "set", "along", "x", "y", "nx", "ny", "t_end")
+#: Query parameter by which the server tells the page that a link was refused (its value: the offending key).
+REFUSED_KEY = "refused"
+#: Most characters of a link's parameter name or value (``set``: of each of its values).
+MAX_LINK_VALUE = 64
+#: Most characters of a link's ``set`` (``NAME=VALUE`` pairs separated by commas).
+MAX_LINK_SET = 2048
+#: Most query parameters of a link.
+MAX_LINK_PARAMS = 32
+
+
+def _plain(text: str) -> bool:
+    """Printable ASCII only (no control characters, no non-ASCII digits that ``str.isdigit`` accepts)."""
+    return text.isascii() and text.isprintable()
+
+
+def link_problem(query: Mapping[str, Sequence[str]]) -> str | None:
+    """The first query parameter of a link beyond the limits, or None.
+
+    Every name and value must be printable ASCII of at most :data:`MAX_LINK_VALUE` characters (``set`` at
+    most :data:`MAX_LINK_SET`, each of its values at most :data:`MAX_LINK_VALUE`), and a link has at most
+    :data:`MAX_LINK_PARAMS` parameters.
+
+    Parameters
+    ----------
+    query : Mapping[str, Sequence[str]]
+        Each name of the query with its values.
+
+    Returns
+    -------
+    str or None
+        The offending name if it is one of :data:`LINK_KEYS` or :data:`REFUSED_KEY`, ``"link"`` for the
+        query as a whole (too many parameters, an over-long or non-ASCII name, or a value of another
+        name); None when the link is within the limits.  :func:`link_limit_message` says it in words.
+    """
+    known = (*LINK_KEYS, REFUSED_KEY)
+    if sum(len(v) for v in query.values()) > MAX_LINK_PARAMS:
+        return "link"
+    for key, values in query.items():
+        if not (_plain(key) and len(key) <= MAX_LINK_VALUE):
+            return "link"
+        where = key if key in known else "link"
+        for value in values:
+            if not _plain(value) or len(value) > (MAX_LINK_SET if key == "set" else MAX_LINK_VALUE):
+                return where
+            if key == "set" and any(len(item) > 2 * MAX_LINK_VALUE + 1 or len(item.partition("=")[2].strip())
+                                    > MAX_LINK_VALUE for item in value.split(",")):
+                return where
+    return None
+
+
+def link_limit_message(key: str) -> str:
+    """One line: what :func:`link_problem` refused (``key``: its result)."""
+    limits = (f"printable ASCII text of at most {MAX_LINK_VALUE} characters per name and value (set: at most "
+              f"{MAX_LINK_SET} characters), at most {MAX_LINK_PARAMS} parameters")
+    if key in (*LINK_KEYS, REFUSED_KEY):
+        return f"'{key}' in the link is too long or not plain text; a link holds {limits}"
+    return f"the link is too long or not plain text; a link holds {limits}"
 
 
 @dataclass(frozen=True)
@@ -210,9 +270,12 @@ class ViewState:
         Raises
         ------
         ParameterError
-            A malformed number or ``set`` entry (names and values are
-            checked when the state is resolved, :meth:`space`).
+            A parameter beyond the limits of :func:`link_problem`, a malformed number or ``set`` entry
+            (names and values are checked when the state is resolved, :meth:`Origin.space_of`).
         """
+        problem = link_problem({k: [v] for k, v in query.items()})
+        if problem is not None:
+            raise ParameterError(link_limit_message(problem), parameter=problem if problem in LINK_KEYS else None)
         model = query.get("model") or default.model
         preset = query.get("preset") or (default.preset if model == default.model else "")
         same = model == default.model and preset == default.preset

@@ -19,6 +19,8 @@ import keyword
 import re
 from collections.abc import Iterable
 
+from ..model.components import coordinate_unit
+
 __all__ = ["RESERVED", "local_names", "coordinate_unit", "rate_unit", "residual_label", "residual_unit",
            "is_identifier", "latex_symbol"]
 
@@ -87,9 +89,6 @@ def local_names(names: Iterable[str], taken: Iterable[str] = ()) -> dict[str, st
     return out
 
 
-def coordinate_unit(name: str) -> str:
-    """Unit of a coordinate or pad deformation: ``rad`` for the disk tilts ``q...``, else ``m``."""
-    return "rad" if name.startswith("q") else "m"
 
 
 def rate_unit(name: str, order: int) -> str:

@@ -65,10 +65,17 @@ if TYPE_CHECKING:
     from .roles import ParameterRoles
 
 __all__ = ["Value", "FrictionLaw", "Disk", "Pad", "Caliper", "ModelSpec", "Component", "MAX_PADS", "MAX_COORDINATES",
-           "Kind", "COMPONENTS", "param", "attribute", "components"]
+           "Kind", "COMPONENTS", "param", "attribute", "components", "coordinate_unit"]
 
 Value = Union[float, str]
 FACES = ("upper", "lower")
+
+
+def coordinate_unit(name: str) -> str:
+    """Unit of a coordinate or pad deformation: ``rad`` for the disk tilts ``q...``, else ``m`` (pad and caliper
+    displacements, the pads' tangential deformations ``l...``)."""
+    return "rad" if name.startswith("q") else "m"
+
 _NAME = re.compile(r"^\w+$", re.ASCII)
 
 

@@ -11,7 +11,9 @@ Parameter files, presets and the command line accept values such as
 
 Anything else (attribute access, subscripts, lambdas, comprehensions, strings,
 unknown functions or names) raises :class:`~brakesqueal.errors.ParameterError`
-with a one-line message naming the expression and the offending piece.
+with a one-line message naming the expression and the offending piece, and so
+does a number literal that a double cannot hold as typed (``1e400`` overflows,
+``1e-400`` underflows: :func:`brakesqueal.inputs.number_problem`).
 Arithmetic failures (division by zero, overflow, domain errors, a NaN result)
 raise the same error, naming the values of the names the expression used.
 :func:`dependency_order` sorts a set of definitions that refer to each other.
@@ -25,6 +27,7 @@ import math
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from brakesqueal.inputs import DOUBLE_MAX, DOUBLE_MIN, MAX_EXPRESSION_CHARS, number_problem
 from brakesqueal.errors import ParameterError
 
 __all__ = [
@@ -49,7 +52,7 @@ CONSTANTS: Mapping[str, float] = {"pi": math.pi, "inf": math.inf}
 #: Names that parameters and auxiliary quantities must not use.
 RESERVED_NAMES: frozenset[str] = frozenset(FUNCTIONS) | frozenset(CONSTANTS)
 
-_MAX_LENGTH = 1000
+_MAX_LENGTH = MAX_EXPRESSION_CHARS
 
 _BINARY_SYMBOLS: Mapping[type[ast.operator], str] = {
     ast.Add: "+",
@@ -142,6 +145,11 @@ def _check(node: ast.AST, what: str, expr: str, found: set[str]) -> None:
     if isinstance(node, ast.Constant):
         if isinstance(node.value, bool) or not isinstance(node.value, (int, float)):
             raise _reject(what, expr, _kind(node))
+        if abs(node.value) > DOUBLE_MAX or 0 < abs(node.value) < DOUBLE_MIN or node.value == 0:
+            typed = ast.get_source_segment(expr.strip(), node) or repr(node.value)
+            problem = number_problem(typed)
+            if problem:  # a literal a double cannot hold as typed (1e400, 1e-400)
+                raise ParameterError(f"{what} = {_one_line(expr)}: the number {_one_line(typed, 40)} {problem}")
     elif isinstance(node, ast.Name):
         if node.id in FUNCTIONS:
             raise _reject(what, expr, f"bare function name '{node.id}'", "call it")

@@ -30,20 +30,24 @@ Parameter file::
     [parameters]             # values overriding the preset (or all parameters)
     mu1 = 0.7
 
-Files larger than :data:`MAX_FILE_BYTES` are refused before they are read
-whole; every problem is one :class:`~brakesqueal.errors.ParameterError` line
-naming the file and the key.
+Every file is read by the one input reader of :mod:`brakesqueal.inputs`:
+a regular file (never a FIFO or device) of at most :data:`MAX_FILE_BYTES`,
+whose nesting and value lengths are bounded before it is parsed; every
+problem is one :class:`~brakesqueal.errors.ParameterError` line naming the
+file and the key.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import re
 import tomllib
 from dataclasses import MISSING
 from typing import Any, Mapping
 
+from ..inputs import MAX_FILE_BYTES, check_data, check_text, number_problem, read_input
 from ..errors import ParameterError
 from .components import COMPONENTS, Component, FrictionLaw, Kind, ModelSpec
 from .expressions import evaluate
@@ -52,32 +56,35 @@ from .parameters import Parameters, Preset, Value
 __all__ = ["spec_from_dict", "spec_to_dict", "load_model", "model_to_toml", "read_toml", "load_parameter_file",
            "parameters_to_toml", "MAX_FILE_BYTES", "read_toml_text", "presets_from_dict"]
 
-#: Largest model, parameter or study file read.
-MAX_FILE_BYTES = 1 << 20
-
 _PRESET_KEYS = ("description", "reference", "free", "fixed", "tied", "auxiliary")
 _BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
 _ESCAPES = {"\\": "\\\\", '"': '\\"', "\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f", "\r": "\\r"}
 
 
-def _overflow(text: str) -> float:
-    """TOML float parser that refuses overflow (``1e400``): only a literal ``inf`` means infinity."""
-    v = float(text)
-    if math.isinf(v) and text.strip().lstrip("+-").lower() != "inf":
-        raise _Overflow(text)
-    return v
+class _BadNumber(ValueError):
+    """A TOML number that a double cannot hold as typed (the text and the problem)."""
 
 
-class _Overflow(ValueError):
-    """A TOML number beyond the double range."""
+def _number(text: str) -> float:
+    """TOML float parser that refuses numbers beyond the double range, as typed (``1e400``, ``1e-400``); only a
+    literal ``inf`` means infinity."""
+    problem = number_problem(text)
+    if problem:
+        raise _BadNumber(text, problem)
+    return float(text)
 
 
-def read_toml_text(path: str, what: str) -> tuple[str, dict[str, Any]]:
-    """Read a TOML file (at most :data:`MAX_FILE_BYTES`): its text and document; every failure one ParameterError.
+def read_toml_text(path: str | os.PathLike[str], what: str) -> tuple[str, dict[str, Any]]:
+    """Read a TOML file through the one input reader: its text and document; every failure one ParameterError.
+
+    The file is read by :func:`brakesqueal.inputs.read_input` (a regular file of at most
+    :data:`MAX_FILE_BYTES`, never a FIFO or device), its nesting and value lengths are bounded before it is
+    parsed (:func:`~brakesqueal.inputs.check_text`), numbers a double cannot hold are refused as typed, and
+    the document is checked by :func:`~brakesqueal.inputs.check_data`.
 
     Parameters
     ----------
-    path : str
+    path : str or os.PathLike
         The file.
     what : str
         What the file is, for messages (``"model file"``, ``"parameter file"``, ``"study file"``).
@@ -87,34 +94,30 @@ def read_toml_text(path: str, what: str) -> tuple[str, dict[str, Any]]:
     text : str
         The file's text.
     data : dict
-        The parsed TOML document (numbers beyond the double range are refused, never read as infinity).
+        The parsed TOML document.
     """
+    text = read_input(path, what)
+    where = f"{what} '{os.fspath(path)}'"
+    check_text(text, where)
     try:
-        with open(path, "rb") as fh:
-            raw = fh.read(MAX_FILE_BYTES + 1)
-    except OSError as exc:
-        raise ParameterError(f"cannot read {what} '{path}': {exc.strerror or exc}") from None
-    if len(raw) > MAX_FILE_BYTES:
-        raise ParameterError(f"{what} '{path}' is larger than {MAX_FILE_BYTES // 1024} KiB; refusing to read it")
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise ParameterError(f"{what} '{path}' is not UTF-8 text (byte {exc.start})") from None
-    try:
-        return text, tomllib.loads(text, parse_float=_overflow)
-    except _Overflow as exc:
-        raise ParameterError(f"{what} '{path}': the number {exc} overflows (at most 1.8e308; write inf for a "
-                             "rigid support)") from None
+        data = tomllib.loads(text, parse_float=_number)
+    except _BadNumber as exc:
+        typed, problem = exc.args
+        line = text[:text.find(typed)].count("\n") + 1 if typed in text else None
+        at = f" (line {line})" if line else ""
+        raise ParameterError(f"{where}: the number {typed}{at} {problem}") from None
     except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"{what} '{path}' is not valid TOML: {exc}") from None
+        raise ParameterError(f"{where} is not valid TOML: {exc}") from None
+    check_data(data, where)
+    return text, data
 
 
-def read_toml(path: str, what: str) -> dict[str, Any]:
-    """Read a TOML file (at most :data:`MAX_FILE_BYTES`), turning every failure into one ParameterError line.
+def read_toml(path: str | os.PathLike[str], what: str) -> dict[str, Any]:
+    """Read a TOML file (:func:`read_toml_text`), turning every failure into one ParameterError line.
 
     Parameters
     ----------
-    path : str
+    path : str or os.PathLike
         The file.
     what : str
         What the file is, for messages (``"model file"``, ``"parameter file"``).
@@ -216,6 +219,7 @@ def spec_from_dict(data: Mapping[str, Any], *, source: str = "model") -> ModelSp
 
     if not isinstance(data, Mapping):
         raise ParameterError(f"{source}: must be a table")
+    check_data(data, source)
     if is_matrix_model_data(data):  # a model given by coefficient matrices (file paths absolute or from here)
         return matrix_spec_from_dict(data, source=source)  # type: ignore[return-value]
     top = ("name", "description", "reference", "parameters", *(k.table for k in COMPONENTS.values()), "presets")
@@ -318,13 +322,13 @@ def spec_to_dict(spec: ModelSpec, *, presets: bool = True) -> dict[str, Any]:
     return d
 
 
-def load_model(path: str) -> ModelSpec:
+def load_model(path: str | os.PathLike[str]) -> ModelSpec:
     """Read a model TOML file; errors name the file and the key.
 
     Parameters
     ----------
-    path : str
-        Path of the TOML file (layout in the module docstring).
+    path : str or os.PathLike
+        Path of the TOML file (layout in the module docstring); never a file descriptor.
 
     Returns
     -------
@@ -334,12 +338,12 @@ def load_model(path: str) -> ModelSpec:
     Raises
     ------
     ParameterError
-        If the file cannot be read, is too large, not UTF-8, not valid TOML,
+        If ``path`` is not a path, the file cannot be read, is not a regular
+        file, is too large, nests too deeply, is not UTF-8, not valid TOML,
         or describes an invalid model.
     """
-    import os
-
     data = read_toml(path, "model file")
+    path = os.fspath(path)
     source = f"model file '{path}'"
     from .matrices import is_matrix_model_data, matrix_spec_from_dict
 
@@ -429,8 +433,6 @@ def load_parameter_file(path: str) -> tuple[str | None, str | None, dict[str, Va
         One line naming the file and the key for an unreadable file, invalid
         TOML, unknown top-level keys or wrong types.
     """
-    import os
-
     from ..suggest import did_you_mean
 
     data = read_toml(path, "parameter file")

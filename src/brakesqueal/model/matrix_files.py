@@ -179,6 +179,10 @@ def detect_format(path: str) -> str:
     path = os.fspath(path)
     ext = os.path.splitext(path)[1].lower()
     if ext == ".mtx":
+        if os.path.exists(path):  # a FIFO or device is refused before it is opened (it could block forever)
+            from ..inputs import check_input_file
+
+            check_input_file(path, "matrix file")
         try:
             with open(path, "rb") as f:
                 head = f.read(14)
@@ -682,8 +686,10 @@ def read_matrix_file(path: str, format: str | None = None, names: Sequence[str] 
             raise _err(path, f"no such file: neither {stem}.sti nor {stem}.mas exists")
     elif not os.path.exists(path):
         raise _err(path, "no such file")
-    elif not os.path.isfile(path):
-        raise _err(path, "is not a file")
+    else:
+        from ..inputs import check_input_file
+
+        check_input_file(path, "matrix file")  # a FIFO, device or directory: refused, never opened (one rule)
     try:
         dofs: tuple[str, ...] | None = None
         if fmt == "mat":

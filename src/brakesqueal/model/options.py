@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from typing import TYPE_CHECKING
+import os
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
+from ..inputs import check_option
+from ..validation import validated
 from ..errors import ParameterError
 from .parameters import ParameterSpace, Parameters, Value, parse_sets
 
 if TYPE_CHECKING:
     from .components import ModelSpec
+    from .matrices import MatrixSpec
 
 __all__ = ["resolve_space", "resolve_parameters", "regularised_pads", "damped_pads", "stick_slip_everywhere",
            "DEFAULT_PRESET", "MAX_PAD_SLOPE", "MAX_STICK_SPEED", "MAX_PAD_DAMPING"]
@@ -19,18 +23,20 @@ __all__ = ["resolve_space", "resolve_parameters", "regularised_pads", "damped_pa
 DEFAULT_PRESET = "paper-fig2"
 
 
-def resolve_space(model: ModelSpec | str | None = None, preset: str | None = None, params: str | None = None,
-                  sets: Sequence[str] | dict[str, Value] = ()) -> ParameterSpace:
+@validated
+def resolve_space(model: ModelSpec | MatrixSpec | str | os.PathLike[str] | None = None, preset: str | None = None,
+                  params: str | os.PathLike[str] | None = None,
+                  sets: Sequence[str] | Mapping[str, Any] = ()) -> ParameterSpace:
     """Combine the model, preset, parameter-file and ``--set`` options into one parameter space.
 
     Parameters
     ----------
-    model : ModelSpec or str, optional
+    model : ModelSpec, MatrixSpec, str or os.PathLike, optional
         A model, a built-in model name or a model file path (``--model``).
     preset : str, optional
         A preset name (``--preset``): a preset of the model, or, without a
-        model, any built-in preset (which names its model).
-    params : str, optional
+        model, any built-in preset (which names its model).  Never empty.
+    params : str or os.PathLike, optional
         A parameter file (``--params``): optional ``model`` and ``preset``
         keys and a ``[parameters]`` table of overrides.
     sets : sequence of str or dict, optional
@@ -54,13 +60,19 @@ def resolve_space(model: ModelSpec | str | None = None, preset: str | None = Non
     Raises
     ------
     ParameterError
-        Conflicting model or preset names between the options and the file,
-        unknown names (with a suggestion), invalid values.
+        Arguments of the wrong type, an empty or too long option
+        (:func:`brakesqueal.inputs.check_option`), conflicting model or
+        preset names between the options and the file, unknown names (with a
+        suggestion), invalid values.
     """
     from .components import ModelSpec
     from .library import get_model, get_preset, resolve_model
 
-    overrides = dict(sets) if isinstance(sets, dict) else parse_sets(list(sets))
+    if isinstance(model, (str, os.PathLike)):
+        model = check_option(model, "--model")
+    preset = check_option(preset, "--preset", name=True)
+    params = check_option(params, "--params")
+    overrides = dict(sets) if isinstance(sets, Mapping) else parse_sets(list(sets))
     entries: dict[str, Value] = {}
     f_model = f_preset = None
     source = None
@@ -101,8 +113,10 @@ def resolve_space(model: ModelSpec | str | None = None, preset: str | None = Non
     return space
 
 
-def resolve_parameters(model: ModelSpec | str | None = None, preset: str | None = None, params: str | None = None,
-                       sets: Sequence[str] | dict[str, Value] = ()) -> Parameters:
+@validated
+def resolve_parameters(model: ModelSpec | MatrixSpec | str | os.PathLike[str] | None = None,
+                       preset: str | None = None, params: str | os.PathLike[str] | None = None,
+                       sets: Sequence[str] | Mapping[str, Any] = ()) -> Parameters:
     """The validated parameter set of :func:`resolve_space` at its current point.
 
     Parameters

@@ -22,6 +22,7 @@ parameter set.  Validation goes through :mod:`.roles` for every channel.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
@@ -29,6 +30,7 @@ from typing import TYPE_CHECKING, Any, Union, cast, overload
 
 import numpy as np
 
+from ..inputs import MAX_EXPRESSION_CHARS, MAX_NAME_CHARS, number_problem, shown
 from ..errors import ParameterError
 from .expressions import RESERVED_NAMES, dependency_order, evaluate, evaluate_array, names_in, to_sympy
 
@@ -78,12 +80,12 @@ def compliance(value: ArrayLike) -> float | np.ndarray:
     return float(out) if np.ndim(out) == 0 else out
 
 
-def as_model_spec(model: ModelSpec | str) -> ModelSpec:
+def as_model_spec(model: ModelSpec | str | os.PathLike[str]) -> ModelSpec:
     """The :class:`~brakesqueal.model.components.ModelSpec` named by ``model``.
 
     Parameters
     ----------
-    model : ModelSpec or str
+    model : ModelSpec, MatrixSpec, str or os.PathLike
         A model, a built-in model name or the path of a model TOML file.
 
     Returns
@@ -104,9 +106,12 @@ def as_model_spec(model: ModelSpec | str) -> ModelSpec:
         return model
     if isinstance(model, MatrixSpec):  # the same parameter interface (name, parameters, presets, roles, unit)
         return cast("ModelSpec", model)
+    if isinstance(model, os.PathLike):
+        model = os.fspath(model)
     if isinstance(model, str):
         return resolve_model(model)
-    raise ParameterError(f"model must be a ModelSpec or a model name; got {model!r}")
+    raise ParameterError(f"model must be a ModelSpec, a MatrixSpec, a built-in model's name or a model file; got "
+                         f"{shown(model)} ({type(model).__name__})", parameter="model")
 
 
 class Parameters(Mapping[str, float]):
@@ -610,7 +615,10 @@ def parse_sets(sets: Sequence[str], *, option: str = "--set") -> dict[str, Value
     Raises
     ------
     ParameterError
-        A malformed assignment, a number that overflows, or a name given twice.
+        A malformed assignment, a name or value too long (``MAX_NAME_CHARS``, ``MAX_EXPRESSION_CHARS`` of
+        :mod:`brakesqueal.inputs`), a number
+        that a double cannot hold as typed (``1e400`` overflows, ``1e-400`` underflows:
+        :func:`~brakesqueal.inputs.number_problem`), or a name given twice.
     """
 
     def says(name: str, value: str) -> str:
@@ -620,21 +628,27 @@ def parse_sets(sets: Sequence[str], *, option: str = "--set") -> dict[str, Value
     for text in sets:
         name, sep, value = str(text).partition("=")
         name, value = name.strip(), value.strip()
+        if len(name) > MAX_NAME_CHARS:
+            raise ParameterError(f"{option or 'value'}: a name is {len(name)} characters long (at most "
+                                 f"{MAX_NAME_CHARS})")
+        if len(value) > MAX_EXPRESSION_CHARS:
+            raise ParameterError(f"{says(name, '...')}: the value is {len(value)} characters long (at most "
+                                 f"{MAX_EXPRESSION_CHARS})", parameter=name if name.isidentifier() else None)
         if not sep or not name.isidentifier() or not value:
             if not option and name.isidentifier():
                 raise ParameterError(f"{name}: enter a number or an expression (e.g. 0.4, inf, 16*pi)",
                                      parameter=name)
-            raise ParameterError(f"malformed {option or 'value'} {text!r}: expected NAME=VALUE")
+            raise ParameterError(f"malformed {option or 'value'} {shown(str(text))}: expected NAME=VALUE")
         if name in overrides:
             raise ParameterError(f"{option or 'value'} '{name}' is given more than once", parameter=name)
+        problem = number_problem(value)
+        if problem:
+            raise ParameterError(f"{says(name, value)}: the number {problem}", parameter=name)
         try:
             number = float(value)
         except ValueError:
             overrides[name] = value
             continue
-        if math.isinf(number) and value.lower().lstrip("+-") not in ("inf", "infinity"):
-            raise ParameterError(f"{says(name, value)}: the number overflows (write inf for an infinite value)",
-                                 parameter=name)
         if math.isnan(number):
             raise ParameterError(f"{says(name, value)}: not a number", parameter=name)
         overrides[name] = number

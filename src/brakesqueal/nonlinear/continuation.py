@@ -244,10 +244,13 @@ class CycleBranch:
             a.ticklabel_format(axis="y", useOffset=False)
         if np.ptp(fr) <= 1e-9 * max(float(np.max(np.abs(fr))), 1e-300):
             axes[1].set_ylim(float(np.mean(fr)) * 0.99, float(np.mean(fr)) * 1.01)
-        axes[0].set_ylabel(f"first-harmonic amplitude of {names[j]}")
+        from ..labels import axis_label, branch_status_text, unit
+        from ..model.components import coordinate_unit
+
+        axes[0].set_ylabel(f"first-harmonic amplitude of {names[j]} [{coordinate_unit(str(names[j]))}]")
         axes[1].set_ylabel("frequency [Hz]")
-        axes[1].set_xlabel(pn)
-        axes[0].set_title(f"limit cycles: {self.status}")
+        axes[1].set_xlabel(axis_label(pn, unit(pn) or None))
+        fig.suptitle(f"limit cycles (shooting): {branch_status_text(self.status)}")
         return fig
 
 

@@ -12,6 +12,7 @@ from ..errors import ParameterError, SilentMotionError
 from ..status import RunStatus
 from ._model import SilentState, SimulationModel, _scales, _value, simulation_model
 from ._run import EstimationGrid, Run, engagement_at
+from ._stiffness import check_stiffness
 from .estimate import LinearModes
 from .trajectory import Trajectory
 
@@ -284,7 +285,13 @@ def simulate(
     ------
     ParameterError
         Bad options or initial state (non-finite, ``t_end <= t0``, tolerances
-        out of range, a pad out of contact at the initial state).
+        out of range, a pad out of contact at the initial state); or, before
+        anything is integrated, a span that the model's stiffness makes
+        infeasible for an explicit method: more than ``max(1e8, max_steps)``
+        steps by the lower bound ``(t_end - t0) max|lambda| / 6.8`` (``lambda``
+        the eigenvalues of the linearization at the silent motion; the message
+        gives the estimate, the time it would take and the parameters the
+        fastest time scale depends on; implicit methods are not limited).
     SilentMotionError
         If the silent motion does not exist (needed for the reference state).
     KeyboardInterrupt
@@ -385,6 +392,9 @@ def _simulate(model: SimulationModel | Engine, params: Parameters, t0: float, t1
     k.event_values(y0, l0, dl0, p, st.vr0, np.empty(7 * npad), ev0)
     if not np.all(np.isfinite(f0)) or not np.all(np.isfinite(ev0)):
         raise ParameterError(f"the equations cannot be evaluated at the initial state {y0.tolist()}")
+    # a span the model's stiffness makes infeasible for an explicit method is refused before the run
+    check_stiffness(model, params, t0, t1, method, max_steps, modes,
+                    lambda: k.rhs(y0, l0.copy(), dl0.copy(), p, st.ztol, g, mw, np.empty(y0.size)))
     eng0 = (ev0[:npad] > 0).astype(np.int64) if unilateral else np.ones(npad, dtype=np.int64)
     for j, pad in enumerate(model.pads):
         if ev0[j] <= 0 and not unilateral:

@@ -264,8 +264,8 @@ class Run:
                 code, t_end, sol_msg = -5, a, ""
                 break
             nfev += int(sol.nfev)
-            got = sol.t.size
-            Yc = np.ascontiguousarray(sol.y.T)
+            got = int(np.size(sol.t))  # SciPy leaves t and y as empty lists when it fails before a requested time
+            Yc = np.ascontiguousarray(np.asarray(sol.y, dtype=float).T) if got else np.empty((0, N))
             io, ie = inv[: i1 - i0], inv[i1 - i0 : i1 - i0 + te.size]
             ok_o, ok_e = io < got, ie < got
             Y[i0 : i0 + int(ok_o.sum())] = Yc[io[ok_o]]

@@ -314,9 +314,13 @@ def _window_too_short(status: str, t: np.ndarray, x: np.ndarray, n: int, lin_g: 
     """The summary of a record shorter than one period of the leading mode: no growth rate or frequency."""
     amp = float(np.sqrt((x[:, :n] ** 2).sum(axis=1)).max())
     duration = float(t[-1] - t[0])
-    warn = (f"the estimation window ({duration:.3g} s) is shorter than one period of the leading mode "
-            f"({1 / f_lead:.3g} s at {f_lead:.6g} Hz): growth rate and frequency cannot be estimated; simulate "
-            "for longer")
+    if f_lead > 0:
+        warn = (f"the estimation window ({duration:.3g} s) is shorter than one period of the leading mode "
+                f"({1 / f_lead:.3g} s at {f_lead:.6g} Hz): growth rate and frequency cannot be estimated; simulate "
+                "for longer")
+    else:  # an estimated frequency of exactly 0 (e.g. a motion frozen by an enormous damping): no period at all
+        warn = (f"the motion does not oscillate within the estimation window ({duration:.3g} s, estimated "
+                "frequency 0 Hz): growth rate and frequency cannot be estimated; simulate for longer")
     return Summary(status, math.nan, math.nan, amp, None, estimate_window=(float(t[0]), float(t[-1])),
                    estimate_rate_hz=float((t.size - 1) / duration) if duration > 0 else math.nan,
                    linear_growth_rate=lin_g, linear_frequency_hz=lin_f, warnings=(warn,),

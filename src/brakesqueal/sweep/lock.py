@@ -25,6 +25,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..outputs import process_running, process_start_ticks
 from .store import StoreError, _NotWritable
 
 __all__ = ["StoreLock", "LockInfo", "lock_path", "lock_holder"]
@@ -37,31 +38,11 @@ def lock_path(store: Path) -> Path:
     return store.parent / f"{store.name}.lock"
 
 
-def _proc_start(pid: int) -> str | None:
-    """Start time of process ``pid`` in clock ticks since boot (Linux), to detect PID reuse."""
-    try:
-        stat = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:
-        return None
-    try:
-        return stat[stat.rindex(")") + 2:].split()[19]
-    except (ValueError, IndexError):
-        return None
-
-
 def _alive(pid: int, start: str | None) -> bool:
     """Whether process ``pid`` runs on this host (and, if known, is the one started at ``start``)."""
-    if pid <= 0:
+    if not process_running(pid):
         return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        pass
-    except OSError:
-        return False
-    now = _proc_start(pid)
+    now = process_start_ticks(pid)
     return start is None or now is None or now == start
 
 
@@ -247,7 +228,7 @@ class StoreLock:
 
     def _content(self) -> bytes:
         me = {"pid": os.getpid(), "host": socket.gethostname(), "started": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-              "proc_start": _proc_start(os.getpid()), "store": str(self.store)}
+              "proc_start": process_start_ticks(os.getpid()), "store": str(self.store)}
         return json.dumps(me).encode()
 
     def _claim(self, fd: int, created: bool) -> bool:

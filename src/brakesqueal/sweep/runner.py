@@ -28,7 +28,7 @@ from ..errors import ParameterError
 from ..labels import unit
 from .compute import ChunkSpec, compute_chunk
 from .lock import StoreLock, lock_holder
-from .store import (StoreError, _NotWritable, check_location, check_skeleton, check_writable,
+from .store import (StoreError, _NotWritable, check_location, check_overwrite, check_skeleton, check_writable,
                     inspect_store, open_group, prepare_store, read_manifest, study_attrs, variable_attrs,
                     verified_chunks, write_chunk)
 from .study import Study, StudySource, load_study
@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from distributed import Client, Future, LocalCluster
 
 __all__ = ["sweep", "run_sweep", "sweep_status", "open_sweep", "SweepRun", "SweepStatus", "default_store",
-           "local_cluster", "check_scheduler_address"]
+           "local_cluster", "check_scheduler_address", "max_workers", "MAX_WORKERS_ENV", "WORKERS_PER_CORE"]
 
 #: Largest result (bytes) of a study computed in memory (no store).
 _MAX_IN_MEMORY = 2 * 10**9
@@ -204,7 +204,58 @@ def _check_executor(workers: object, scheduler: object, client: object) -> str |
         raise ParameterError("give at most one of --workers, --scheduler (or client=)")
     if workers is not None and (not isinstance(workers, int) or isinstance(workers, bool) or workers < 1):
         raise ParameterError(f"--workers must be a positive integer; got {workers!r}")
+    if workers is not None:
+        cap, why = max_workers()
+        if workers > cap:
+            raise ParameterError(f"--workers must be in [1, {cap}] ({why}; set {MAX_WORKERS_ENV}=N to allow "
+                                 f"more); got {workers}", parameter="workers")
     return check_scheduler_address(scheduler) if scheduler is not None else None
+
+
+#: Environment variable that sets the largest ``--workers`` (default: :data:`WORKERS_PER_CORE` × the usable cores).
+MAX_WORKERS_ENV = "BRAKESQUEAL_MAX_WORKERS"
+#: Worker processes allowed per usable core by default (the workers are single-threaded).
+WORKERS_PER_CORE = 4
+
+
+def _usable_cores() -> int:
+    """The cores this process may run on (its CPU affinity where the platform tells, else all)."""
+    import os
+
+    count = getattr(os, "process_cpu_count", None)  # Python >= 3.13
+    if count is not None:
+        return max(int(count() or 1), 1)
+    try:
+        return max(len(os.sched_getaffinity(0)), 1)
+    except (AttributeError, OSError):  # pragma: no cover - macOS, Windows
+        return max(os.cpu_count() or 1, 1)
+
+
+def max_workers() -> tuple[int, str]:
+    """The largest number of local worker processes ``--workers`` may start, and why.
+
+    Returns
+    -------
+    cap : int
+        ``$BRAKESQUEAL_MAX_WORKERS`` if set, else :data:`WORKERS_PER_CORE` × the usable cores.
+    reason : str
+        Where the cap comes from (for the refusal's message).
+
+    Raises
+    ------
+    ParameterError
+        ``$BRAKESQUEAL_MAX_WORKERS`` is not a positive integer.
+    """
+    import os
+
+    raw = os.environ.get(MAX_WORKERS_ENV, "").strip()
+    if raw:
+        if not raw.isdigit() or len(raw) > 9 or int(raw) < 1:
+            raise ParameterError(f"{MAX_WORKERS_ENV} must be a positive integer (at most 999999999); got "
+                                 f"{raw[:40]!r}{'...' if len(raw) > 40 else ''}")
+        return int(raw), f"{MAX_WORKERS_ENV}={int(raw)}"
+    cores = _usable_cores()
+    return WORKERS_PER_CORE * cores, f"{WORKERS_PER_CORE} per usable core, {cores} core{'s' * (cores != 1)}"
 
 
 @contextlib.contextmanager
@@ -253,14 +304,68 @@ def local_cluster(workers: int) -> LocalCluster:
     ``MALLOC_TRIM_THRESHOLD_`` is left unset (with it glibc ``mmap``s every large
     temporary array: about 15 %).  For an existing cluster, set
     ``distributed.worker.profile.enabled: false`` in its Dask configuration.
+
+    The worker processes never see a terminal's Ctrl-C (it goes to the whole
+    foreground process group): they start with ``SIGINT`` blocked
+    (:func:`_ctrl_c_deferred`), and the calling process, which receives the
+    interrupt, shuts them down.  Otherwise every worker printed the traceback
+    of its own ``KeyboardInterrupt`` (and one that lost its parent while
+    starting, an ``EOFError``).  A Ctrl-C while the workers start takes effect
+    once they have started (a few seconds); the cluster is then closed.
     """
     import dask
     from distributed import LocalCluster
 
-    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
-                          "distributed.worker.profile.enabled": False}):
-        return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                            silence_logs=logging.ERROR, env=_WORKER_ENV)
+    _check_executor(workers, None, None)
+    cluster: LocalCluster | None = None
+    try:
+        with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+                              "distributed.worker.profile.enabled": False}), _ctrl_c_deferred():
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   silence_logs=logging.ERROR, env=_WORKER_ENV)
+    except BaseException:  # e.g. the Ctrl-C deferred during the start, raised as it ends: shut the workers down
+        if cluster is not None:
+            cluster.close()
+        raise
+    return cluster
+
+
+@contextlib.contextmanager
+def _ctrl_c_deferred() -> Iterator[None]:
+    """``SIGINT`` blocked in this thread, and so in every thread and process started inside.
+
+    A blocked signal mask is inherited by new threads and kept across ``fork``
+    and ``exec``: the cluster's event loop is started here, its nannies start
+    the worker processes from threads of that loop, so the workers start (and
+    stay) deaf to Ctrl-C from their first instruction on (no window before a
+    handler could be installed).  A Ctrl-C to this thread meanwhile is pending,
+    not lost: it is raised as the block ends.  Ending the program while workers
+    start instead left a worker reading its start-up data from a closed pipe
+    (an ``EOFError`` traceback).
+    """
+    import signal
+
+    if not hasattr(signal, "pthread_sigmask"):  # pragma: no cover - Windows: no process groups to shield from
+        yield
+        return
+    # multiprocessing starts its resource tracker on the first spawn and *unblocks* SIGINT in the spawning thread
+    # afterwards: start it now, from this thread, so that the loop's threads keep the mask.  The tracker (a
+    # process of its own, which outlives us) removes the semaphores of workers whose program was ended before it
+    # closed them, as it should, but also warned about them on the terminal after the program had ended: it is
+    # started with that one warning ignored (-W options are passed on to it).
+    from multiprocessing import resource_tracker
+
+    quiet = "ignore:resource_tracker:UserWarning"
+    sys.warnoptions.append(quiet)
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        sys.warnoptions.remove(quiet)
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)  # a pending Ctrl-C is raised right after this
 
 
 def _results(study: Study, spec: ChunkSpec, todo: list[int],
@@ -417,6 +522,8 @@ def run_sweep(study: StudySource, *, store: str | Path | None = None, workers: i
         return SweepRun(ds, None, st.n_chunks, 0)
     path = path.resolve()
     check_location(path)
+    if overwrite:
+        check_overwrite(path)  # only a store this package made is ever deleted: refused before any work
     lock = StoreLock(path)
     try:
         lock.acquire()

@@ -11,6 +11,16 @@ Layout (Zarr format 3, one directory)::
     STORE/_sweep_chunks/_creation.json
                                     creation record: the exact metadata (``zarr.json``) of every
                                     node and the checksum of every coordinate array
+    STORE/_sweep_chunks/.brakesqueal-store
+                                    ownership marker (JSON: kind, format, study hash; beside
+                                    the chunk markers, where Zarr readers do not look)
+
+**Only our own stores are ever deleted.**  ``--overwrite`` (:func:`remove_store`)
+deletes a directory only if this package made it (:func:`is_own_store`: its
+marker, its creation record, or, for stores of versions before the marker,
+metadata naming a study hash and a brakesqueal version); anything else, a
+directory that merely holds a file named ``zarr.json`` or another program's
+Zarr store, is refused in one line and left as it is.
 
 **Creation is atomic.**  The skeleton (metadata, coordinates, consolidated
 metadata, creation record last) is built in a hidden sibling directory
@@ -61,14 +71,17 @@ if TYPE_CHECKING:
 
     from .study import Study
 
-__all__ = ["StoreError", "MARKERS", "MANIFEST", "study_attrs", "variable_attrs", "coordinates", "create_store",
-           "prepare_store", "inspect_store", "check_skeleton", "read_manifest", "open_group", "write_chunk",
-           "write_file", "completed_chunks", "verified_chunks", "remove_store", "check_location", "check_writable",
-           "checksum", "StoreCheck", "io_error"]
+__all__ = ["StoreError", "MARKERS", "MANIFEST", "STORE_MARKER", "is_own_store", "check_overwrite", "study_attrs",
+           "variable_attrs", "coordinates", "create_store", "prepare_store", "inspect_store", "check_skeleton",
+           "read_manifest", "open_group", "write_chunk", "write_file", "completed_chunks", "verified_chunks",
+           "remove_store", "check_location", "check_writable", "checksum", "StoreCheck", "io_error"]
 
 MARKERS = "_sweep_chunks"
 MANIFEST = f"{MARKERS}/_creation.json"
+#: Ownership marker written into every store this package creates (see :func:`is_own_store`).
+STORE_MARKER = f"{MARKERS}/.brakesqueal-store"
 _FORMAT = "brakesqueal-sweep-store/1"
+_STORE_KIND = "brakesqueal sweep store"
 #: ``status`` codes (:class:`~brakesqueal.status.PointStatus`); chunks not yet written read as ``NOT_COMPUTED``.
 _STATUS_FILL = int(PointStatus.NOT_COMPUTED)
 
@@ -309,6 +322,8 @@ def create_store(path: Path, study: Study) -> dict[str, Any]:
     tmp = path.parent / f".{path.name}.creating-{os.getpid()}-{uuid.uuid4().hex[:8]}"
     try:
         manifest = _build_skeleton(tmp, study, study_attrs(study))
+        write_file(tmp / STORE_MARKER, json.dumps({"kind": _STORE_KIND, "format": _FORMAT,
+                                                   "study_hash": manifest["study_hash"]}).encode())
         os.rename(tmp, path)
     except OSError as exc:
         shutil.rmtree(tmp, ignore_errors=True)
@@ -405,14 +420,15 @@ def inspect_store(path: Path, study: Study) -> StoreCheck:
     attrs = root.get("attributes") if isinstance(root, dict) and isinstance(root.get("attributes"), dict) else None
     h = manifest["study_hash"] if manifest else (attrs or {}).get("study_hash")
     if h is None:
+        if not is_own_store(path):
+            raise ParameterError(f"'{path}' exists and is not a sweep store made by brakesqueal (no {STORE_MARKER} "
+                                 "marker, creation record or brakesqueal metadata); choose another store (--out) "
+                                 "or remove it by hand")
         if attrs is not None:
             raise ParameterError(f"store '{path}' is not a brakesqueal sweep store (no key 'study_hash'); "
                                  "pass --overwrite to replace it")
-        if (path / MANIFEST).exists() or (path / MARKERS).exists() or (path / "zarr.json").exists():
-            raise StoreError(f"store '{path}' is damaged beyond repair: neither its metadata (zarr.json) nor its "
-                             f"creation record ({MANIFEST}) can be read; pass --overwrite to recompute it")
-        raise ParameterError(f"'{path}' exists and is not a brakesqueal sweep store; "
-                             "choose another store (--out) or remove it")
+        raise StoreError(f"store '{path}' is damaged beyond repair: neither its metadata (zarr.json) nor its "
+                         f"creation record ({MANIFEST}) can be read; pass --overwrite to recompute it")
     if h != study.hash():
         src = (manifest and _read_study_file(manifest)) or (attrs or {}).get("study_file")
         raise _different(path, study, h, src)
@@ -554,21 +570,69 @@ def prepare_store(path: Path, study: Study, *, overwrite: bool) -> tuple[zarr.Gr
     return open_group(path, check.manifest), check.problems
 
 
+def is_own_store(path: Path) -> bool:
+    """Whether ``path`` is a sweep store made by this package (so ``--overwrite`` may delete it).
+
+    True for a directory (not a symbolic link) holding the ownership marker
+    :data:`STORE_MARKER`, or an intact creation record (:data:`MANIFEST`), or
+    (stores of versions before the marker) root metadata whose attributes
+    name a study hash and a brakesqueal version.  A file merely named
+    ``zarr.json``, or another program's Zarr store, is not.
+
+    Parameters
+    ----------
+    path : Path
+        The directory.
+
+    Returns
+    -------
+    bool
+    """
+    if path.is_symlink() or not path.is_dir():
+        return False
+    m = _read_json(path / STORE_MARKER)
+    if isinstance(m, dict) and m.get("kind") == _STORE_KIND:
+        return True
+    if read_manifest(path) is not None:
+        return True
+    root = _read_json(path / "zarr.json")
+    attrs = root.get("attributes") if isinstance(root, dict) else None
+    return (isinstance(attrs, dict) and isinstance(attrs.get("study_hash"), str)
+            and isinstance(attrs.get("brakesqueal_version"), str))
+
+
+def check_overwrite(path: Path) -> None:
+    """Refuse (one line) to overwrite ``path`` unless it is absent, an empty directory or our own store.
+
+    Raises
+    ------
+    ParameterError
+        ``path`` exists and is not a store made by this package (:func:`is_own_store`).
+    """
+    if not os.path.lexists(path):
+        return
+    if path.is_dir() and not path.is_symlink() and not any(path.iterdir()):
+        return
+    if not is_own_store(path):
+        what = "a symbolic link" if path.is_symlink() else "a file" if not path.is_dir() else "a directory"
+        raise ParameterError(f"refusing to overwrite '{path}': it is {what} brakesqueal did not make (no "
+                             f"{STORE_MARKER} marker or creation record of a sweep store); remove it by hand if "
+                             "it should go, or choose another store (--out)", parameter="overwrite")
+
+
 def remove_store(path: Path) -> None:
     """Delete a store directory (renamed away first, so the path never holds a half-deleted store).
 
-    Refuses anything that does not look like a sweep or Zarr store.
+    Refuses (:func:`check_overwrite`) anything this package did not make.
     """
-    if path.is_dir() and ((path / "zarr.json").is_file() or (path / MANIFEST).is_file()
-                          or (path / MARKERS).is_dir() or not any(path.iterdir())):
+    check_overwrite(path)
+    if path.is_dir():
         gone = path.parent / f".{path.name}.deleting-{os.getpid()}-{uuid.uuid4().hex[:8]}"
         try:
             os.rename(path, gone)
         except OSError as exc:
             raise io_error(exc, "removing the old store", path, resume=False) from None
         shutil.rmtree(gone, ignore_errors=True)
-    elif path.exists():
-        raise ParameterError(f"refusing to overwrite '{path}': it is not a Zarr store")
 
 
 # ---------------------------------------------------------------- location checks

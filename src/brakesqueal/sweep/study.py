@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any, TypeGuard, Union
 
 import numpy as np
 
+from ..validation import validated
 from ..errors import ParameterError
 from ..model.parameters import Value
 
@@ -415,6 +416,7 @@ def _read(path: str) -> tuple[str, dict[str, Any]]:
     return read_toml_text(path, "study file")
 
 
+@validated
 def load_study(study: StudySource) -> Study:
     """Read and validate a study.
 
@@ -440,6 +442,9 @@ def load_study(study: StudySource) -> Study:
         text, data = _read(str(study))
         return _from_data(data, str(study), text, Path(study).resolve().parent)
     if isinstance(study, Mapping):
+        from ..inputs import check_data
+
+        check_data(study, "study <dict>")
         return _from_data(dict(study), "<dict>", json.dumps(study, sort_keys=True, default=str), Path.cwd())
     raise ParameterError(f"a study is a TOML file path, a dict or a Study; got {type(study).__name__}")
 
