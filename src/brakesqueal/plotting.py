@@ -15,8 +15,8 @@ if TYPE_CHECKING:
     from .analysis.modes import ModeTracks
     from .results import CrossingResult, StabilityMap
 
-__all__ = ["new_figure", "styled", "plot_map", "plot_map_arrays", "map_title", "MAP_COLORS", "plot_path",
-           "plot_critical_curves", "save"]
+__all__ = ["new_figure", "styled", "plot_map", "plot_map_arrays", "map_title", "MAP_COLORS", "MAP_STABLE",
+           "MAP_UNSTABLE", "plot_path", "plot_critical_curves", "save"]
 
 _P = ParamSpec("_P")
 _R = TypeVar("_R")
@@ -65,6 +65,10 @@ def _label(name: str, units: str) -> str:
 
 #: Colourings of a map: the certified verdict, or a continuous field with the verdict's boundary on top.
 MAP_COLORS = ("verdict", "max_real", "frequency")
+#: Fill colour of the stable points of a verdict map (the explorer's map uses the same).
+MAP_STABLE = "#c8e6c9"
+#: Fill colour of the unstable (squealing) points of a verdict map (the explorer's map uses the same).
+MAP_UNSTABLE = "#f4c7c3"
 
 
 @overload
@@ -193,9 +197,10 @@ def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, 
     z = np.where(failed, np.nan, np.asarray(stable, dtype=float))
     handles: list[Artist] = []
     if color == "verdict":
-        ax.pcolormesh(xs, ys, z, cmap=ListedColormap(["#f4c7c3", "#c8e6c9"]), vmin=0, vmax=1, shading="nearest",
+        ax.pcolormesh(xs, ys, z, cmap=ListedColormap([MAP_UNSTABLE, MAP_STABLE]), vmin=0, vmax=1, shading="nearest",
                       rasterized=True)
-        handles += [Patch(facecolor="#c8e6c9", label="stable"), Patch(facecolor="#f4c7c3", label="unstable (squeal)")]
+        handles += [Patch(facecolor=MAP_STABLE, label="stable"),
+                    Patch(facecolor=MAP_UNSTABLE, label="unstable (squeal)")]
     else:
         from .labels import axis_label
 

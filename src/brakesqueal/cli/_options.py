@@ -53,7 +53,8 @@ PresetOpt = Annotated[Optional[str], typer.Option(
 ParamsOpt = Annotated[Optional[str], typer.Option(
     "--params", help="Parameter file (TOML: model, preset, [parameters]).", rich_help_panel="Model")]
 SetOpt = Annotated[Optional[list[str]], typer.Option(
-    "--set", help="NAME=VALUE in SI units (repeatable; 'inf' = rigid; setting a tied name replaces its tie).",
+    "--set", help="NAME=VALUE in SI units, or with a unit: 1200rpm, 5mm, 2kN/mm, 50km/h@0.3m (vehicle speed at "
+                  "a wheel radius), echoed in SI (repeatable; 'inf' = rigid; setting a tied name replaces its tie).",
     rich_help_panel="Model")]
 FormatOpt = Annotated[OutFormat, typer.Option("--format", help="Output format.")]
 NoCacheOpt = Annotated[bool, typer.Option("--no-cache", help="Derive in-process; do not read or write the cache.")]
@@ -148,7 +149,8 @@ def pads_option(space: ParameterSpace, pad_slope: float | None, stick_speed: flo
 
 
 def space_from(model: str | None, preset: str | None, params: str | None, sets: list[str] | None) -> ParameterSpace:
-    """The :class:`~brakesqueal.model.parameters.ParameterSpace` of the shared options (notes replaced ties).
+    """The :class:`~brakesqueal.model.parameters.ParameterSpace` of the shared options (notes values given
+    with units, in SI, and replaced ties).
 
     The options are checked first (:func:`brakesqueal.inputs.check_option`: never empty, never longer than
     the limits), so that messages name them as typed (``--preset``), not as the library's arguments."""
@@ -158,7 +160,12 @@ def space_from(model: str | None, preset: str | None, params: str | None, sets: 
     check_option(model, "--model")
     check_option(preset, "--preset", name=True)
     check_option(params, "--params")
+    from ..model.units import Quantity
+
     space = resolve_space(model, preset, params, list(sets or []))
+    for name, value in space.values.items():
+        if isinstance(value, Quantity):
+            note(value.echo(name))
     for name in space.untied:
         note(f"--set {name}=... replaces the tie {name} = {space.preset.tied[name]} of preset '{space.label}'")
     return space

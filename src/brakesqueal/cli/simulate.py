@@ -136,10 +136,18 @@ def _simulate_cmd(
                   {**init, "contact": contact.value})
         if wav and tr.t.size < 2:
             raise ParameterError("the trajectory has fewer than two samples; nothing to write to --wav")
-        _write(tr, out, plot, wav)
+        wav_s = _write(tr, out, plot, wav)
     summary = tr.summary
+    from ..model.components import coordinate_unit
+
     data = {**summary.to_dict(), "model": tr.model, "message": tr.message, "start": tr.start,
-            "t_end_reached": tr.t_end_reached, "wall_s": tr.stats.get("wall_s")}  # fmt: skip
+            "t_end_reached": tr.t_end_reached, "duration_s": tr.duration, "stop_reason": tr.stop_reason,
+            "amplitude_final_by_coordinate": {c: {"amplitude": a if math.isfinite(a) else None,
+                                                  "unit": coordinate_unit(c)}
+                                              for c, a in tr.final_amplitudes().items()},
+            "wall_s": tr.stats.get("wall_s")}  # fmt: skip
+    if wav_s is not None:
+        data["wav_s"] = wav_s
     if contact == ContactLaw.unilateral:
         data["contact"] = contact.value
         duty = tr.duty_cycle
@@ -151,6 +159,12 @@ def _simulate_cmd(
             sys.stdout.write(f"{k:22s} {v}\n")
     for w in summary.warnings:
         sys.stderr.write(f"brakesqueal: warning: {w}\n")
+    if tr.status != "finished" or wav_s is not None:
+        # why the run (and with it the WAV) is as long as it is: never a short file without a reason
+        note = f"the run {tr.stop_reason}"
+        if wav_s is not None:
+            note += f"; {wav} holds {wav_s:.4g} s of audio"
+        sys.stderr.write(f"brakesqueal: note: {note}\n")
     if tr.status == "failed":
         # outputs are written; exit status 1 distinguishes a solver failure from bad input (2)
         sys.stderr.write(f"brakesqueal: simulation failed: {tr.message}\n")
@@ -174,8 +188,8 @@ def _run(p: Parameters, t_end: float, method: str, rtol: float, atol: float | No
         )  # fmt: skip
 
 
-def _write(tr: Trajectory, out: str | None, plot: str | None, wav: str | None) -> None:
-    """Write the outputs atomically (each OSError: one line naming the option)."""
+def _write(tr: Trajectory, out: str | None, plot: str | None, wav: str | None) -> float | None:
+    """Write the outputs atomically (each OSError: one line naming the option); the WAV's length [s] or None."""
     from ..interrupts import check_interrupt
 
     if out:
@@ -188,7 +202,9 @@ def _write(tr: Trajectory, out: str | None, plot: str | None, wav: str | None) -
         write_with(plot, lambda tmp: fig.savefig(tmp, dpi=300), what="--plot")
         check_interrupt()
     if wav:
-        tr.to_wav(wav, what="--wav")
+        rate = 44100
+        return tr.to_wav(wav, rate=rate, what="--wav") / rate
+    return None
 
 
 def register(app: typer.Typer) -> None:

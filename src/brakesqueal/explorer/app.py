@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import contextlib
 import html
+import io
 import json
 import logging
 import math
@@ -33,6 +34,7 @@ from typing import TYPE_CHECKING, Any, Concatenate, Final, Literal, ParamSpec, T
 import numpy as np
 
 from ..errors import BrakesquealError, ParameterError
+from ..plotting import MAP_STABLE, MAP_UNSTABLE
 from .state import (
     AUDIO_RATE,
     LINK_KEYS,
@@ -53,9 +55,12 @@ from .state import (
     hopf_text,
     link_limit_message,
     locus_lines,
+    locus_file,
     locus_view,
+    map_file,
     map_view,
     simulation_view,
+    slider_names,
     slider_range,
 )
 from .worker import Cancelled, CannotSend, ChildProcess, LatestWorker
@@ -93,7 +98,11 @@ URL_DELAY_MS = 400
 #: the steps of a moving slider, so that their work and their update of the page stay off its path).
 INFO_REST_MS = 250
 _LOG_FORMAT = "return Number((10 ** tick).toPrecision(3)).toExponential();"
-_MAP_PALETTE = ["#f3a5a5", "#a9cdf5", "#c8c8c8"]  # unstable, stable, no verdict
+#: The map's fill colours (unstable, stable, no verdict): the command line's map figures' (green stable, red unstable).
+_MAP_PALETTE = [MAP_UNSTABLE, MAP_STABLE, "#c8c8c8"]
+#: Colours of the current point and of stable and unstable limit cycles: matplotlib's C0 and C3, as in the command
+#: line's figures (stable cycles drawn in C0, unstable ones in C3).
+_POINT, _CYCLE_STABLE, _CYCLE_UNSTABLE = "#1f77b4", "#1f77b4", "#d62728"
 #: Look of the message line (Bootstrap's "danger" alert, as Panel's Alert pane had).
 _ALERT_STYLE = {"background-color": "#f8d7da", "color": "#721c24", "border": "1px solid #f5c6cb",
                 "border-radius": "4px", "padding": "0.5em 1em"}
@@ -101,6 +110,9 @@ _ALERT_STYLE = {"background-color": "#f8d7da", "color": "#721c24", "border": "1p
 #: the overlay layer of a plot when only overlay renderers changed, not its axes, grids and lines.  They have
 #: no legend entries (an overlay repaint erases their legend glyphs); titles and the map's legend text name them.
 _MOVING: Final = "overlay"
+#: Widths [px] of the page's columns: the controls, each of the two views of a row, the texts beside the map.  With
+#: Panel's margins the page is about 1,230 px wide: it fits a 1280 px screen without a horizontal scroll bar.
+_LEFT, _HALF, _TEXTS = 360, 410, 400
 
 
 def _fmt_value(v: float) -> str:
@@ -454,11 +466,15 @@ class Explorer:
         self.alert = pn.pane.HTML("", visible=False, sizing_mode="stretch_width", css_classes=["bs-alert"],
                                   styles=_ALERT_STYLE)  # escaped text: never Markdown (a link's value is in it)
         self.params_box = pn.Column(sizing_mode="stretch_width")
+        self.more_box = pn.Card(title="more parameters", collapsed=True, sizing_mode="stretch_width",
+                                css_classes=["bs-more"])
+        self.more_box.param.watch(self._on_more_card, "collapsed")
+        self._more_names: list[str] = []
         self.fixed_box = pn.Card(title="fixed parameters", collapsed=True, sizing_mode="stretch_width")
         self.fixed_box.param.watch(self._on_fixed_card, "collapsed")
-        self.along_select = pn.widgets.Select(name="root locus along", width=130)
-        self.x_select = pn.widgets.Select(name="map x", width=100)
-        self.y_select = pn.widgets.Select(name="map y", width=100)
+        self.along_select = pn.widgets.Select(name="root locus along", width=120)
+        self.x_select = pn.widgets.Select(name="map x", width=95)
+        self.y_select = pn.widgets.Select(name="map y", width=95)
         self.nx_input = pn.widgets.IntInput(name="x points", value=self.state.nx, start=2, width=90)
         self.ny_input = pn.widgets.IntInput(name="y points", value=self.state.ny, start=2, width=90)
         for w in (self.along_select, self.x_select, self.y_select, self.nx_input, self.ny_input):
@@ -484,9 +500,33 @@ class Explorer:
                                      sizing_mode="stretch_width")
         self.cycles_text = pn.pane.HTML("Press Cycles to continue the limit cycles from the Hopf point on the path.",
                                         sizing_mode="stretch_width")
+        # export of the current view: the map's data with the library's writers, the modes along the locus's path
+        # (the figures' own "save" tools write PNG files)
+        self._map_view: MapView | None = None
+        self.map_nc_download = pn.widgets.FileDownload(callback=partial(self._map_file, "netcdf"), filename="map.nc",
+                                                       label="map (NetCDF)", width=115, disabled=True,
+                                                       css_classes=["bs-export-map-nc"])
+        self.map_csv_download = pn.widgets.FileDownload(callback=partial(self._map_file, "csv"), filename="map.csv",
+                                                        label="map (CSV)", width=105, disabled=True,
+                                                        css_classes=["bs-export-map-csv"])
+        self.locus_download = pn.widgets.FileDownload(callback=self._locus_file, filename="locus.csv",
+                                                      label="locus (CSV)", width=115, disabled=True,
+                                                      css_classes=["bs-export-locus"])
         self.dynamics_box = pn.Column()  # the simulation's and cycles' views, built on first use
         self.fig_hist: Any = None
         self.render = pn.pane.HTML(self._render_html(), width=0, height=0, margin=0)
+
+    def _map_file(self, fmt: str) -> io.BytesIO:
+        """The shown map as a file (:func:`~.state.map_file`)."""
+        if self._map_view is None:
+            raise ParameterError("no map is shown yet")
+        return io.BytesIO(map_file(self._map_view, fmt))
+
+    def _locus_file(self) -> io.BytesIO:
+        """The modes along the shown root locus's path as CSV (:func:`~.state.locus_file`)."""
+        if self._drawn_tracks is None:
+            raise ParameterError("no root locus is shown yet")
+        return io.BytesIO(locus_file(self._drawn_tracks))
 
     def _axis_options(self) -> None:
         names = list(self.space.settable())
@@ -512,35 +552,52 @@ class Explorer:
         return {n: slider_range(base, n) for n in self.space.settable()}
 
     def _rebuild_parameters(self) -> None:
-        """One slider and one typed input per free name; typed inputs for the fixed names."""
-        pn = self.pn
-        from bokeh.models import CustomJSTickFormatter
-
+        """One slider and one typed input per free name (the most important ones shown, the others in the
+        "more parameters" card, built when it is first opened); typed inputs for the fixed names."""
         self.sliders: dict[str, Any] = {}
         self.inputs: dict[str, Any] = {}
         self.ranges = self._preset_ranges()
-        rows = []
-        space = self.space
-        for name in space.preset.free:
-            rng = self.ranges[name]
-            value = space.value(name)
-            kw: dict[str, Any] = {"format": CustomJSTickFormatter(code=_LOG_FORMAT)} if rng.log else {}
-            lo, hi = rng.to_slider(rng.low), rng.to_slider(rng.high)
-            slider = pn.widgets.FloatSlider(name=_label(space, name), start=lo, end=hi, step=(hi - lo) / 500,
-                                            value=rng.to_slider(value), width=230, css_classes=[f"bs-slider-{name}"],
-                                            **kw)
-            box = pn.widgets.TextInput(value=_fmt_value(value), width=110, name=" ",
-                                       css_classes=[f"bs-input-{name}"])
-            slider.param.watch(lambda e, n=name: self._on_slider(n, e.new), "value")
-            box.param.watch(lambda e, n=name: self._on_text(n, e.new), "value")
-            _undebounce(slider, box)
-            self.sliders[name], self.inputs[name] = slider, box
-            rows.append(pn.Row(slider, box, sizing_mode="stretch_width"))
-        self.params_box.objects = rows
+        shown, self._more_names = slider_names(self.space)
+        self.params_box.objects = [self._slider_row(name) for name in shown]
+        self.more_box.title = f"more parameters ({len(self._more_names)})"
+        self.more_box.visible = bool(self._more_names)
+        self.more_box.objects = []
+        if not self.more_box.collapsed:
+            self._build_more()
         self.fixed_box.objects = []
         if not self.fixed_box.collapsed:
             self._build_fixed()
         self._axis_options()
+
+    def _slider_row(self, name: str) -> Viewable:
+        """The slider and typed input of a free name."""
+        pn = self.pn
+        from bokeh.models import CustomJSTickFormatter
+
+        space = self.space
+        rng = self.ranges[name]
+        value = space.value(name)
+        kw: dict[str, Any] = {"format": CustomJSTickFormatter(code=_LOG_FORMAT)} if rng.log else {}
+        lo, hi = rng.to_slider(rng.low), rng.to_slider(rng.high)
+        slider = pn.widgets.FloatSlider(name=_label(space, name), start=lo, end=hi, step=(hi - lo) / 500,
+                                        value=rng.to_slider(value), width=210, css_classes=[f"bs-slider-{name}"],
+                                        **kw)
+        box = pn.widgets.TextInput(value=_fmt_value(value), width=100, name=" ",
+                                   css_classes=[f"bs-input-{name}"])
+        slider.param.watch(lambda e, n=name: self._on_slider(n, e.new), "value")
+        box.param.watch(lambda e, n=name: self._on_text(n, e.new), "value")
+        _undebounce(slider, box)
+        self.sliders[name], self.inputs[name] = slider, box
+        return pn.Row(slider, box, sizing_mode="stretch_width")
+
+    def _build_more(self) -> None:
+        """The sliders of the less important free names (built when their card is first opened)."""
+        self.more_box.objects = [self._slider_row(name) for name in self._more_names]
+
+    @_batched
+    def _on_more_card(self, event: Event) -> None:
+        if not event.new and not self.more_box.objects and self._more_names:
+            self._build_more()
 
     def _build_fixed(self) -> None:
         """Typed inputs for the fixed names (built when their card is first opened: a dozen inputs fewer to
@@ -573,8 +630,8 @@ class Explorer:
         pn = self.pn
         self.src_locus = ColumnDataSource(locus_lines(np.empty(0), np.empty((0, 0))))
         self.src_now = ColumnDataSource({"re": [], "im": []})
-        f = figure(height=330, width=420, title="root locus along the path; red: the current eigenvalues",
-                   x_axis_label="Re λ [1/s]", y_axis_label="Im λ [1/s]", tools="pan,wheel_zoom,box_zoom,reset")
+        f = figure(height=330, width=_HALF, title="root locus along the path; red: the current eigenvalues",
+                   x_axis_label="Re λ [1/s]", y_axis_label="Im λ [1/s]", tools="pan,wheel_zoom,box_zoom,reset,save")
         f.line("re", "im", source=self.src_locus, line_width=1.5, color="#4c72b0", alpha=0.8)
         f.scatter("re", "im", source=self.src_now, size=9, color="#d62728", level=_MOVING)
         f.add_layout(Span(location=0, dimension="height", line_color="black", line_dash="dashed", line_width=1))
@@ -605,21 +662,21 @@ class Explorer:
         pn = self.pn
         self.src_hist = ColumnDataSource({"t": [], "x": []})
         self.src_spec = ColumnDataSource({"f": [], "a": []})
-        h = figure(height=220, width=520, title="time history", x_axis_label="t [s]", y_axis_label="deviation",
-                   tools="pan,wheel_zoom,box_zoom,reset")
+        h = figure(height=220, width=480, title="time history", x_axis_label="t [s]", y_axis_label="deviation",
+                   tools="pan,wheel_zoom,box_zoom,reset,save")
         h.line("t", "x", source=self.src_hist, line_width=0.8)
         self.fig_hist = h
-        s = figure(height=220, width=360, title="spectrum", x_axis_label="frequency [Hz]",
-                   y_axis_label="amplitude", y_axis_type="log", tools="pan,wheel_zoom,box_zoom,reset")
+        s = figure(height=220, width=340, title="spectrum", x_axis_label="frequency [Hz]",
+                   y_axis_label="amplitude", y_axis_type="log", tools="pan,wheel_zoom,box_zoom,reset,save")
         s.line("f", "a", source=self.src_spec, line_width=0.8)
         self.fig_spec = s
         self.src_cycles = ColumnDataSource({"p": [], "a": [], "color": []})
         self.span_loss = Span(location=None, dimension="height", line_color="#d62728", line_dash="dotted",
                               line_width=2)
         c = figure(height=220, width=420,
-                   title="limit cycles (blue: stable, orange: unstable, grey: beyond the contact loss)",
+                   title="limit cycles (blue: stable, red: unstable, grey: beyond the contact loss)",
                    x_axis_label="path parameter", y_axis_label="tilt amplitude [rad]",
-                   tools="pan,wheel_zoom,box_zoom,reset")
+                   tools="pan,wheel_zoom,box_zoom,reset,save")
         c.scatter("p", "a", source=self.src_cycles, color="color", size=5)
         c.add_layout(self.span_loss)
         if isinstance(c.title, Title):  # figure() made it one
@@ -636,12 +693,12 @@ class Explorer:
         xt: Literal["log", "linear"] = "log" if log else "linear"
         name = self.state.along
         lab = _label(self.space, name)
-        a = figure(height=165, width=420, title="mode coupling", x_axis_type=xt, y_axis_label="f [Hz]",
-                   tools="pan,wheel_zoom,box_zoom,reset")
+        a = figure(height=165, width=_HALF, title="mode coupling", x_axis_type=xt, y_axis_label="f [Hz]",
+                   tools="pan,wheel_zoom,box_zoom,reset,save")
         a.line("value", "freq", source=self.src_locus, line_width=1.5, color="#4c72b0")
         a.add_layout(self.span_f)
-        b = figure(height=165, width=420, x_axis_type=xt, x_axis_label=lab, y_axis_label="Re λ [1/s]",
-                   x_range=a.x_range, tools="pan,wheel_zoom,box_zoom,reset")
+        b = figure(height=165, width=_HALF, x_axis_type=xt, x_axis_label=lab, y_axis_label="Re λ [1/s]",
+                   x_range=a.x_range, tools="pan,wheel_zoom,box_zoom,reset,save")
         b.line("value", "re", source=self.src_locus, line_width=1.5, color="#4c72b0")
         b.add_layout(self.span_r)
         return column(a, b)
@@ -653,15 +710,15 @@ class Explorer:
         from bokeh.plotting import figure
 
         st = self.state
-        f = figure(height=380, width=470, title="stability map (green cross: the current point; click to move there)",
+        f = figure(height=380, width=450, title="stability map (blue cross: the current point; click to move there)",
                    x_axis_label=_label(self.space, st.x) + (" (log)" if x_log else ""),
                    y_axis_label=_label(self.space, st.y) + (" (log)" if y_log else ""),
-                   tools="tap,pan,wheel_zoom,box_zoom,reset")
+                   tools="tap,pan,wheel_zoom,box_zoom,reset,save")
         # color_mapper: a property of the Image glyph that bokeh's typed image() keywords leave out
         f.image("image", x="x", y="y", dw="dw", dh="dh", source=self.src_map,
                 color_mapper=self.map_mapper)  # type: ignore[call-arg]
         f.line("x", "y", source=self.src_boundary, line_color="black", line_width=2, legend_label="boundary")
-        f.scatter("x", "y", source=self.src_point, marker="cross", size=16, line_width=3, color="#2ca02c",
+        f.scatter("x", "y", source=self.src_point, marker="cross", size=16, line_width=3, color=_POINT,
                   level=_MOVING)
         f.legend.location = "bottom_right"
         if isinstance(f.title, Title):  # figure() made it one
@@ -680,19 +737,20 @@ class Explorer:
         pn = self.pn
         head = pn.Row(pn.pane.HTML("<h2 style='margin:4px 0'>brakesqueal explorer</h2>"), self.model_select,
                       self.preset_select, sizing_mode="stretch_width")
-        left = pn.Column(self.params_box, self.fixed_box,
+        left = pn.Column(self.params_box, self.more_box, self.fixed_box,
                          pn.Row(self.along_select, self.x_select, self.y_select),
                          pn.Row(self.nx_input, self.ny_input, self.map_progress),
                          pn.Row(self.t_end_input, self.sim_button),
                          pn.Row(self.cycles_button, self.cancel_button, self.cycles_progress),
                          self.sim_progress,
-                         width=400)
-        legend = pn.pane.HTML("<small>map: <span style='background:#a9cdf5'>&nbsp;stable&nbsp;</span> "
-                              "<span style='background:#f3a5a5'>&nbsp;unstable&nbsp;</span> "
+                         width=_LEFT)
+        legend = pn.pane.HTML(f"<small>map: <span style='background:{MAP_STABLE}'>&nbsp;stable&nbsp;</span> "
+                              f"<span style='background:{MAP_UNSTABLE}'>&nbsp;unstable&nbsp;</span> "
                               "<span style='background:#c8c8c8'>&nbsp;no verdict&nbsp;</span>; black: the exact "
-                              "boundary (refined by bisection); green cross: the current point</small>")
-        texts = pn.Column(self.leading_text, self.cs_text, self.hopf_text, self.map_text, legend, self.sim_text,
-                          self.cycles_text, width=460)
+                              "boundary (refined by bisection); blue cross: the current point</small>")
+        export = pn.Row(self.map_nc_download, self.map_csv_download, self.locus_download)
+        texts = pn.Column(self.leading_text, self.cs_text, self.hopf_text, self.map_text, legend, export, self.sim_text,
+                          self.cycles_text, width=_TEXTS)
         views = pn.Column(pn.Row(self.pane_locus, self.pane_modes), pn.Row(self.pane_map, texts),
                           self.dynamics_box)
         return pn.Column(head, self.alert, pn.Row(left, views), self.render, sizing_mode="stretch_width")
@@ -864,7 +922,7 @@ class Explorer:
                 lifted = np.abs(cv.p - cv.p[0]) > abs(cv.contact_loss - cv.p[0])
             judged = cv.judged if cv.judged is not None else np.ones(cv.p.size, dtype=bool)
             self.src_cycles.data = {"p": cv.p, "a": cv.amplitude,
-                                    "color": ["#bbbbbb" if off or not ok else "#4c72b0" if st else "#dd8452"
+                                    "color": ["#bbbbbb" if off or not ok else _CYCLE_STABLE if st else _CYCLE_UNSTABLE
                                               for st, off, ok in zip(cv.stable, lifted, judged)]}
             self.span_loss.location = cv.contact_loss
             self.fig_cycles.xaxis.axis_label = _label(self.origin.space_of(state), state.along)
@@ -972,12 +1030,15 @@ class Explorer:
         if tr is not None and tr is not self._drawn_tracks:  # unchanged paths are not sent again
             self._drawn_tracks = tr
             self.src_locus.data = locus_lines(tr.values, tr.eigenvalues)  # float64 arrays: binary buffers
+            self.locus_download.filename = f"locus_{state.along}.csv"
+            self.locus_download.disabled = False
             log_now = bool(tr.log)
             if getattr(self, "_modes_key", None) != (state.along, log_now, state.model, state.preset):
                 self._modes_key = (state.along, log_now, state.model, state.preset)
                 self.pane_modes.object = self._modes_figure(log_now)
         if lv.message:  # no path: clear the previous one rather than show it for another point
             self._drawn_tracks = None
+            self.locus_download.disabled = True
             self.src_locus.data = locus_lines(np.empty(0), np.empty((0, 0)))
             self.leading_text.object += f"<br><i>{html.escape(lv.message)}</i>"
         x, y = self._map_point(space, state)
@@ -1085,6 +1146,10 @@ class Explorer:
         bx = np.log10(mv.boundary_x) if mv.x_log else mv.boundary_x
         by = np.log10(mv.boundary_y) if mv.y_log else mv.boundary_y
         self.src_boundary.data = {"x": bx, "y": by}
+        self._map_view = mv
+        for w, suffix in ((self.map_nc_download, "nc"), (self.map_csv_download, "csv")):
+            w.filename = f"map_{state.x}_{state.y}.{suffix}"
+            w.disabled = False
         space = self.origin.space_of(state)
         px, py = self._map_point(space, state)
         self.src_point.data = {"x": [px], "y": [py]}

@@ -43,6 +43,7 @@ __all__ = ["MAX_MAP_POINTS", "MAX_T_END", "LOCUS_POINTS", "AUDIO_RATE", "SliderR
            "slider_range", "format_eigenvalue", "leading_eigenvalue", "MapView", "map_view", "LocusView",
            "locus_view", "locus_lines", "critical_speed_text", "hopf_scan", "hopf_text", "SimulationView",
            "simulation_view", "check_map_size", "check_t_end", "Origin", "audio_samples", "default_axes",
+           "MAX_SLIDERS", "ROLE_RANK", "important_names", "slider_names", "MAP_FORMATS", "map_file", "locus_file",
            "stability_names", "CyclesView", "cycles_view", "LINK_KEYS", "MAX_LINK_VALUE", "MAX_LINK_SET",
            "MAX_LINK_PARAMS", "REFUSED_KEY", "link_problem", "link_limit_message"]
 
@@ -311,25 +312,91 @@ class ViewState:
                    nx=integer("nx", default.nx), ny=integer("ny", default.ny), t_end=t_end)
 
 
+#: Most parameter sliders the page shows at first; a model's other free names are behind "more parameters".
+MAX_SLIDERS = 8
+#: Rank of a parameter role in :func:`important_names` (lower first): the spin rate, the friction coefficients,
+#: the pads' tangential stiffnesses, the other stiffnesses; any other friction field (a slope), the preload.
+#: Every other role (inertias, masses, dampings, geometry) comes after these, in the model's order.
+ROLE_RANK: Mapping[str, int] = {
+    "disk.Omega": 0, "friction.mu": 1, "pad.k_ip": 2,
+    "pad.k": 3, "disk.k_t": 3, "caliper.k_n": 3, "caliper.k_t": 3, "pad.k_c": 3,
+}
+_OTHER_FRICTION, _PRELOAD, _REST = 4, 5, 6
+
+
+def _role_rank(key: str) -> int:
+    if key in ROLE_RANK:
+        return ROLE_RANK[key]
+    if key.startswith("friction."):
+        return _OTHER_FRICTION
+    return _PRELOAD if key == "pad.preload" else _REST
+
+
+def important_names(space: ParameterSpace, names: Sequence[str]) -> list[str]:
+    """``names`` ordered by what an engineer varies first: by the rank of their roles (:data:`ROLE_RANK`).
+
+    The spin rate ``Omega``, the friction coefficients, the pads' tangential
+    stiffnesses ``k_ip``, the other stiffnesses, other friction fields, the
+    preload; then the rest (inertias ``Theta``/``Phi``, masses, dampings,
+    geometry).  Names of equal rank keep their order in ``names``; a name of
+    no known role (a preset's derived name) counts as the rest.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The space (its model gives the roles).
+    names : Sequence[str]
+        Settable names.
+
+    Returns
+    -------
+    list of str
+    """
+    from ..model.roles import parameter_roles
+
+    uses = parameter_roles(space.model).uses
+    rank = {n: min((_role_rank(role.key) for role, _ in uses.get(n, ())), default=_REST) for n in names}
+    return sorted(names, key=lambda n: rank[n])  # (a stable sort)
+
+
+def slider_names(space: ParameterSpace) -> tuple[list[str], list[str]]:
+    """The free names whose sliders the page shows at first, and the others (behind "more parameters").
+
+    A preset with at most :data:`MAX_SLIDERS` free names shows them all, in its order; a larger one (a model
+    file's default preset frees every parameter) shows its :data:`MAX_SLIDERS` most :func:`important_names`.
+    """
+    free = list(space.preset.free)
+    if len(free) <= MAX_SLIDERS:
+        return free, []
+    ranked = important_names(space, free)
+    shown = set(ranked[:MAX_SLIDERS])
+    return [n for n in ranked if n in shown], [n for n in free if n not in shown]
+
+
 def default_axes(space: ParameterSpace) -> tuple[str, str, str]:
-    """Default ``(along, x, y)`` of a space: its first two free names that move the least-stable eigenvalue.
+    """Default ``(along, x, y)`` of a space: its two most important free names that move the least-stable eigenvalue.
 
     A preset with two free names (``paper-fig2``: ``mu``, ``k_ip``) keeps
-    them.  With more, names on which the verdict cannot depend at the current
-    point are passed over (:func:`stability_names`; e.g. the ``belt``'s disk
-    thickness, whose map would be uniformly unstable).
+    them.  With more, they are ordered by :func:`important_names` (so a model
+    with a spin rate and a friction coefficient gets the map ``Omega`` ×
+    ``mu``, never the disk's inertias ``Theta`` × ``Phi``), and names on which
+    the verdict cannot depend at the current point are passed over
+    (:func:`stability_names`; e.g. the ``belt``'s disk thickness, whose map
+    would be uniformly unstable).  The root locus runs along ``y``.
     """
     names = list(space.settable())
     free = list(space.preset.free) or names
     if len(free) > 2:
+        free = important_names(space, free)
         free = stability_names(space, free) or free
-    along = free[0]
-    if len(free) >= 2:
+    if len(free) > 2:
+        x, y = free[0], free[1]
+    elif len(free) == 2:
         x, y = free[1], free[0]
     else:
-        others = [n for n in names if n != along]
-        x, y = (others[0] if others else along), along
-    return along, x, y
+        others = [n for n in names if n != free[0]]
+        x, y = (others[0] if others else free[0]), free[0]
+    return y, x, y
 
 
 def stability_names(space: ParameterSpace, names: list[str]) -> list[str]:
@@ -490,6 +557,7 @@ class MapView:
     boundary_x: np.ndarray
     boundary_y: np.ndarray
     method: str
+    result: StabilityMap | None = field(default=None, compare=False, repr=False)
 
 
 def map_view(space: ParameterSpace, x: str, y: str, rx: SliderRange, ry: SliderRange, nx: int, ny: int, *,
@@ -518,7 +586,51 @@ def map_view(space: ParameterSpace, x: str, y: str, rx: SliderRange, ry: SliderR
     bx = ds[f"boundary_{x}"].values if f"boundary_{x}" in ds else np.empty(0)
     by = ds[f"boundary_{y}"].values if f"boundary_{y}" in ds else np.empty(0)
     return MapView(ds[x].values, ds[y].values, rx.log, ry.log, mr, stable, status, np.asarray(bx, dtype=float),
-                   np.asarray(by, dtype=float), str(ds.attrs.get("method", "")))
+                   np.asarray(by, dtype=float), str(ds.attrs.get("method", "")), m)
+
+
+#: Formats of an exported map: its writer's file suffix.
+MAP_FORMATS: Mapping[str, str] = {"netcdf": "nc", "csv": "csv"}
+
+
+def map_file(mv: MapView, fmt: str) -> bytes:
+    """The map of a view as a file: the library's own writers (:meth:`~brakesqueal.results.StabilityMap.to_netcdf`,
+    :meth:`~brakesqueal.results.StabilityMap.to_csv`).
+
+    Parameters
+    ----------
+    mv : MapView
+        A view made by :func:`map_view`.
+    fmt : {"netcdf", "csv"}
+        The format.
+
+    Returns
+    -------
+    bytes
+
+    Raises
+    ------
+    ParameterError
+        An unknown format, or a view without its map.
+    """
+    import tempfile
+    from pathlib import Path
+
+    if fmt not in MAP_FORMATS:
+        raise ParameterError(f"map format must be one of {', '.join(MAP_FORMATS)}; got {fmt!r}")
+    if mv.result is None:
+        raise ParameterError("this map view holds no map to export")
+    with tempfile.TemporaryDirectory(prefix="brakesqueal-export-") as tmp:
+        path = str(Path(tmp) / f"map.{MAP_FORMATS[fmt]}")
+        (mv.result.to_netcdf if fmt == "netcdf" else mv.result.to_csv)(path)
+        return Path(path).read_bytes()
+
+
+def locus_file(tracks: ModeTracks) -> bytes:
+    """The modes along the root locus's path as CSV, one row per (path value, mode): the columns of
+    :meth:`~brakesqueal.analysis.modes.ModeTracks.to_xarray` (``real`` [1/s], ``frequency`` [Hz], ...)."""
+    ds = tracks.to_xarray()
+    return str(ds.to_dataframe().reset_index().to_csv(index=False)).encode("utf-8")
 
 
 # ---------------------------------------------------------------------------------------------- speeds, Hopf

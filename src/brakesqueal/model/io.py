@@ -425,7 +425,8 @@ def load_parameter_file(path: str) -> tuple[str | None, str | None, dict[str, Va
     preset : str or None
         The ``preset`` key.
     entries : dict
-        The ``[parameters]`` table: numbers or expression strings.
+        The ``[parameters]`` table: numbers or expression strings (a number with a unit, ``"1200 rpm"``,
+        in SI: a :class:`~.units.Quantity`).
 
     Raises
     ------
@@ -449,11 +450,16 @@ def load_parameter_file(path: str) -> tuple[str | None, str | None, dict[str, Va
     if isinstance(model, str) and (model.endswith(".toml") and not os.path.isabs(model)):
         model = os.path.join(os.path.dirname(os.path.abspath(path)), model)
     table = _table(data, "parameters", where, what="a table ([parameters])")
+    from .units import parse_quantity
+
+    entries: dict[str, Value] = {}
     for key, value in table.items():
         if isinstance(value, bool) or not isinstance(value, (int, float, str)):
             raise ParameterError(f"{where}: key 'parameters.{key}' must be a number or an expression string; "
                                  f"got {value!r} ({type(value).__name__})")
-    return model, preset, dict(table)
+        quantity = parse_quantity(value, f"{where}: parameters.{key} = {value!r}") if isinstance(value, str) else None
+        entries[key] = value if quantity is None else quantity  # "1200 rpm": in SI, checked against the unit
+    return model, preset, entries
 
 
 def parameters_to_toml(params: Parameters) -> str:

@@ -33,6 +33,7 @@ import numpy as np
 from ..inputs import MAX_EXPRESSION_CHARS, MAX_NAME_CHARS, number_problem, shown
 from ..errors import ParameterError
 from .expressions import RESERVED_NAMES, dependency_order, evaluate, evaluate_array, names_in, to_sympy
+from .units import check_quantity, parse_quantity
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -159,6 +160,8 @@ class Parameters(Mapping[str, float]):
             raise ParameterError(f"{where}missing parameter(s) {', '.join(missing)} of model '{spec.name}' "
                                  "(give all of them or start from a preset)", parameter=missing[0],
                                  names=tuple(missing))
+        for n in names:
+            check_quantity(n, values[n], spec.unit(n))
         vals = {n: _number(values[n], f"{where}value of '{n}'", n) for n in names}
         probs = problems(spec.roles(), vals)
         if probs:
@@ -370,6 +373,7 @@ class Preset:
         overrides = dict(overrides or {})
         for name in overrides:
             self.check_name(name)
+            check_quantity(name, overrides[name], self.unit(name))
         defs = {**self.fixed, **self.free}
         tied = {k: v for k, v in self.tied.items() if k not in overrides}
         values = {n: _number(overrides.get(n, d), f"value of '{n}'", n) for n, d in defs.items()}
@@ -444,8 +448,9 @@ class ParameterSpace:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "values", MappingProxyType(dict(self.values)))
-        for n in self.values:
+        for n, v in self.values.items():
             self.preset.check_name(n)
+            check_quantity(n, v, self.preset.unit(n))
 
     # ---------------------------------------------------------------- construction
     @classmethod
@@ -644,6 +649,13 @@ def parse_sets(sets: Sequence[str], *, option: str = "--set") -> dict[str, Value
         problem = number_problem(value)
         if problem:
             raise ParameterError(f"{says(name, value)}: the number {problem}", parameter=name)
+        try:
+            quantity = parse_quantity(value, says(name, value))
+        except ParameterError as exc:
+            raise exc.about(name) from None
+        if quantity is not None:
+            overrides[name] = quantity
+            continue
         try:
             number = float(value)
         except ValueError:

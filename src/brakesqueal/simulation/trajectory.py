@@ -764,9 +764,73 @@ class Trajectory:
         mode = self.modes.left[:, 0] if self.modes is not None else None
         return integration_error_bound(x, x + self.silent_state, self.rtol, self.atol, float(steps), dur, mode)
 
-    def spectrum(self) -> tuple[np.ndarray, np.ndarray]:
-        """Hann-windowed amplitude spectrum of the first coordinate's deviation: ``(frequency [Hz], |X|)``."""
-        x = self.dq[:, 0] - self.dq[:, 0].mean()
+    @property
+    def main_coordinate(self) -> int:
+        """Index of the coordinate that carries the motion: the one the plot's phase portrait and spectrum show.
+
+        A tilting disk: the tilt (``q1`` or ``q2``) with the larger RMS deviation from the silent motion over
+        the output samples (a mode can move ``q2`` while ``q1`` hardly moves); a non-tilting disk: the
+        coordinate with the largest RMS deviation (all displacements [m]).  0 without samples.
+        """
+        cand = [j for j, c in enumerate(self.coords) if c.startswith("q")] if self.tilting else list(range(self.n))
+        if not cand or self.t.size == 0:
+            return 0
+        d = self.dq[:, cand]
+        rms = np.sqrt(np.nanmean(np.where(np.isfinite(d), d, np.nan) ** 2, axis=0))
+        return cand[int(np.nanargmax(rms))] if np.any(np.isfinite(rms)) else cand[0]
+
+    def final_amplitudes(self) -> dict[str, float]:
+        """``max |Q_j - Q_j0|`` of each coordinate over the last two periods of the output samples.
+
+        The period is that of :attr:`summary`'s frequency (else the last tenth of the record).  Each value is
+        in its coordinate's unit (:func:`~brakesqueal.model.components.coordinate_unit`: tilts ``q...`` [rad],
+        displacements [m]), unlike :attr:`Summary.amplitude_final`, the norm over all coordinates.
+
+        Returns
+        -------
+        dict
+            Coordinate name -> amplitude (NaN without samples).
+        """
+        if self.t.size == 0:
+            return {c: math.nan for c in self.coords}
+        f = self.summary.frequency_hz
+        dt = float(self.t[1] - self.t[0]) if self.t.size > 1 else 0.0
+        per = int(2 / (f * dt)) if math.isfinite(f) and f > 0 and dt > 0 else self.t.size // 10
+        per = max(min(per, self.t.size), 1)
+        tail = np.abs(self.dq[-per:])
+        return {c: float(np.nanmax(tail[:, j])) if np.any(np.isfinite(tail[:, j])) else math.nan
+                for j, c in enumerate(self.coords)}
+
+    @property
+    def duration(self) -> float:
+        """Simulated time [s]: from the start to :attr:`t_end_reached` (the length of the WAV's signal)."""
+        return self.t_end_reached - float(self.t_span[0])
+
+    @property
+    def stop_reason(self) -> str:
+        """One line: how long the run lasted and why it ended (end time reached, an event, a failure).
+
+        Every output carries it (the CLI's text and JSON, NetCDF ``attrs["stop_reason"]``, the plot), so an
+        early stop (e.g. a contact loss with ``events="stop"``) and a short WAV never go unexplained.
+        """
+        t_req = float(self.t_span[1] - self.t_span[0])
+        if self.status == "finished":
+            return f"ran the whole {_seconds(t_req)}"
+        why = self.message or str(self.status)
+        what = "failed" if self.status == "failed" else "stopped early"
+        return f"{what} after {_seconds(self.duration)} of {_seconds(t_req)}: {why}"
+
+    def spectrum(self, coordinate: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """Hann-windowed amplitude spectrum of a coordinate's deviation: ``(frequency [Hz], |X|)``.
+
+        Parameters
+        ----------
+        coordinate : int, optional
+            Index of the coordinate (default 0, the first; :attr:`main_coordinate` is the one that carries
+            the motion, which :meth:`plot` shows).
+        """
+        j = int(coordinate)
+        x = self.dq[:, j] - self.dq[:, j].mean()
         w = np.hanning(x.size)
         X = np.abs(np.fft.rfft(x * w)) * 2 / w.sum()
         f = np.fft.rfftfreq(x.size, self.t[1] - self.t[0])
@@ -779,8 +843,15 @@ class Trajectory:
         coordinate's); the envelope joins the peaks of the combined deviation
         ``sqrt(sum dq_i^2)`` (no edge effects of a transform); the phase
         portrait shows the last three periods of the squeal frequency (the
-        whole record would fill an annulus).  Returns the matplotlib ``Figure``
-        (never calls ``show``), in the package's figure style (two journal columns wide).
+        whole record would fill an annulus).  Phase portrait and spectrum show
+        the coordinate that carries the motion (:attr:`main_coordinate`: the
+        tilt with the larger RMS deviation; a non-tilting disk: the coordinate
+        with the largest), named in their titles; every unit is that of its
+        coordinate (:func:`~brakesqueal.model.components.coordinate_unit`).
+        The title gives the final amplitude of that coordinate and
+        :attr:`stop_reason` (how long the run lasted and why it ended).
+        Returns the matplotlib ``Figure`` (never calls ``show``), in the
+        package's figure style (two journal columns wide).
         """
         import matplotlib
         from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -788,6 +859,7 @@ class Trajectory:
         from scipy.signal import find_peaks
 
         from ..labels import STYLE
+        from ..model.components import coordinate_unit
 
         style: dict[Any, Any] = dict(STYLE)  # rc values of the package's style (matplotlib's stubs want rc keys)
         with matplotlib.rc_context(style):
@@ -801,10 +873,12 @@ class Trajectory:
             s = self.summary
             cols = [0, 1] if self.tilting else list(range(self.n))
             dq = self.dq[:, cols]
-            unit = "rad" if self.tilting else "m"
+            units = {coordinate_unit(self.coords[j]) for j in cols}
+            unit = units.pop() if len(units) == 1 else "rad, m"
+            m = self.main_coordinate
             for i, j in enumerate(cols):
                 c = self.coords[j]
-                ax_t.plot(self.t, dq[:, i], lw=0.5, alpha=1.0 if i == 0 else 0.7, label=f"{c} − {c}₀")
+                ax_t.plot(self.t, dq[:, i], lw=0.5, alpha=1.0 if j == m else 0.7, label=f"{c} − {c}₀")
             r = np.sqrt(np.sum(dq**2, axis=1))
             peaks, _ = find_peaks(r)
             if peaks.size >= 2:
@@ -812,32 +886,34 @@ class Trajectory:
                 ax_t.plot(self.t[peaks], -r[peaks], "k", lw=0.8)
             ax_t.set_xlabel("$t$ [s]")
             ax_t.set_ylabel(f"{'tilt' if self.tilting else 'coordinate'} deviation [{unit}]")
-            amp = f"{s.amplitude_final:.3g} {unit}" if math.isfinite(s.amplitude_final) else "n/a"
+            cm = self.coords[m]
+            um = coordinate_unit(cm)
+            a = self.final_amplitudes().get(cm, math.nan)
+            amp = f"{a:.3g} {um}" if math.isfinite(a) else "n/a"
             ax_t.set_title(
-                f"{self.model}, {self.status}: $f$ = {s.frequency_hz:.2f} Hz, growth rate = {s.growth_rate:.4g} 1/s, "
-                f"final amplitude = {amp}", loc="left")
+                f"{self.model}: $f$ = {s.frequency_hz:.2f} Hz, growth rate = {s.growth_rate:.4g} 1/s, "
+                f"final amplitude of {cm} = {amp}\n{self.stop_reason}", loc="left", wrap=True)
             if self.t_event is not None:
-                ax_t.axvline(self.t_event, color="r", ls="--", lw=1, label=self.status)
+                ax_t.axvline(self.t_event, color="r", ls="--", lw=1, label=str(self.status).replace("-", " "))
             ax_t.legend(loc="lower left", bbox_to_anchor=(1.0, 0.0), frameon=False)
-            c0 = self.coords[0]
             keep = slice(None)
             if math.isfinite(s.frequency_hz) and s.frequency_hz > 0 and self.t.size >= 2:
                 keep = self.t >= self.t[-1] - 3.0 / s.frequency_hz
-            ax_p.plot(self.dq[keep, 0], self.Qdot[keep, 0], lw=0.8)
-            ax_p.set_xlabel(f"{c0} − {c0}₀ [{unit}]")
-            ax_p.set_ylabel(f"d{c0}/d$t$ [{unit}/s]")
-            ax_p.set_title("phase portrait, last three periods", loc="left")
+            ax_p.plot(self.dq[keep, m], self.Qdot[keep, m], lw=0.8)
+            ax_p.set_xlabel(f"{cm} − {cm}₀ [{um}]")
+            ax_p.set_ylabel(f"d{cm}/d$t$ [{um}/s]")
+            ax_p.set_title(f"phase portrait of {cm}, last three periods", loc="left")
             ax_p.ticklabel_format(style="sci", scilimits=(-2, 3))
             if self.t.size >= 16:
-                f, X = self.spectrum()
+                f, X = self.spectrum(m)
                 ax_s.semilogy(f, X + 1e-300, lw=0.7)
                 if math.isfinite(s.frequency_hz) and s.frequency_hz > 0:
                     ax_s.axvline(s.frequency_hz, color="r", ls="--", lw=1, label=f"squeal {s.frequency_hz:.1f} Hz")
                     ax_s.set_xlim(0, min(f[-1], 4 * s.frequency_hz))
                     ax_s.legend(frameon=False)
             ax_s.set_xlabel("frequency [Hz]")
-            ax_s.set_ylabel(f"|{c0}| [{unit}]")
-            ax_s.set_title("spectrum", loc="left")
+            ax_s.set_ylabel(f"|{cm}| [{um}]")
+            ax_s.set_title(f"spectrum of {cm}", loc="left")
         return fig
 
     # ---------------------------------------------------------------- export
@@ -864,6 +940,7 @@ class Trajectory:
             "pad_treatment": json.dumps({name: ("dynamic" if name in self.dynamic else "quasi-static")
                                          for name in self.pad_unknowns}),
             "audio_velocity": what, "contact_law": self.contact_law,
+            "stop_reason": self.stop_reason, "duration_s": self.duration,
         }  # fmt: skip
         for k, v in self.summary.to_dict().items():
             if k == "status":
@@ -961,6 +1038,11 @@ class Trajectory:
                 w.setframerate(int(rate))
                 w.writeframes(pcm.tobytes())
         return int(pcm.size)
+
+
+def _seconds(t: float) -> str:
+    """A duration for people: ``18 ms``, ``0.2 s``, ``3.5 s``."""
+    return f"{1e3 * t:.3g} ms" if abs(t) < 0.1 else f"{t:.4g} s"
 
 
 def soft_quasi_static_pads(params: Parameters) -> tuple[str, ...]:

@@ -322,8 +322,7 @@ def create_store(path: Path, study: Study) -> dict[str, Any]:
     tmp = path.parent / f".{path.name}.creating-{os.getpid()}-{uuid.uuid4().hex[:8]}"
     try:
         manifest = _build_skeleton(tmp, study, study_attrs(study))
-        write_file(tmp / STORE_MARKER, json.dumps({"kind": _STORE_KIND, "format": _FORMAT,
-                                                   "study_hash": manifest["study_hash"]}).encode())
+        write_file(tmp / STORE_MARKER, _marker_bytes(manifest))
         os.rename(tmp, path)
     except OSError as exc:
         shutil.rmtree(tmp, ignore_errors=True)
@@ -503,13 +502,22 @@ def open_group(path: Path, manifest: dict[str, Any], *, read_only: bool = False)
                            mode="r" if read_only else "r+", zarr_format=3)
 
 
+def _marker_bytes(manifest: dict[str, Any]) -> bytes:
+    """The content of :data:`STORE_MARKER`: this store was made by brakesqueal, for the study of ``manifest``."""
+    return json.dumps({"kind": _STORE_KIND, "format": _FORMAT, "study_hash": manifest["study_hash"]}).encode()
+
+
 def _repair(path: Path, study: Study, check: StoreCheck) -> None:
-    """Rewrite the creation record, damaged metadata and coordinates (they follow from the study)."""
+    """Rewrite the creation record, the store marker, damaged metadata and coordinates (they follow from the
+    study)."""
     m = check.manifest
     try:
         if check.record_missing:
             (path / MARKERS).mkdir(exist_ok=True)
             write_file(path / MANIFEST, _record_bytes(m))
+        if not (path / STORE_MARKER).is_file():  # lost with the markers' directory (the store is ours: checked)
+            (path / MARKERS).mkdir(exist_ok=True)
+            write_file(path / STORE_MARKER, _marker_bytes(m))
         for key in check.metadata:
             (path / key).parent.mkdir(parents=True, exist_ok=True)
             write_file(path / key, m["nodes"][key].encode())
