@@ -99,13 +99,13 @@ def test_long_values_are_refused_without_echoing_them(tmp_path, capsys):
                  f'{"k" * 200} = 1\n'):
         for path, cmd in _channels(tmp_path, body):
             rc, err = _cli(capsys, *cmd)
-            _one_line(rc, err, path, "characters long (at most")
+            assert _one_line(rc, err, path, "characters long (at most").startswith("brakesqueal: error: ")
     long = "x" * 100_000
     for args, option in ((["--model", long], "--model"), (["--preset", long], "--preset"),
                          (["--params", long], "--params"), (["--set", f"{long}=1"], "--set"),
                          (["--set", f"mu={long}"], "--set mu=")):
         rc, err = _cli(capsys, "linearize", *args)
-        _one_line(rc, err, option, "characters long (at most")
+        assert _one_line(rc, err, option, "characters long (at most").startswith("brakesqueal: error: ")
 
 
 def test_expressions_nested_10000_deep_are_one_line(capsys):
@@ -243,17 +243,17 @@ def test_files_quote_the_number_as_typed(tmp_path, capsys):
         params = tmp_path / "p.toml"
         params.write_text(f"{_PARAMS}k_t = {typed}\n")
         rc, err = _cli(capsys, "linearize", "--params", str(params))
-        _one_line(rc, err, str(params), word, shown)
+        assert _one_line(rc, err, str(params), word, shown).startswith("brakesqueal: error: ")
         model = tmp_path / "m.toml"
         text = model_to_toml(get_model("paper"))
         model.write_text("\n".join(f"k_t = {typed}" if ln.startswith("k_t = ") else ln
                                    for ln in text.splitlines()) + "\n")
         rc, err = _cli(capsys, "linearize", "--model", str(model))
-        _one_line(rc, err, str(model), word, shown)
+        assert _one_line(rc, err, str(model), word, shown).startswith("brakesqueal: error: ")
         study = tmp_path / "s.toml"
         study.write_text(f'preset = "paper-fig2"\n[parameters]\nk_t = {typed}\n[axes]\nmu = "0.1:1:3"\n')
         rc, err = _cli(capsys, "sweep", str(study), "--out", str(tmp_path / "s.zarr"))
-        _one_line(rc, err, str(study), word, shown)
+        assert _one_line(rc, err, str(study), word, shown).startswith("brakesqueal: error: ")
 
 
 def test_inf_stays_a_rigid_support_and_zero_stays_zero(capsys, tmp_path):
@@ -274,7 +274,7 @@ def test_number_options_quote_the_value_as_typed(capsys):
                      ["reduce", "--model", "disk_brake100", "--along", "Omega=2*pi:8*pi:3", "--re=-50:50",
                       "--freq", "0:2000", "--out", "r.toml", "--tol"]):
             rc, err = _cli(capsys, *args, typed)
-            _one_line(rc, err, args[-1], typed, word)
+            assert _one_line(rc, err, args[-1], typed, word).startswith("brakesqueal: error: ")
 
 
 # ----------------------------------------------------------------------------------------- 3. non-regular files

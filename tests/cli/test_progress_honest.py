@@ -25,7 +25,7 @@ def _run(fracs: list[float], dts: list[float], every: float = 1.0, done: bool = 
     return lines
 
 
-def _check(lines: list[str], done: bool) -> None:
+def _check(lines: list[str], done: bool) -> bool:
     pcts = [float(_PCT.search(s).group(1)) for s in lines]
     assert pcts == sorted(pcts), lines  # never lower than before
     assert len(set(lines)) == len(lines) and len(set(pcts)) == len(pcts), lines  # never the same line twice
@@ -36,6 +36,7 @@ def _check(lines: list[str], done: bool) -> None:
     for s, p in zip(lines, pcts):
         if "left" in s:
             assert p >= 100 * ETA_MIN_FRACTION and p < 100, s
+    return True
 
 
 @pytest.mark.parametrize("seed", range(40))
@@ -56,14 +57,14 @@ def test_random_fractions_jumping_back_and_reaching_one(seed):
         fracs.append(f)
     dts = [rng.expovariate(1.0) for _ in range(n)]
     done = rng.random() < 0.7
-    _check(_run(fracs, dts, done=done), done)
+    assert _check(_run(fracs, dts, done=done), done)
 
 
 def test_stiff_start_gives_no_eta():
     """1 % after 11 s, then done a second later: no "about 1065 s left"."""
     lines = _run([0.01, 0.02, 0.5, 0.999, 1.0, 1.0], [11.0, 0.2, 0.2, 0.2, 0.2, 0.2], every=10.0)
     assert lines and not any("left" in s for s in lines)
-    _check(lines, True)
+    assert _check(lines, True)
 
 
 def test_repeated_one_prints_hundred_once_at_the_end():
@@ -82,7 +83,7 @@ def test_steady_rate_gives_an_eta_after_ten_percent():
     first = float(_PCT.search(with_eta[0]).group(1))
     assert first >= 10.0
     assert "about 30 s left" in [s for s in lines if "40.0%" in s][0]  # 60 % left at 2 %/s
-    _check(lines, True)
+    assert _check(lines, True)
 
 
 def test_no_hundred_after_an_error(monkeypatch):
