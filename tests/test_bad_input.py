@@ -16,6 +16,7 @@ import inspect
 import math
 import os
 import random
+import typing
 import subprocess
 import sys
 import time
@@ -378,8 +379,8 @@ def samples():
     space = brakesqueal.resolve_space(preset="paper-fig2")
     params = space.resolve({})
     return [params, space, Axis("mu", 0.1, 1.0, 3), get_model("paper"), "x", 1.0, 2, True, None,
-            {"mu": 0.5}, ("x",), (0.0, 1.0), [1.0, 2.0], np.array([1.0, 2.0]), lambda *a: None, Path("x.toml"),
-            get_model("minimal"), CrossingResult.__new__(CrossingResult)]
+            {"mu": 0.5}, {"M": "M"}, {"mu": (0.4, 0.5)}, ("x",), (0.0, 1.0), [1.0, 2.0], np.array([1.0, 2.0]),
+            lambda *a: None, Path("x.toml"), get_model("minimal"), CrossingResult.__new__(CrossingResult)]
 
 
 #: Values of the wrong kind for some hint or other: wrong types, non-finite numbers, negative counts, strings
@@ -403,6 +404,8 @@ def test_wrong_arguments_of_every_public_function_name_the_argument(samples):
             if p.kind in (p.VAR_KEYWORD, p.VAR_POSITIONAL) or p.default is not inspect.Parameter.empty:
                 continue
             good = [s for s in samples if V._allows(hints.get(n, object), s)]
+            if not good and typing.get_origin(hints.get(n)) is typing.Literal:  # e.g. export_code's target
+                good = list(typing.get_args(hints[n]))
             assert good, (label, n)
             base[n] = good[0]
         for n, p in sig.parameters.items():

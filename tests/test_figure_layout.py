@@ -27,6 +27,7 @@ COMMANDS = {
     "map": ["map", "--x", "k_ip=1e5:1e10:40:log", "--y", "mu=0.05:1:30", "--out", "{tmp}/m.nc", "--plot", "{out}"],
     "map-max-real": ["map", "--x", "k_ip=1e5:1e10:40:log", "--y", "mu=0.05:1:30", "--out", "{tmp}/m2.nc",
                      "--plot", "{out}", "--color", "max_real"],
+    "map-pad-only": ["map", "--x", "mu1=0:1:25", "--y", "mu2=0:1:25", "--out", "{tmp}/m3.nc", "--plot", "{out}"],
     "crossings": ["crossings", "--along", "k_ip=1e5:1e10:log", "--set", "mu=0.5", "--plot", "{out}"],
     "critical-speed": ["critical-speed", "--preset", "paper-fig3", "--set", "mu1=0.6", "--set", "mu2=0.4",
                        "--range", "1:1e5", "--plot", "{out}"],
@@ -38,6 +39,9 @@ COMMANDS = {
     "plot-map": ["plot", "{tmp}/grid3.zarr", "--at", "Omega=50", "--out", "{out}"],
     "plot-slice": ["plot", "{tmp}/line.zarr", "--out", "{out}"],
     "plot-hist": ["plot", "{tmp}/lhs.zarr", "--out", "{out}"],
+    "region": ["region", "--preset", "paper-fig3", "--set", "k_ip=inf", "--set", "mu2=0.5", "--x", "mu1=0:1",
+               "--y", "Omega=10:20000:log", "--grid", "21", "--plot", "{out}"],
+    "uq": ["uq", str(Path(__file__).resolve().parents[1] / "examples" / "study-uq-mu.toml"), "--plot", "{out}"],
 }
 
 #: the sweep stores the ``plot`` commands draw (small studies, made by the library before the commands run)

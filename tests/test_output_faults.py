@@ -25,7 +25,7 @@ LIMIT = 4096  # bytes: every output below is larger
 
 CASES = {
     "map --out": (["map", "--x", "k_ip=1e5:1e10:80:log", "--y", "mu=0.05:1:80", "--no-eigen"], "--out", "m.nc"),
-    "map --plot": (["map", "--x", "k_ip=1e5:1e10:12:log", "--y", "mu=0.05:1:12", "--no-eigen", "--out", "small.nc"],
+    "map --plot": (["map", "--x", "k_ip=1e5:1e10:8:log", "--y", "mu=0.05:1:8", "--no-eigen", "--out", "small.nc"],
                    "--plot", "m.png"),  # the NetCDF file (with its boundary) fits below the limit, the figure does not
     "crossings --plot": (["crossings", "--along", "k_ip=1e5:1e10:log", "--set", "mu=0.5"], "--plot", "c.png"),
     "critical-speed --plot": (["critical-speed", "--preset", "paper-fig3", "--set", "mu1=0.6", "--set", "mu2=0.4"],

@@ -93,6 +93,19 @@ __all__ = [
     "load_study",
     "Study",
     "SweepStatus",
+    "run_sweep",
+    "plot_sweep",
+    "parse_axis",
+    "export_code",
+    "import_matrices",
+    "box_eigenvalues",
+    "reduce_matrix_model",
+    "reproduce_fig2",
+    "reproduce_fig3",
+    "run_uq",
+    "hopf_curves",
+    "region_diagram",
+    "robust_box",
 ]
 
 _LAZY = {
@@ -152,6 +165,19 @@ _LAZY = {
     "load_study": "sweep",
     "Study": "sweep",
     "SweepStatus": "sweep",
+    "run_sweep": "sweep",
+    "plot_sweep": "sweep",
+    "parse_axis": "analysis.maps",
+    "export_code": "export",
+    "import_matrices": "model.matrices",
+    "box_eigenvalues": "api",
+    "reduce_matrix_model": "api",
+    "reproduce_fig2": "reproduce",
+    "reproduce_fig3": "reproduce",
+    "run_uq": "uq",
+    "hopf_curves": "api_nonlinear",
+    "region_diagram": "api_nonlinear",
+    "robust_box": "api",
 }
 
 

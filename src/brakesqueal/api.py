@@ -20,7 +20,7 @@ infinity where a finite number is needed or a count below one is one
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Annotated, Any, cast
 
 from .validation import Range, validated
@@ -38,6 +38,9 @@ if TYPE_CHECKING:
     from .model.components import ModelSpec
     from .model.matrices import MatrixSpec
     from .model.parameters import Parameters, ParameterSpace
+    from .analysis.matrix_analysis import BoxResult, Reduction
+    from .robust import RobustResult
+    from .results import CriticalSpeedResult, CrossingResult, StabilityMap
 
 __all__ = ["engine", "silent_motion", "linearize", "pad_rate_eigenvalues", "eigen_analysis", "evaluate",
            "evaluate_point", "stability_map", "write_map", "crossings", "critical_speeds", "critical_speeds_many",
@@ -205,7 +208,8 @@ def evaluate_point(space: ParameterSpace, values: Mapping[str, Any] | None = Non
 @validated
 def stability_map(space: ParameterSpace, x: Axis, y: Axis, *, force: bool = False, eigen: bool = True,
                   chunk_points: _Count = 1 << 18, progress: Callable[[float], None] | None = None,
-                  boundary: bool = True, modes: str = "all", quantities: tuple[str, ...] | None = None) -> Any:
+                  boundary: bool = True, modes: str = "all", quantities: tuple[str, ...] | None = None
+                  ) -> StabilityMap:
     """A stability map over two settable parameters (:func:`brakesqueal.analysis.maps.stability_map`).
 
     Parameters
@@ -267,7 +271,7 @@ def write_map(space: ParameterSpace, x: Axis, y: Axis, path: str | os.PathLike[s
 
 
 @validated
-def crossings(space: ParameterSpace, axis: Axis, *, modes: str = "all") -> Any:
+def crossings(space: ParameterSpace, axis: Axis, *, modes: str = "all") -> CrossingResult:
     """Every stability change along one settable parameter (:func:`brakesqueal.analysis.crossings.crossings`).
 
     Parameters
@@ -289,7 +293,8 @@ def crossings(space: ParameterSpace, axis: Axis, *, modes: str = "all") -> Any:
 
 
 @validated
-def critical_speeds(space: ParameterSpace, lo: _Speed = 1.0, hi: _Speed = 1e5, *, modes: str = "all") -> Any:
+def critical_speeds(space: ParameterSpace, lo: _Speed = 1.0, hi: _Speed = 1e5, *, modes: str = "all"
+                    ) -> CriticalSpeedResult:
     """All onsets and re-stabilisations along Ω (:func:`brakesqueal.analysis.crossings.critical_speeds`).
 
     Parameters
@@ -365,3 +370,95 @@ def modes_along(space: ParameterSpace, name: str, start: float, stop: float, *, 
     from .analysis.modes import modes_along as _modes
 
     return _modes(engine(space), space, name, start, stop, num=num, log=log, pad_rates=pad_rates)
+
+
+@validated
+def box_eigenvalues(params: Parameters, *, re: tuple[float, float], freq: tuple[float, float], max_shifts: int = 40,
+                    progress: Callable[[int, int], Any] | None = None) -> BoxResult:
+    """Eigenvalues of a matrix model in a box of the complex plane, with error bounds (``brakesqueal box``).
+
+    Parameters
+    ----------
+    params : Parameters
+        A parameter set of a model given by coefficient matrices.
+    re : (float, float)
+        Range of Re λ [1/s] (e.g. ``(-50, inf)``).
+    freq : (float, float)
+        Frequency range [Hz], ``0 <= f_lo < f_hi``.
+    max_shifts : int
+        Most shift-and-invert runs before the box is declared not covered (verdict undecided).
+    progress : callable, optional
+        ``progress(done, total)`` per shift.
+
+    Returns
+    -------
+    BoxResult
+        See :func:`brakesqueal.analysis.matrix_analysis.box_analysis`.
+    """
+    from .analysis.matrix_analysis import box_analysis
+
+    return box_analysis(engine(params), params, re=re, freq=freq, max_shifts=max_shifts, progress=progress)
+
+
+@validated
+def reduce_matrix_model(space: ParameterSpace, samples: Sequence[float], *, re: tuple[float, float],
+                        freq: tuple[float, float], r: int | None = None, tol: float = 1e-10, checks: int = 2,
+                        name: str | None = None, progress: Callable[[int, int], Any] | None = None) -> Reduction:
+    """Parametric reduction of a matrix model along its spin (``brakesqueal reduce``).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        A model given by coefficient matrices, with its preset and overrides.
+    samples : sequence of float
+        Spin values [rad/s] the eigenvectors are sampled at.
+    re, freq : (float, float)
+        The box whose eigenvalues the reduced model keeps (:func:`box_eigenvalues`).
+    r : int, optional
+        Reduced dimension (default: every singular value above ``tol`` of the largest).
+    tol : float
+        Relative singular-value cut-off.
+    checks : int
+        Spins between the samples where the reduced model is checked against the full one.
+    name : str, optional
+        Name of the reduced model.
+    progress : callable, optional
+        ``progress(done, total)``.
+
+    Returns
+    -------
+    Reduction
+        See :func:`brakesqueal.analysis.matrix_analysis.reduce_model`.
+    """
+    from .analysis.matrix_analysis import reduce_model
+
+    return reduce_model(engine(space), space, samples, re=re, freq=freq, r=r, tol=tol, checks=checks, name=name,
+                        progress=progress)
+
+
+@validated
+def robust_box(space: ParameterSpace, box: Mapping[str, Sequence[float]], *,
+               max_boxes: Annotated[int, Range(1, 10_000_000)] = 4000,
+               max_depth: Annotated[int, Range(1, 200)] = 60) -> RobustResult:
+    """Certified robust window (``brakesqueal robust``): is every point of a parameter box stable?
+
+    Branch and bound on enclosures of the exact characteristic quartic and its Hurwitz determinant over the box
+    (:func:`brakesqueal.robust.robust_box`; ``docs/uq.md``): "stable" for every point, "unstable" with a
+    certified witness point, or "undecided" with the sub-boxes left; never decided by sampling.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The parameter space (a 2-DOF model with a closed form; ties apply).
+    box : Mapping[str, sequence of float]
+        Settable name -> ``(lo, hi)``, ``lo < hi``.
+    max_boxes, max_depth : int
+        Branch-and-bound budgets (sub-boxes examined, bisection depth).
+
+    Returns
+    -------
+    RobustResult
+    """
+    from .robust import robust_box as _robust_box
+
+    return _robust_box(engine(space), space, box, max_boxes=max_boxes, max_depth=max_depth)

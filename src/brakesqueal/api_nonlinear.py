@@ -31,11 +31,12 @@ if TYPE_CHECKING:
     from .nonlinear.models import HopfPoint
     from .nonlinear.squeal import SquealBranch
     from .nonlinear.system import PiecewiseSystem, SmoothSystem
+    from .region import HopfCurve, RegionResult
     from .results import CrossingResult
     from .simulation import SimulationModel, Trajectory
 
 __all__ = ["simulate", "simulation_model", "hopf_points", "limit_cycles", "squeal_branch", "harmonic_branch",
-           "model_system", "model_piecewise_system", "exact_lyapunov", "model_flow"]
+           "model_system", "model_piecewise_system", "exact_lyapunov", "model_flow", "hopf_curves", "region_diagram"]
 
 
 def _engine(model: ModelSpec | MatrixSpec | str | os.PathLike[str] | Parameters | ParameterSpace,
@@ -326,3 +327,67 @@ def model_flow(space: ParameterSpace, name: str, *, system: SmoothSystem | None 
     from .nonlinear.compiled import model_flow as _model_flow
 
     return _model_flow(_engine(space, use_cache), space, name, system=system, use_cache=use_cache, rtol=rtol)
+
+
+@validated
+def hopf_curves(space: ParameterSpace, x: Axis, y: Axis, *, seeds: Annotated[int, Range(1, 100)] = 5,
+                max_points: Annotated[int, Range(2, 10000)] = 200, ds_max: Annotated[float, Range(1e-4, 0.5)] = 0.05,
+                lyapunov: bool = True, use_cache: bool = True) -> list[HopfCurve]:
+    """Every Hopf curve of the silent motion in a box of two settable parameters, with ``l1`` along it and its
+    codimension-2 points (:func:`brakesqueal.region.hopf_curves`; ``docs/region.md``).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides (a model with nonlinear equations).
+    x, y : Axis
+        The two axes (ranges; ``log`` for logarithmic).
+    seeds : int
+        Lines per direction on which the curves are seeded by exact crossings.
+    max_points : int
+        Most points per curve.
+    ds_max : float
+        Largest continuation step, as a fraction of the (scaled) box.
+    lyapunov : bool
+        Compute ``l1`` at every point (and locate generalised-Hopf points).
+    use_cache : bool
+        Use the code cache.
+
+    Returns
+    -------
+    list of HopfCurve
+    """
+    from .region import hopf_curves as _curves
+
+    return _curves(_engine(space, use_cache), space, x, y, seeds=seeds, max_points=max_points, ds_max=ds_max,
+                   lyapunov=lyapunov, use_cache=use_cache)
+
+
+@validated
+def region_diagram(space: ParameterSpace, x: Axis, y: Axis, *, seeds: Annotated[int, Range(1, 100)] = 5,
+                   max_points: Annotated[int, Range(2, 10000)] = 200,
+                   ds_max: Annotated[float, Range(1e-4, 0.5)] = 0.05, grid: Annotated[int, Range(2, 2000)] | None = 41,
+                   lyapunov: bool = True, use_cache: bool = True) -> RegionResult:
+    """The squeal region diagram (``brakesqueal region``): Hopf curves with ``l1`` and codimension-2 points over
+    the certified stability map (:func:`brakesqueal.region.region_diagram`; ``docs/region.md``).
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides (a model with nonlinear equations).
+    x, y : Axis
+        The two axes.
+    seeds, max_points, ds_max, lyapunov, use_cache
+        As :func:`hopf_curves`.
+    grid : int or None
+        Points per axis of the certified map drawn beneath (``None``: no map).
+
+    Returns
+    -------
+    RegionResult
+        ``to_dict()`` (the JSON of ``brakesqueal region``), ``text()``, ``to_dataset()``, ``plot()``.
+    """
+    from .region import region_diagram as _region
+
+    return _region(_engine(space, use_cache), space, x, y, seeds=seeds, max_points=max_points, ds_max=ds_max,
+                   grid=grid, lyapunov=lyapunov, use_cache=use_cache)

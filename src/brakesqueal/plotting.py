@@ -16,7 +16,7 @@ if TYPE_CHECKING:
     from .results import CrossingResult, StabilityMap
 
 __all__ = ["new_figure", "styled", "plot_map", "plot_map_arrays", "map_title", "MAP_COLORS", "MAP_STABLE",
-           "MAP_UNSTABLE", "plot_path", "plot_critical_curves", "save"]
+           "MAP_PAD_ONLY", "MAP_UNSTABLE", "plot_path", "plot_critical_curves", "save"]
 
 _P = ParamSpec("_P")
 _R = TypeVar("_R")
@@ -69,6 +69,9 @@ MAP_COLORS = ("verdict", "max_real", "frequency")
 MAP_STABLE = "#c8e6c9"
 #: Fill colour of the unstable (squealing) points of a verdict map (the explorer's map uses the same).
 MAP_UNSTABLE = "#f4c7c3"
+#: The explorer's fill of points whose disk modes are stable while a massless pad's own 0 Hz mode is unstable
+#: (figures hatch them over :data:`MAP_STABLE`).
+MAP_PAD_ONLY = "#e6ee9c"
 
 
 @overload
@@ -108,10 +111,11 @@ def plot_map(m: StabilityMap, ax: Axes | None = None, *, x: str | None = None, t
     yn = outer if xn == inner else inner
     axes = [(n, ds[n].values, ds[n].attrs.get("units", ""), ds[n].attrs.get("scale") == "log") for n in (xn, yn)]
     field = ds[color].transpose(yn, xn).values if color in ("max_real", "frequency") and color in ds else None
+    disk = ds["disk_stable"].transpose(yn, xn).values if "disk_stable" in ds else None
     return plot_map_arrays(axes[0], axes[1], ds["stable"].transpose(yn, xn).values,
                            ds["status"].transpose(yn, xn).values, ax=ax,
                            title=title if title is not None else map_title(ds.attrs.get("space", ""), xn, yn),
-                           boundary=boundary_of(ds, (xn, yn)), color=color, field=field)
+                           boundary=boundary_of(ds, (xn, yn)), color=color, field=field, disk_stable=disk)
 
 
 def _title(fig: Figure | SubFigure, ax: Axes, title: str, own: bool) -> None:
@@ -135,20 +139,26 @@ def map_title(space: str, xn: str, yn: str) -> str:
 def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, np.ndarray, str, bool],
                     stable: np.ndarray, status: np.ndarray, *, ax: None = None, title: str = "",
                     boundary: tuple[np.ndarray, np.ndarray] | None = None, color: str = "verdict",
-                    field: np.ndarray | None = None) -> Figure: ...
+                    field: np.ndarray | None = None, disk_stable: np.ndarray | None = None) -> Figure: ...
 @overload
 def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, np.ndarray, str, bool],
                     stable: np.ndarray, status: np.ndarray, *, ax: Axes, title: str = "",
                     boundary: tuple[np.ndarray, np.ndarray] | None = None, color: str = "verdict",
-                    field: np.ndarray | None = None) -> Figure | SubFigure: ...
+                    field: np.ndarray | None = None, disk_stable: np.ndarray | None = None
+                    ) -> Figure | SubFigure: ...
 
 
 @styled
 def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, np.ndarray, str, bool],
                     stable: np.ndarray, status: np.ndarray, *, ax: Axes | None = None, title: str = "",
                     boundary: tuple[np.ndarray, np.ndarray] | None = None, color: str = "verdict",
-                    field: np.ndarray | None = None) -> Figure | SubFigure:
+                    field: np.ndarray | None = None, disk_stable: np.ndarray | None = None
+                    ) -> Figure | SubFigure:
     """Plot a stability map given as arrays (what :func:`plot_map` draws, without xarray).
+
+    Where a massless pad's own (0 Hz, non-oscillatory) mode is the only unstable one (``stable`` false,
+    ``disk_stable`` 1), the verdict colouring shows the disk's modes: those points are drawn stable and
+    hatched, with their own legend entry, and the boundary drawn is the disk modes' (on the grid).
 
     Parameters
     ----------
@@ -169,6 +179,8 @@ def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, 
         ``frequency`` colour the points by that field (``field``) with a colour bar.
     field : ndarray, optional
         The field for ``color = "max_real"`` or ``"frequency"``.
+    disk_stable : ndarray of int, optional
+        The verdict of the disk's modes alone (1 stable, 0 unstable, -1 none; the map's ``disk_stable``).
 
     Returns
     -------
@@ -196,11 +208,26 @@ def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, 
     failed = status >= 2
     z = np.where(failed, np.nan, np.asarray(stable, dtype=float))
     handles: list[Artist] = []
+    pad_only = np.zeros(z.shape, dtype=bool)
+    if disk_stable is not None:
+        disk = np.asarray(disk_stable)
+        pad_only = ~failed & (z == 0) & (disk == 1)
+    if pad_only.any() and disk_stable is not None:  # colour the disk's modes; the pad-only points marked
+        failed = failed | (np.asarray(disk_stable) < 0)
+        z = np.where(failed, np.nan, (np.asarray(disk_stable) == 1).astype(float))
+        boundary = None  # the stored boundary is that of every mode: the disk's drawn on the grid below
     if color == "verdict":
         ax.pcolormesh(xs, ys, z, cmap=ListedColormap([MAP_UNSTABLE, MAP_STABLE]), vmin=0, vmax=1, shading="nearest",
                       rasterized=True)
         handles += [Patch(facecolor=MAP_STABLE, label="stable"),
                     Patch(facecolor=MAP_UNSTABLE, label="unstable (squeal)")]
+        if pad_only.any():
+            import matplotlib as mpl
+
+            with mpl.rc_context({"hatch.color": "0.45", "hatch.linewidth": 0.5}):
+                ax.contourf(xs, ys, pad_only.astype(float), levels=[0.5, 1.5], colors="none", hatches=["///"])
+            handles.append(Patch(facecolor=MAP_STABLE, edgecolor="0.45", hatch="///", lw=0.5,
+                                 label="pad's own 0 Hz mode only"))
     else:
         from .labels import axis_label
 
@@ -225,7 +252,8 @@ def plot_map_arrays(xaxis: tuple[str, np.ndarray, str, bool], yaxis: tuple[str, 
         handles.append(Line2D([], [], color="k", lw=1.2, label="stability boundary"))
     elif np.any(np.isfinite(z)) and 0 < np.nanmean(z) < 1:  # all-NaN (no verdict anywhere): no boundary
         ax.contour(xs, ys, np.nan_to_num(z, nan=0.0), levels=[0.5], colors="k", linewidths=1.2)
-        handles.append(Line2D([], [], color="k", lw=1.2, label="stability boundary (grid)"))
+        what = "disk modes' boundary (grid)" if pad_only.any() else "stability boundary (grid)"
+        handles.append(Line2D([], [], color="k", lw=1.2, label=what))
     if xlog:
         ax.set_xscale("log")
     if ylog:

@@ -35,7 +35,25 @@ def _noop(frac: float) -> None:
 
 def reproduce_fig2(out: str | Path, *, n_kip: int = 301, n_mu: int = 241, mu_line: float = FIG2_MU,
                    progress: Callable[[float], None] = _noop) -> dict[str, Any]:
-    """Write ``fig2.png``, ``fig2.nc``, ``fig2.csv``, ``fig2.json`` to ``out``; returns the summary."""
+    """Reproduce the paper's Fig. 2: write ``fig2.png``, ``fig2.nc``, ``fig2.csv``, ``fig2.json`` to ``out``
+    (``brakesqueal reproduce fig2``).
+
+    Parameters
+    ----------
+    out : str or Path
+        Output directory (created; files in it are replaced atomically).
+    n_kip, n_mu : int
+        Grid points along ``k_ip`` (1e5 … 1e10 N/m, logarithmic) and ``mu`` (0.05 … 1).
+    mu_line : float
+        The friction coefficient of the dashed line on which points A and B are located.
+    progress : callable
+        Called with the completed fraction.
+
+    Returns
+    -------
+    dict
+        The summary written to ``fig2.json`` (``A_k_ip``, ``B_k_ip``, ``mu_line``, the map's counts, ...).
+    """
     from .analysis.maps import Axis
     from .api import crossings, stability_map
     from .model.parameters import ParameterSpace
@@ -131,7 +149,25 @@ def fig3_tips(space: ParameterSpace, diff: np.ndarray, onset: np.ndarray, certai
 
 def reproduce_fig3(out: str | Path, *, n_diff: int = 393, omega_range: tuple[float, float] = (1.0, 1e5),
                    progress: Callable[[float], None] = _noop) -> dict[str, Any]:
-    """Write ``fig3.png``, ``fig3.nc``, ``fig3.csv``, ``fig3.json`` to ``out``; returns the summary."""
+    """Reproduce the paper's Fig. 3: write ``fig3.png``, ``fig3.nc``, ``fig3.csv``, ``fig3.json`` to ``out``
+    (``brakesqueal reproduce fig3``).
+
+    Parameters
+    ----------
+    out : str or Path
+        Output directory (created; files in it are replaced atomically).
+    n_diff : int
+        Points along the friction difference ``mu1 - mu2`` (at ``mu1 + mu2 = 1``).
+    omega_range : (float, float)
+        The spin range [rad/s] searched for critical speeds.
+    progress : callable
+        Called with the completed fraction.
+
+    Returns
+    -------
+    dict
+        The summary written to ``fig3.json`` (the minimum critical speed and where it is, ...).
+    """
     import xarray as xr
 
     from .api import critical_speeds_many

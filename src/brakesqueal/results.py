@@ -616,9 +616,11 @@ def plot_map_file(path: str, *, x: str | None = None, title: str | None = None, 
         yn = outer if xn == inner else inner
         st, ss = grid("stable"), grid("status")
         field = grid(color, float) if color in f.variables and color in ("max_real", "frequency") else None
+        disk = grid("disk_stable") if "disk_stable" in f.variables else None
         if xn == outer:
             st, ss = st.T, ss.T
             field = None if field is None else field.T
+            disk = None if disk is None else disk.T
 
         def axis(n: str) -> tuple[str, np.ndarray, str, bool]:
             v = f.variables[n]
@@ -633,7 +635,8 @@ def plot_map_file(path: str, *, x: str | None = None, title: str | None = None, 
     finally:
         f.variables.clear()  # the variables' arrays view the mapped file: drop them so it can be unmapped
         f.close()
-    return plot_map_arrays(xa, ya, st.astype(bool), ss, title=label, boundary=b, color=color, field=field)
+    return plot_map_arrays(xa, ya, st.astype(bool), ss, title=label, boundary=b, color=color, field=field,
+                           disk_stable=disk)
 
 
 @dataclass(frozen=True)

@@ -217,7 +217,7 @@ def _allows(hint: Any, v: Any) -> bool:
     if origin in (typing.Union, types.UnionType):
         return any(_allows(a, v) for a in args)
     if origin is typing.Literal:
-        return any(v == a and type(v) is type(a) for a in args)
+        return any(type(v) is type(a) and v == a for a in args)  # the type first: an array is never a literal
     if hint is float:
         return _is_real(v) and _finite(v)
     if hint is int:

@@ -113,3 +113,48 @@ def test_floats_and_sympy_rationals_are_taken_exactly():
     assert iv[0][0] <= Fraction(1, 10) <= iv[0][1]
     with pytest.raises(ValueError, match="lo="):
         isolate_real_roots([[1, 1]], 1, 0)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_balanced_roots_agree_with_mpmath_on_polynomials_spanning_hundreds_of_decades(seed):
+    """The exact-route profile's roots (Newton polygon groups, double-precision starts, 50-digit polish) against
+    mpmath's polyroots at 80 digits with a large extra precision: the least-stable root's real part to 1e-40 of
+    its modulus; where the fast route gives up (NaN) the caller falls back to mpmath itself."""
+    import mpmath
+
+    from brakesqueal.analysis.robust import balanced_roots_summary
+
+    rng = np.random.default_rng(seed)
+    given_up = 0
+    for _ in range(60):
+        e = rng.integers(-300, 300, 5)
+        c = [Fraction(float(rng.uniform(0.5, 2) * rng.choice([-1, 1]))) * Fraction(2) ** int(x) for x in e]
+        mr, fr = balanced_roots_summary(c)
+        with mpmath.workdps(80):
+            roots = mpmath.polyroots([mpmath.mpf(x.numerator) / x.denominator for x in reversed(c)], maxsteps=5000,
+                                     extraprec=5000)
+            order = sorted(roots, key=lambda z: -mpmath.re(z))
+            top = order[0]
+            ref_mr, ref_fr, mod = float(mpmath.re(top)), float(abs(mpmath.im(top)) / (2 * mpmath.pi)), abs(top)
+            # the frequency is that of one root only where no other (but its conjugate) has the same real part
+            unique = all(mpmath.re(top) - mpmath.re(z) > mpmath.mpf(10) ** -30 * mod
+                         for z in order[1:] if abs(z - mpmath.conj(top)) > mpmath.mpf(10) ** -30 * mod)
+        if not np.isfinite(mr):
+            given_up += 1
+            continue
+        assert abs(mr - ref_mr) <= 1e-40 * float(mod)
+        if unique:
+            assert abs(fr - ref_fr) <= 1e-40 * float(mod)
+    assert given_up <= 6
+
+
+def test_exact_route_profile_at_the_magnitude_bound_has_its_roots():
+    """At N0 = 1e100 the quartic's coefficients span 1e-2 .. 1e290 and its roots 1e1 .. 1e97: the profile of the
+    exact route carries every point's max Re (mpmath's polyroots gave NaN there, after 0.3 s a point)."""
+    from brakesqueal import critical_speeds
+    from brakesqueal.model.parameters import ParameterSpace
+
+    r = critical_speeds(ParameterSpace.from_preset("paper-fig3", {"N0": 1e100}), 1.0, 1e5)
+    prof = np.asarray(r.profile[1])  # (values, max_real)
+    assert prof.size and np.all(np.isfinite(prof))
+    assert np.all((prof >= 0) == (not r.stable_at_start))  # no crossing in the range: one sign throughout

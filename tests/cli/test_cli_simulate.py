@@ -103,3 +103,15 @@ def test_simulate_unilateral_contact_matches_library(capsys):
     assert "out of contact at the initial state" in capsys.readouterr().err
     assert main(["simulate", "--contact", "sideways"]) == 2
     assert "--contact" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("model,unit", [("paper", "rad"), ("six-dof", "none")])
+def test_the_norm_amplitude_says_its_unit_or_that_it_has_none(capsys, model, unit):
+    """``amplitude_final`` is a norm over every coordinate: one unit only when all coordinates share it."""
+    rc = main(["simulate", "--model", model, "--t-end", "0.002", "--format", "json", "--no-progress"])
+    assert rc == 0
+    data = json.loads(capsys.readouterr().out)
+    units = {v["unit"] for v in data["amplitude_final_by_coordinate"].values()}
+    assert data["amplitude_final_unit"].startswith(unit)
+    assert (len(units) == 1) == (data["amplitude_final_unit"] in units)

@@ -427,6 +427,8 @@ EXEMPT = {
     "analysis/eigen.py": "numeric eigen-analysis of a linear model (render_linear_model's verdict): generates no code "
                          "and its text is not cached",
     "suggest.py": "closest-name suggestions in error messages",
+    "region/auto.py": "writes AUTO-07p user functions (export_code's C text) into a temporary build directory "
+                      "per run: nothing of it is cached",
     "model/parameters.py": "parameter values and presets: never enter generated code",
     "model/roles.py": "ranges and units of parameters: validation only",
     "model/matrices.py": "models given by coefficient matrices: nothing is generated for them (their engine is keyed "

@@ -89,3 +89,24 @@ def test_figures_save_png_and_a_view_without_a_map_refuses():
         map_file(empty, "csv")
     with pytest.raises(ParameterError, match="netcdf, csv"):
         map_file(empty, "xlsx")
+
+
+def test_the_map_shows_the_disk_modes_and_marks_pad_only_points():
+    """Asymmetric friction: a massless pad's own 0 Hz mode is unstable where the disk's modes are stable; the
+    map draws those points apart (code 3), as the figures hatch them, and says how many there are."""
+    from brakesqueal.explorer import app
+
+    ex = app.Explorer(Origin(resolve_space(None, "paper-fig2", None, ["mu1=0.5", "mu2=0.5"])),
+                      {"x": "mu1", "y": "mu2", "nx": "6", "ny": "6"})
+    try:
+        assert _wait(lambda: "map" in ex.shown, 120), ex.shown
+        ds = ex._map_view.result.data
+        disk = ds["disk_stable"].transpose("mu2", "mu1").values
+        stable = ds["stable"].transpose("mu2", "mu1").values.astype(bool)
+        decided = ds["status"].transpose("mu2", "mu1").values <= 1
+        expected = np.where(decided, np.where(~stable & (disk == 1), 3, stable), 2)
+        assert np.array_equal(shown_codes(ex), expected)
+        assert ex.shown["map"]["pad_only"] == int((expected == 3).sum()) > 0
+        assert "only a massless pad's own 0 Hz mode" in ex.map_text.object
+    finally:
+        ex.stop()

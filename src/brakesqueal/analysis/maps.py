@@ -195,7 +195,25 @@ def resolution_problem(start: float, stop: float, num: int, log: bool) -> str | 
 
 
 def parse_axis(text: str, *, with_num: bool = True) -> Axis:
-    """Parse ``NAME=START:STOP:N[:log]`` (or ``NAME=START:STOP[:log]`` with ``with_num=False``)."""
+    """Parse ``NAME=START:STOP:N[:log]`` (or ``NAME=START:STOP[:log]`` with ``with_num=False``), the form of the
+    CLI's ``--x``, ``--y`` and ``--along`` options.
+
+    Parameters
+    ----------
+    text : str
+        The axis, e.g. ``"k_ip=1e5:1e10:400:log"``; ``START`` and ``STOP`` may be expressions (``2*pi``).
+    with_num : bool
+        Whether the number of points ``N`` is part of the form (maps) or not (paths).
+
+    Returns
+    -------
+    Axis
+
+    Raises
+    ------
+    ParameterError
+        A malformed axis, bounds that are not finite or reversed, or fewer than 2 points (one line, naming it).
+    """
     from ..model.expressions import evaluate
 
     name, sep, spec = text.partition("=")
@@ -354,7 +372,8 @@ def _blocks(n_o: int, n_i: int, points: int) -> Iterator[tuple[int, int, int, in
             yield r0, r0 + 1, c0, min(n_i, c0 + points)
 
 
-#: The quantities a map stores besides ``stable``, ``status``, ``max_real`` and ``frequency`` (by default).
+#: The quantities a map stores besides ``stable``, ``status``, ``max_real`` and ``frequency`` (by default; and
+#: ``disk_stable`` for a model with massless pads' own modes, which a map's figure colours by default).
 MAP_EXTRAS = ("carrier", "route")
 
 
@@ -380,12 +399,16 @@ def _rows(space: ParameterSpace, plan: _Plan, names: tuple[str, ...], chunk_poin
         yield r0, r1, c0, c1, evaluate_block(plan.engine, space, pts, names, modes=modes)
 
 
-def _names(eigen: bool, extras: tuple[str, ...] | None) -> tuple[tuple[str, ...], tuple[str, ...]]:
+def _names(eigen: bool, extras: tuple[str, ...] | None, engine: Engine | None = None
+           ) -> tuple[tuple[str, ...], tuple[str, ...]]:
     """``(all quantity names, the extras)`` of a map: ``max_real``/``frequency`` with ``eigen``, and the extras
-    (default :data:`MAP_EXTRAS`; quantities needing eigenvalues are left out without ``eigen``)."""
-    from .quantities import quantity
+    (default :data:`MAP_EXTRAS`, with ``disk_stable`` where the model's massless pads have modes of their own;
+    quantities needing eigenvalues are left out without ``eigen``)."""
+    from .quantities import has_pad_modes, quantity
 
-    ex = tuple(MAP_EXTRAS if extras is None else extras)
+    if extras is None:
+        extras = MAP_EXTRAS + (("disk_stable",) if engine is not None and has_pad_modes(engine) else ())
+    ex = tuple(extras)
     for n in ex:
         quantity(n)  # unknown names: one error naming the allowed ones
     ex = tuple(n for n in ex if n not in ("stable", "status", "max_real", "frequency") and (eigen or not
@@ -452,7 +475,7 @@ def stability_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, *, fo
     from .quantities import attributes, quantity
 
     plan = _plan(engine, space, x, y, force, eigen)
-    names, ex = _names(eigen, quantities)
+    names, ex = _names(eigen, quantities, engine)
     n_o, n_i = plan.outer.num, plan.inner.num
     stable = np.zeros((n_o, n_i), dtype=bool)
     status = np.zeros((n_o, n_i), dtype=np.int8)
@@ -511,6 +534,9 @@ class MapSummary:
         that occur); the points of ``ok`` and ``ok_nontrivial_silent_motion`` have a verdict, the others none.
     unstable : int
         Number of points with a verdict ``unstable``.
+    pad_only : int
+        Number of unstable points whose disk modes are certified stable: only a massless pad's own
+        (non-oscillatory) mode is unstable there (``disk_stable`` stored; 0 otherwise).
     """
 
     points: int
@@ -520,6 +546,7 @@ class MapSummary:
     inner: Axis
     status_counts: dict[str, int] = field(default_factory=dict)
     unstable: int = 0
+    pad_only: int = 0
 
     @property
     def stable(self) -> int:
@@ -536,7 +563,11 @@ class MapSummary:
         (:func:`~brakesqueal.status.verdict_counts_text`)."""
         from ..status import verdict_counts_text
 
-        return verdict_counts_text(self.points, self.stable, self.unstable, self.status_counts)
+        text = verdict_counts_text(self.points, self.stable, self.unstable, self.status_counts)
+        if self.pad_only:
+            text += (f"; {self.pad_only} of the unstable points only through a massless pad's own 0 Hz mode "
+                     "(disk modes stable there: not squeal; variable 'disk_stable')")
+        return text
 
 
 def write_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, path: str, *, force: bool = False,
@@ -582,7 +613,7 @@ def write_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, path: str
     from .quantities import attributes, quantity
 
     plan = _plan(engine, space, x, y, force, eigen, in_memory=False)
-    names, ex = _names(eigen, quantities)
+    names, ex = _names(eigen, quantities, engine)
     n_o, n_i = plan.outer.num, plan.inner.num
     # the boundary needs the verdicts and status codes of the whole grid (2 bytes per point, at most
     # BOUNDARY_MAX_POINTS points); nothing else of the map is held: each block of rows goes to the file at once
@@ -591,7 +622,7 @@ def write_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, path: str
     status = np.zeros((n_o, n_i), dtype=np.int8) if keep else None
     f = MapFile(path, space, plan.outer, plan.inner, eigen=eigen, float_dtype=plan.ftype, method=plan.method,
                 boundary=keep, extras=tuple((n, quantity(n).dtype, attributes(n, engine)) for n in ex))
-    n_stable = n_unstable = 0
+    n_stable = n_unstable = n_pad_only = 0
     counts = np.zeros(len(PointStatus), dtype=np.int64)
     try:
         for r0, r1, c0, c1, v in _rows(space, plan, names, chunk_points, modes):
@@ -602,6 +633,8 @@ def write_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, path: str
             counts += np.bincount(codes, minlength=counts.size)[:counts.size]
             decided = (codes == PointStatus.OK) | (codes == PointStatus.OK_NONTRIVIAL)
             n_unstable += int(np.count_nonzero(decided & ~np.asarray(st, dtype=bool).ravel()))
+            if "disk_stable" in v:
+                n_pad_only += int(np.count_nonzero(~np.asarray(st, dtype=bool) & (v["disk_stable"] == 1)))
             if stable is not None and status is not None:
                 stable[r0:r1, c0:c1] = st
                 status[r0:r1, c0:c1] = ss
@@ -617,4 +650,4 @@ def write_map(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, path: str
     f.close()
     n = n_o * n_i
     return MapSummary(n, n_stable / n, plan.method, plan.outer, plan.inner,
-                      {s.meaning: int(c) for s, c in zip(PointStatus, counts) if c}, n_unstable)
+                      {s.meaning: int(c) for s, c in zip(PointStatus, counts) if c}, n_unstable, n_pad_only)

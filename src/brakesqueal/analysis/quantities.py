@@ -19,6 +19,7 @@ max_real       f8    largest real part of the eigenvalues [1/s]
 frequency      f8    frequency of the least-stable mode [Hz]
 margin         f8    damping ratio of the least-stable mode, ``-Re λ/|λ|``
 carrier        int8  the mode carrying the verdict (flags: the model's components)
+disk_stable    int8  verdict of the disk's modes alone (a massless pad's own mode left out; -1: none)
 route          int8  the route of the dispatcher that decided (flags: the routes)
 critical_speed f8    first destabilising Ω of the searched range [rad/s]
 ============== ===== ================================================================
@@ -40,7 +41,7 @@ if TYPE_CHECKING:
     from ..model.parameters import ParameterSpace
 
 __all__ = ["Quantity", "Block", "QUANTITIES", "ALWAYS", "register_quantity", "quantity", "attributes",
-           "evaluate_block", "needs_eigen"]
+           "evaluate_block", "needs_eigen", "has_pad_modes"]
 
 
 @dataclass
@@ -259,6 +260,47 @@ def _critical_speed(b: Block) -> np.ndarray:
     return out
 
 
+def has_pad_modes(engine: Engine) -> bool:
+    """Whether a model has massless pads whose tangential rates are states (modes of a pad alone).
+
+    Parameters
+    ----------
+    engine : Engine
+        The model's engine.
+
+    Returns
+    -------
+    bool
+    """
+    return bool(carrier_labels(engine)[2].size)
+
+
+def _disk_stable(b: Block) -> np.ndarray:
+    """The verdict of the disk's modes alone: 1 stable, 0 unstable, -1 no verdict.
+
+    Equal to ``stable`` wherever the verdict is "stable" or carried by a mode other than a massless pad's own
+    tangential rate; the points whose instability a pad's rate carries (or whose carrier is not known) are
+    decided again with that mode left out (:func:`~.verdict.decide` with ``modes="disk"``: the same routes).
+    """
+    v = b.verdicts
+    shape = b.points.shape
+    out = np.full(shape, -1, dtype=np.int8)
+    decided = np.isin(b.status, DECIDED)
+    out[decided & b.stable] = 1
+    pads = carrier_labels(b.engine)[2]
+    unstable = decided & ~b.stable
+    again = unstable & (np.isin(v.carrier, pads) | (v.carrier < 0)) if pads.size else np.zeros(shape, dtype=bool)
+    out[unstable & ~again] = 0
+    flat = np.flatnonzero(again)
+    if flat.size:
+        ix = np.unravel_index(flat, shape)
+        at = {n: np.broadcast_to(b.points.settable_values(n), shape)[ix] for n in b.points.names}
+        d = decide(b.engine, b.space, Points.of(b.space, at), eigen=False, modes="disk", carriers="cheap")
+        ok = np.isin(d.status, DECIDED)
+        out[ix] = np.where(ok & d.stable, 1, np.where(ok, 0, -1)).astype(np.int8).reshape(-1)
+    return out
+
+
 def _route_labels(engine: Engine) -> tuple[str, ...]:
     return route_names()
 
@@ -283,6 +325,12 @@ for _q in (
                                                 "determined: a larger model's point decided from its "
                                                 "characteristic polynomial)"},
              lambda b: b.verdicts.carrier, labels=lambda e: carrier_labels(e)[0]),
+    Quantity("disk_stable", "i1", -1, {"long_name": "the disk's modes alone asymptotically stable (certified; a "
+                                                    "massless pad's own tangential-rate mode left out; -1: no "
+                                                    "verdict)",
+                                       "flag_values": np.array([-1, 0, 1], dtype=np.int8),
+                                       "flag_meanings": "no_verdict unstable stable"},
+             _disk_stable),
     Quantity("route", "i1", 0, {"long_name": "stability route that decided the point (brakesqueal.analysis.verdict; "
                                              "0: none)"},
              lambda b: b.verdicts.method, labels=_route_labels),

@@ -66,7 +66,8 @@ if TYPE_CHECKING:
 __all__ = [
     "UNSTABLE", "STABLE", "UNDECIDED", "STATUS_UNDECIDED", "INPUT_REL", "routh_verdicts", "routh_exact",
     "isolate_real_roots", "quartic_interval", "eigen_verdicts",
-    "mp_roots_summary", "roots_summary", "exact_trivial_entries", "balance", "state_verdicts", "descriptor_verdicts",
+    "mp_roots_summary", "balanced_roots_summary", "bounded_verdict", "roots_summary", "exact_trivial_entries",
+    "balance", "state_verdicts", "descriptor_verdicts",
     "extended_descriptor_verdict", "EXTENDED_VERDICT_MAX_SIZE", "mp_balanced", "extended_analysis", "extended_eigen",
     "state_analysis", "state_matrices", "descriptor_states",
 ]
@@ -684,18 +685,39 @@ def extended_analysis(E: np.ndarray, A: np.ndarray, k: int, labels: np.ndarray |
         carriers = lab[owner]
         if exclude is not None and len(exclude):
             judged = ~np.isin(carriers, np.asarray(exclude, dtype=np.int64))
+    code, mr, fr, bd, j = bounded_verdict(out, bounds, judged)
+    return code, mr, fr, bd, out, (int(carriers[j]) if j >= 0 else -1)
+
+
+def bounded_verdict(lam: np.ndarray, bounds: np.ndarray, judged: np.ndarray) -> tuple[int, float, float, float, int]:
+    """The verdict of eigenvalues with error bounds, some of them judged (the others reported, not judged).
+
+    Stable if every judged eigenvalue lies left of the imaginary axis by more than its bound, unstable if one
+    lies right of it by more than its bound, undecided otherwise (stable when nothing is judged).
+
+    Parameters
+    ----------
+    lam, bounds : ndarray, shape (m,)
+        The eigenvalues and their error bounds.
+    judged : ndarray of bool, shape (m,)
+        Which count.
+
+    Returns
+    -------
+    code, max_real, frequency, bound, index
+        The verdict code; the least-stable judged eigenvalue's real part, frequency [Hz] and bound, and its index
+        (NaN and -1 when nothing is judged).
+    """
     if not judged.any():  # every mode excluded
-        return STABLE, math.nan, math.nan, math.nan, out, -1
-    re = np.where(judged, out.real, -np.inf)
-    j = int(np.argmax(re))
-    if np.all((out.real + bounds < 0) | ~judged):
+        return STABLE, math.nan, math.nan, math.nan, -1
+    j = int(np.argmax(np.where(judged, lam.real, -np.inf)))
+    if np.all((lam.real + bounds < 0) | ~judged):
         code = STABLE
-    elif np.any((out.real - bounds > 0) & judged):
+    elif np.any((lam.real - bounds > 0) & judged):
         code = UNSTABLE
     else:
         code = UNDECIDED
-    return (code, float(out[j].real), float(abs(out[j].imag) / (2 * math.pi)), float(bounds[j]), out,
-            int(carriers[j]))
+    return code, float(lam[j].real), float(abs(lam[j].imag) / (2 * math.pi)), float(bounds[j]), j
 
 
 
@@ -798,7 +820,106 @@ def _exact_point(engine: Engine, p: Sequence[float], eigen: bool) -> tuple[int, 
     code = routh_exact(q)
     if not eigen:
         return code, math.nan, math.nan
-    mr, fr = mp_roots_summary(q)
+    mr, fr = balanced_roots_summary(q)
+    # the double-precision roots of the balanced polynomial serve where their sign is the exact verdict's
+    # (the verdict is Routh's, exact); near the boundary or beyond double's range, 50-digit roots
+    if not (math.isfinite(mr) and ((code == STABLE and mr < 0) or (code == UNSTABLE and mr >= 0))):
+        mr, fr = mp_roots_summary(q)
     return code, mr, fr
 
 
+def _log2(x: Fraction) -> int:
+    """``floor(log2 |x|)`` to within one, of an exact nonzero rational, without converting it to a float."""
+    return x.numerator.bit_length() - x.denominator.bit_length() if x > 0 else \
+        (-x).numerator.bit_length() - x.denominator.bit_length()
+
+
+#: Bits by which a coefficient must fall below a group's largest to be left out of that group's roots.
+_GAP_BITS = 80
+
+
+def balanced_roots_summary(coeffs: Sequence[Fraction]) -> tuple[float, float]:
+    """``(max Re λ, |Im λ|/2π)`` of an exactly given polynomial's least-stable root, from double precision.
+
+    The roots are found in groups of one magnitude, read off the Newton polygon of the exact coefficients
+    (the upper convex hull of ``(k, log2 |a_k|)``: an edge from ``i`` to ``j`` holds ``j - i`` roots of modulus
+    about ``2^s``, ``s = (log2|a_i| - log2|a_j|)/(j - i)``; adjacent edges whose other coefficients are not
+    ``2^-80`` below are merged).  Per group the coefficients ``a_i .. a_j`` are scaled exactly (``λ = 2^s μ``),
+    divided by the largest and only then rounded, so that coefficients spanning far more than double's range
+    (parameters at the magnitude bounds, roots from ``1e-100`` to ``1e100``) still give every root.  Each root
+    is then polished by Newton's method on the exact polynomial in 50-digit arithmetic and accepted only if
+    its residual is at rounding level and the roots are distinct; NaN otherwise (then
+    :func:`mp_roots_summary`).  About 100 times faster than :func:`mp_roots_summary`, which also fails on
+    such spreads.
+
+    Parameters
+    ----------
+    coeffs : sequence of Fraction
+        Ascending exact coefficients.
+
+    Returns
+    -------
+    (float, float)
+    """
+    import mpmath
+
+    c = [Fraction(x) for x in coeffs]
+    while len(c) > 1 and c[-1] == 0:
+        c.pop()
+    low = 0
+    while low < len(c) - 1 and c[low] == 0:  # roots at 0
+        low += 1
+    m = len(c) - 1
+    if m < 1:
+        return math.nan, math.nan
+    pts = [(k, _log2(c[k])) for k in range(low, m + 1) if c[k] != 0]
+    hull: list[tuple[int, int]] = []
+    for pt in pts:  # upper convex hull (monotone chain)
+        while len(hull) >= 2 and ((hull[-1][0] - hull[-2][0]) * (pt[1] - hull[-2][1])
+                                  - (hull[-1][1] - hull[-2][1]) * (pt[0] - hull[-2][0])) >= 0:
+            hull.pop()
+        hull.append(pt)
+    edges = [[i, j, (li - lj) / (j - i)] for (i, li), (j, lj) in zip(hull[:-1], hull[1:])]
+    groups = [edges[0]] if edges else []
+    for e in edges[1:]:
+        g = groups[-1]
+        if (e[2] - g[2]) * min(e[1] - e[0], g[1] - g[0]) < _GAP_BITS:  # not separated: one group
+            g[2] = (g[2] * (g[1] - g[0]) + e[2] * (e[1] - e[0])) / (e[1] - g[0])
+            g[1] = e[1]
+        else:
+            groups.append(e)
+    starts: list[tuple[complex, int]] = []  # root = mu 2^sc
+    with np.errstate(all="ignore"):
+        for gi, gj, s in groups:
+            i, j, sc = int(gi), int(gj), round(s)
+            scaled = [c[k] * Fraction(2) ** (sc * k) for k in range(i, j + 1)]
+            big = max(abs(x) for x in scaled)
+            b = [float(x / big) if abs(x) >= big / 2 ** 1000 else 0.0 for x in scaled]
+            mu = np.roots(b[::-1])
+            if mu.size != j - i or not np.all(np.isfinite(mu)):
+                return math.nan, math.nan
+            starts += [(complex(z), sc) for z in mu]
+    if len(starts) != m - low:
+        return math.nan, math.nan
+    with mpmath.workdps(50):
+        approx = [mpmath.mpc(z) * mpmath.ldexp(1, sc) for z, sc in starts]
+        a = [mpmath.mpf(x.numerator) / x.denominator for x in c]
+        da = [k * a[k] for k in range(1, m + 1)]
+        roots = []
+        for z0 in approx:
+            z = mpmath.mpc(z0)
+            for _ in range(4):
+                d = mpmath.polyval(da[::-1], z)
+                if d == 0:
+                    break
+                z -= mpmath.polyval(a[::-1], z) / d
+            size = mpmath.polyval([abs(v) for v in a[::-1]], abs(z))
+            if size == 0 or abs(mpmath.polyval(a[::-1], z)) > size * mpmath.mpf(2) ** -140:
+                return math.nan, math.nan
+            roots.append(z)
+        for p_, q_ in ((p_, q_) for k, p_ in enumerate(roots) for q_ in roots[k + 1:]):
+            if abs(p_ - q_) <= mpmath.mpf(2) ** -60 * max(abs(p_), abs(q_)):
+                return math.nan, math.nan  # two starts polished onto one root
+        roots += [mpmath.mpc(0)] * low
+        top = max(roots, key=lambda z: mpmath.re(z))
+        return float(mpmath.re(top)), float(abs(mpmath.im(top)) / (2 * mpmath.pi))

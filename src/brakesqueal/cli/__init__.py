@@ -248,7 +248,8 @@ def _register_plugins() -> None:
     """Add the command groups that live in their own modules."""
     import importlib
 
-    for name in (".stability", ".modes", ".sweep", ".plot", ".cache", ".simulate", ".export", ".explore", ".fe"):
+    for name in (".stability", ".modes", ".sweep", ".plot", ".cache", ".simulate", ".export", ".explore", ".fe",
+                 ".uq", ".region", ".robust"):
         mod = importlib.import_module(name, __package__)
         mod.register(app)
 
@@ -277,6 +278,9 @@ SUMMARIES: dict[str, str] = {
     "import": "A model file from finite-element coefficient matrices.",
     "box": "Eigenvalues of a large matrix model in a box, with bounds.",
     "reduce": "Reduce a large matrix model along Omega (POD).",
+    "uq": "Squeal as a probability: Sobol indices and P(squeal) of a study.",
+    "region": "Two-parameter squeal regions: Hopf curves, l1, special points.",
+    "robust": "Certified robust design windows: stable for every point of a box.",
     "cache": "Inspect or clear the code cache.",
     "explore": "The squeal explorer in the browser (live, offline).",
 }
@@ -382,9 +386,9 @@ def main(argv: list[str] | None = None) -> int:
     program = argv is None
     try:
         # Ctrl-C within a second: the program (never a caller of main(argv) in its own process) ends a command
-        # that does not unwind in EXIT_AFTER_S (not a sweep: its Dask workers must be shut down), and then skips
-        # the interpreter's slow teardown
-        with interrupt_guard(exit_after=EXIT_AFTER_S if program and args[:1] != ["sweep"] else None), \
+        # that does not unwind in EXIT_AFTER_S (not a sweep or uq: their Dask workers must be shut down), and then
+        # skips the interpreter's slow teardown
+        with interrupt_guard(exit_after=EXIT_AFTER_S if program and args[:1] not in (["sweep"], ["uq"]) else None), \
                 guard_inputs(args):  # an output never replaces an input of the command (brakesqueal.outputs)
             rv = app(args=args, prog_name="brakesqueal", standalone_mode=False)
     except BrakesquealError as exc:

@@ -148,9 +148,14 @@ def pads_option(space: ParameterSpace, pad_slope: float | None, stick_speed: flo
     return regularised_pads(space, pad_slope, stick_speed)
 
 
-def space_from(model: str | None, preset: str | None, params: str | None, sets: list[str] | None) -> ParameterSpace:
+def space_from(model: str | None, preset: str | None, params: str | None, sets: list[str] | None,
+               axes: dict[str, str] | None = None) -> ParameterSpace:
     """The :class:`~brakesqueal.model.parameters.ParameterSpace` of the shared options (notes values given
     with units, in SI, and replaced ties).
+
+    A name that an axis of the command varies (``axes``: name -> option, e.g. ``{"mu1": "--x"}``) and that the
+    preset ties replaces its tie, as ``--set`` would (with a note): a map over ``mu1`` and ``mu2`` of
+    ``paper-fig2`` needs no ``--set``.
 
     The options are checked first (:func:`brakesqueal.inputs.check_option`: never empty, never longer than
     the limits), so that messages name them as typed (``--preset``), not as the library's arguments."""
@@ -168,6 +173,13 @@ def space_from(model: str | None, preset: str | None, params: str | None, sets: 
             note(value.echo(name))
     for name in space.untied:
         note(f"--set {name}=... replaces the tie {name} = {space.preset.tied[name]} of preset '{space.label}'")
+    tied = [n for n in (axes or {}) if n in space.tied]
+    if tied:
+        current = space.resolve()
+        for name in tied:
+            note(f"the {(axes or {})[name]} axis replaces the tie {name} = {space.tied[name]} of preset "
+                 f"'{space.label}'")
+        space = space.with_values({n: float(current[n]) for n in tied})
     return space
 
 

@@ -115,16 +115,14 @@ def box_cmd(
     modes in [f1, f2] Hz", "stable in box", or "undecided" naming what was not resolved."""
     import json
 
-    from ..analysis.matrix_analysis import box_analysis
-    from ..codegen import build
+    from ..api import box_eigenvalues, engine as _engine
     from ._progress import progress as _progress
 
     box_re, box_f = _range(re, "--re"), _range(freq, "--freq")
     p = space_from(model, preset, params, set_).resolve({})
-    engine = build(p.model)
+    engine = _engine(p)
     with _progress("box", progress) as cb:
-        r = box_analysis(engine, p, re=box_re, freq=box_f, max_shifts=max_shifts,
-                         progress=lambda i, n: cb(i / max(n, 1)))
+        r = box_eigenvalues(p, re=box_re, freq=box_f, max_shifts=max_shifts, progress=lambda i, n: cb(i / max(n, 1)))
     rows = [{"re": float(z.real), "im": float(z.imag), "frequency_hz": float(z.imag / (2 * 3.141592653589793)),
              "bound": float(b)} for z, b in zip(r.eigenvalues, r.bounds)]
     if fmt == OutFormat.json:
@@ -165,8 +163,7 @@ def reduce_cmd(
     import numpy as np
 
     from ..analysis.maps import parse_axis
-    from ..analysis.matrix_analysis import reduce_model
-    from ..codegen import build
+    from ..api import engine as _engine, reduce_matrix_model
     from ..model.matrices import write_matrix_model
     from ..outputs import check_output
     from ._progress import progress as _progress
@@ -177,12 +174,12 @@ def reduce_cmd(
         raise ParameterError(f"--tol must be in [0, 1]; got {tol!r}", parameter="--tol")
     check_output(out, what="--out", suffixes=(".toml",))
     ax = parse_axis(along)
-    space = space_from(model, preset, params, set_)
-    engine = build(space.model)
+    space = space_from(model, preset, params, set_, axes={ax.name: "--along"})
+    engine = _engine(space)
     samples = [float(v) for v in ax.values()]
     with _progress("reduce", progress) as cb:
-        red = reduce_model(engine, space, samples, re=_range(re, "--re"), freq=_range(freq, "--freq"), r=dim,
-                           tol=tol, checks=checks, progress=lambda i, n: cb(i / max(n, 1)))
+        red = reduce_matrix_model(space, samples, re=_range(re, "--re"), freq=_range(freq, "--freq"), r=dim,
+                                  tol=tol, checks=checks, progress=lambda i, n: cb(i / max(n, 1)))
     write_matrix_model(red.spec, out)
     if fmt == OutFormat.json:
         sys.stdout.write(json.dumps({**red.to_dict(), "out": out}, indent=2, allow_nan=False,

@@ -38,7 +38,7 @@ def modes(
         check_output(out, what="--out", suffixes=(".nc",))
     if plot:
         check_output(plot, what="--plot", suffixes=PLOT_SUFFIXES)
-    space = space_from(model, preset, params, set_)
+    space = space_from(model, preset, params, set_, axes={axis.name: "--along"})
     from ..codegen import build
     from ._progress import progress as _progress
 

@@ -142,6 +142,7 @@ def _simulate_cmd(
 
     data = {**summary.to_dict(), "model": tr.model, "message": tr.message, "start": tr.start,
             "t_end_reached": tr.t_end_reached, "duration_s": tr.duration, "stop_reason": tr.stop_reason,
+            "amplitude_final_unit": _norm_unit(tr.coords),
             "amplitude_final_by_coordinate": {c: {"amplitude": a if math.isfinite(a) else None,
                                                   "unit": coordinate_unit(c)}
                                               for c, a in tr.final_amplitudes().items()},
@@ -169,6 +170,16 @@ def _simulate_cmd(
         # outputs are written; exit status 1 distinguishes a solver failure from bad input (2)
         sys.stderr.write(f"brakesqueal: simulation failed: {tr.message}\n")
         raise SystemExit(1)
+
+
+def _norm_unit(coords: tuple[str, ...] | list[str]) -> str:
+    """The unit of ``amplitude_final`` (a norm over every coordinate): one unit, or why there is none."""
+    from ..model.components import coordinate_unit
+
+    units = sorted({coordinate_unit(c) for c in coords})
+    if len(units) == 1:
+        return units[0]
+    return f"none (a norm over {' and '.join(units)}: see amplitude_final_by_coordinate)"
 
 
 def _run(p: Parameters, t_end: float, method: str, rtol: float, atol: float | None, events: str, sample_rate: float,

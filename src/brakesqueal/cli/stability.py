@@ -80,7 +80,7 @@ def crossings(
     refuse_set_of_axes(set_, {axis.name: "--along"})
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
-    space = space_from(model, preset, params, set_)
+    space = space_from(model, preset, params, set_, axes={axis.name: "--along"})
     r: CrossingResult = _crossings(space, axis, modes=modes.value)
     if plot:
         _write_plot(r.plot(), plot)
@@ -179,7 +179,7 @@ def map_(
     check_output(out, what="--out", suffixes=(".nc",))
     if plot:
         check_output(plot, what="--plot", suffixes=_PLOT_SUFFIXES)
-    space = space_from(model, preset, params, set_)
+    space = space_from(model, preset, params, set_, axes={ax_x.name: "--x", ax_y.name: "--y"})
     with _progress("map", progress) as cb, atomic_write(out, what="--out") as tmp:
         s = write_map(space, ax_x, ax_y, str(tmp), force=force, eigen=not no_eigen, progress=cb, modes=modes.value)
     msg = f"wrote {out}"
@@ -259,7 +259,8 @@ def hopf(
 
     axis = parse_axis(along, with_num=False)
     refuse_set_of_axes(set_, {axis.name: "--along"})
-    space = pads_option(with_equations(space_from(model, preset, params, set_), "hopf"), None, None, pad_damping)
+    base = with_equations(space_from(model, preset, params, set_, axes={axis.name: "--along"}), "hopf")
+    space = pads_option(base, None, None, pad_damping)
     engine = build(space.model)  # the entry point's engine, passed down
     r: CrossingResult = _crossings(engine, space, axis)
     pts = hopf_points(engine, space, axis, result=r)
@@ -322,7 +323,7 @@ def cycles(
     if pads == "quasi-static" and (pad_damping is not None or pad_slope is not None):
         raise ParameterError("The option '--pads quasi-static' cannot be combined with --pad-damping or --pad-slope "
                              "(they keep the pads' rates)")
-    base = with_equations(space_from(model, preset, params, set_), "cycles")
+    base = with_equations(space_from(model, preset, params, set_, axes={axis.name: "--along"}), "cycles")
     space = pads_option(base, pad_slope, stick_speed, pad_damping)  # checked before anything is computed
     route = cycle_route(space, axis, contact=contact, pads=pads)
     options: dict[str, Any] = {}

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any, Concatenate, Final, Literal, ParamSpec, T
 import numpy as np
 
 from ..errors import BrakesquealError, ParameterError
-from ..plotting import MAP_STABLE, MAP_UNSTABLE
+from ..plotting import MAP_PAD_ONLY, MAP_STABLE, MAP_UNSTABLE
 from .state import (
     AUDIO_RATE,
     LINK_KEYS,
@@ -99,7 +99,7 @@ URL_DELAY_MS = 400
 INFO_REST_MS = 250
 _LOG_FORMAT = "return Number((10 ** tick).toPrecision(3)).toExponential();"
 #: The map's fill colours (unstable, stable, no verdict): the command line's map figures' (green stable, red unstable).
-_MAP_PALETTE = [MAP_UNSTABLE, MAP_STABLE, "#c8c8c8"]
+_MAP_PALETTE = [MAP_UNSTABLE, MAP_STABLE, "#c8c8c8", MAP_PAD_ONLY]
 #: Colours of the current point and of stable and unstable limit cycles: matplotlib's C0 and C3, as in the command
 #: line's figures (stable cycles drawn in C0, unstable ones in C3).
 _POINT, _CYCLE_STABLE, _CYCLE_UNSTABLE = "#1f77b4", "#1f77b4", "#d62728"
@@ -457,9 +457,9 @@ class Explorer:
     # ------------------------------------------------------------------------------------------ widgets
     def _make_widgets(self) -> None:
         pn = self.pn
-        self.model_select = pn.widgets.Select(name="model", options=self.origin.models(), value=self.state.model,
+        self.model_select = pn.widgets.Select(label="model", options=self.origin.models(), value=self.state.model,
                                               width=160)
-        self.preset_select = pn.widgets.Select(name="preset", options=self.origin.presets(self.state.model),
+        self.preset_select = pn.widgets.Select(label="preset", options=self.origin.presets(self.state.model),
                                                value=self.state.preset, width=160)
         self.model_select.param.watch(self._on_model, "value")
         self.preset_select.param.watch(self._on_preset, "value")
@@ -472,21 +472,21 @@ class Explorer:
         self._more_names: list[str] = []
         self.fixed_box = pn.Card(title="fixed parameters", collapsed=True, sizing_mode="stretch_width")
         self.fixed_box.param.watch(self._on_fixed_card, "collapsed")
-        self.along_select = pn.widgets.Select(name="root locus along", width=120)
-        self.x_select = pn.widgets.Select(name="map x", width=95)
-        self.y_select = pn.widgets.Select(name="map y", width=95)
-        self.nx_input = pn.widgets.IntInput(name="x points", value=self.state.nx, start=2, width=90)
-        self.ny_input = pn.widgets.IntInput(name="y points", value=self.state.ny, start=2, width=90)
+        self.along_select = pn.widgets.Select(label="root locus along", width=120)
+        self.x_select = pn.widgets.Select(label="map x", width=95)
+        self.y_select = pn.widgets.Select(label="map y", width=95)
+        self.nx_input = pn.widgets.IntInput(label="x points", value=self.state.nx, start=2, width=90)
+        self.ny_input = pn.widgets.IntInput(label="y points", value=self.state.ny, start=2, width=90)
         for w in (self.along_select, self.x_select, self.y_select, self.nx_input, self.ny_input):
             w.param.watch(self._on_view, "value")
-        self.t_end_input = pn.widgets.FloatInput(name="simulated time [s]", value=self.state.t_end, start=0.001,
+        self.t_end_input = pn.widgets.FloatInput(label="simulated time [s]", value=self.state.t_end, start=0.001,
                                                  end=MAX_T_END, width=130)
         self.t_end_input.param.watch(self._on_view, "value")
-        self.sim_button = pn.widgets.Button(name="Simulate", button_type="primary", width=100)
+        self.sim_button = pn.widgets.Button(label="Simulate", color="primary", width=100)
         self.sim_button.on_click(self._on_simulate)
-        self.cycles_button = pn.widgets.Button(name="Cycles", width=80)
+        self.cycles_button = pn.widgets.Button(label="Cycles", width=80)
         self.cycles_button.on_click(self._on_cycles)
-        self.cancel_button = pn.widgets.Button(name="Cancel", width=80)
+        self.cancel_button = pn.widgets.Button(label="Cancel", width=80)
         self.cancel_button.on_click(self._on_cancel)
         self.map_progress = pn.indicators.Progress(value=0, max=100, width=150, visible=False)
         self.sim_progress = pn.indicators.Progress(value=0, max=100, width=150, visible=False)
@@ -579,10 +579,10 @@ class Explorer:
         value = space.value(name)
         kw: dict[str, Any] = {"format": CustomJSTickFormatter(code=_LOG_FORMAT)} if rng.log else {}
         lo, hi = rng.to_slider(rng.low), rng.to_slider(rng.high)
-        slider = pn.widgets.FloatSlider(name=_label(space, name), start=lo, end=hi, step=(hi - lo) / 500,
+        slider = pn.widgets.FloatSlider(label=_label(space, name), start=lo, end=hi, step=(hi - lo) / 500,
                                         value=rng.to_slider(value), width=210, css_classes=[f"bs-slider-{name}"],
                                         **kw)
-        box = pn.widgets.TextInput(value=_fmt_value(value), width=100, name=" ",
+        box = pn.widgets.TextInput(value=_fmt_value(value), width=100, label=" ",
                                    css_classes=[f"bs-input-{name}"])
         slider.param.watch(lambda e, n=name: self._on_slider(n, e.new), "value")
         box.param.watch(lambda e, n=name: self._on_text(n, e.new), "value")
@@ -608,7 +608,7 @@ class Explorer:
         for name in space.settable():
             if name in space.preset.free:
                 continue
-            box = pn.widgets.TextInput(name=_label(space, name), value=_fmt_value(space.value(name)), width=150,
+            box = pn.widgets.TextInput(label=_label(space, name), value=_fmt_value(space.value(name)), width=150,
                                        css_classes=[f"bs-input-{name}"])
             box.param.watch(lambda e, n=name: self._on_text(n, e.new), "value")
             _undebounce(box)
@@ -644,7 +644,7 @@ class Explorer:
         self.src_map = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
         self.src_boundary = ColumnDataSource({"x": [], "y": []}, name="bs-boundary")
         self.src_point = ColumnDataSource({"x": [], "y": []})
-        self.map_mapper = LinearColorMapper(palette=_MAP_PALETTE, low=-0.5, high=2.5)
+        self.map_mapper = LinearColorMapper(palette=_MAP_PALETTE, low=-0.5, high=3.5)
         self.pane_map = pn.pane.Bokeh(self._map_figure(*self._map_logs), css_classes=['bs-map'])
 
     def _ensure_dynamics(self) -> None:
@@ -746,7 +746,9 @@ class Explorer:
                          width=_LEFT)
         legend = pn.pane.HTML(f"<small>map: <span style='background:{MAP_STABLE}'>&nbsp;stable&nbsp;</span> "
                               f"<span style='background:{MAP_UNSTABLE}'>&nbsp;unstable&nbsp;</span> "
-                              "<span style='background:#c8c8c8'>&nbsp;no verdict&nbsp;</span>; black: the exact "
+                              "<span style='background:#c8c8c8'>&nbsp;no verdict&nbsp;</span> "
+                              f"<span style='background:{MAP_PAD_ONLY}'>&nbsp;disk stable, only a pad's own 0 Hz "
+                              "mode unstable&nbsp;</span>; black: the exact "
                               "boundary (refined by bisection); blue cross: the current point</small>")
         export = pn.Row(self.map_nc_download, self.map_csv_download, self.locus_download)
         texts = pn.Column(self.leading_text, self.cs_text, self.hopf_text, self.map_text, legend, export, self.sim_text,
@@ -1136,6 +1138,8 @@ class Explorer:
         tx = np.log10(mv.x) if mv.x_log else mv.x
         ty = np.log10(mv.y) if mv.y_log else mv.y
         code = np.where(mv.status <= 1, mv.stable.astype(np.int8), 2).astype(np.float32)
+        pad_only = mv.pad_only if mv.pad_only.shape == code.shape else np.zeros(code.shape, dtype=bool)
+        code[pad_only] = 3  # disk modes stable, only a massless pad's own 0 Hz mode unstable
         dx = (tx[-1] - tx[0]) / max(tx.size - 1, 1)
         dy = (ty[-1] - ty[0]) / max(ty.size - 1, 1)
         if self._map_logs != (mv.x_log, mv.y_log) or getattr(self, "_map_axes", None) != (state.x, state.y):
@@ -1145,7 +1149,8 @@ class Explorer:
                              "dw": [tx[-1] - tx[0] + dx], "dh": [ty[-1] - ty[0] + dy]}
         bx = np.log10(mv.boundary_x) if mv.x_log else mv.boundary_x
         by = np.log10(mv.boundary_y) if mv.y_log else mv.boundary_y
-        self.src_boundary.data = {"x": bx, "y": by}
+        # the refined boundary is that of every mode: left out where the colours show the disk's modes
+        self.src_boundary.data = {"x": bx[:0], "y": by[:0]} if pad_only.any() else {"x": bx, "y": by}
         self._map_view = mv
         for w, suffix in ((self.map_nc_download, "nc"), (self.map_csv_download, "csv")):
             w.filename = f"map_{state.x}_{state.y}.{suffix}"
@@ -1156,9 +1161,13 @@ class Explorer:
         n = mv.x.size * mv.y.size
         frac = float(np.mean(mv.stable))
         self.map_text.object = (f"<b>map:</b> {mv.x.size} × {mv.y.size} = {n:,} points (at most {MAX_MAP_POINTS:,}), "
-                                f"{100 * frac:.1f} % stable, boundary with {int(np.isfinite(mv.boundary_x).sum())} "
+                                f"{100 * frac:.1f} % stable"
+                                + (f" ({int(pad_only.sum()):,} more with stable disk modes: only a massless pad's own "
+                                   "0 Hz mode is unstable there)" if pad_only.any() else "")
+                                + f", boundary with {int(np.isfinite(mv.boundary_x).sum())} "
                                 f"refined vertices; {html.escape(mv.method)}")
         self.shown["map"] = {"state": state.to_query(), "points": n, "stable_fraction": frac,
+                             "pad_only": int(pad_only.sum()),
                              "boundary_vertices": int(np.isfinite(mv.boundary_x).sum())}
 
     def _compute_sim(self, state: ViewState, check: Callable[[float], None]) -> SimulationView:

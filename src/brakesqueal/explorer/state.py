@@ -545,6 +545,9 @@ class MapView:
         The stored refined boundary (curves separated by NaN; empty if none).
     method : str
         The map's route.
+    pad_only : ndarray of bool
+        Points whose disk modes are certified stable while a massless pad's own 0 Hz mode is unstable (the
+        map's ``disk_stable``; drawn apart, not as squeal).
     """
 
     x: np.ndarray
@@ -558,6 +561,7 @@ class MapView:
     boundary_y: np.ndarray
     method: str
     result: StabilityMap | None = field(default=None, compare=False, repr=False)
+    pad_only: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=bool), compare=False, repr=False)
 
 
 def map_view(space: ParameterSpace, x: str, y: str, rx: SliderRange, ry: SliderRange, nx: int, ny: int, *,
@@ -585,8 +589,11 @@ def map_view(space: ParameterSpace, x: str, y: str, rx: SliderRange, ry: SliderR
     mr = np.where(status <= 1, mr, np.nan)
     bx = ds[f"boundary_{x}"].values if f"boundary_{x}" in ds else np.empty(0)
     by = ds[f"boundary_{y}"].values if f"boundary_{y}" in ds else np.empty(0)
+    pad_only = np.zeros(stable.shape, dtype=bool)
+    if "disk_stable" in ds:
+        pad_only = (status <= 1) & ~stable.astype(bool) & (ds["disk_stable"].transpose(y, x).values == 1)
     return MapView(ds[x].values, ds[y].values, rx.log, ry.log, mr, stable, status, np.asarray(bx, dtype=float),
-                   np.asarray(by, dtype=float), str(ds.attrs.get("method", "")), m)
+                   np.asarray(by, dtype=float), str(ds.attrs.get("method", "")), m, pad_only)
 
 
 #: Formats of an exported map: its writer's file suffix.
@@ -771,19 +778,23 @@ def simulation_view(space: ParameterSpace, t_end: float, *,
 
     check_t_end(t_end)
     tr: Trajectory = simulate(space.resolve({}), float(t_end), sample_rate=float(AUDIO_RATE), progress=progress)
-    dq = tr.dq[:, 0]
-    t, x = _decimate(np.asarray(tr.t, dtype=float), np.asarray(dq, dtype=float), HISTORY_POINTS)
+    from ..model.components import coordinate_unit
+
+    j = tr.main_coordinate  # the coordinate that carries the motion (q1 or q2, or a pad's displacement)
+    name = tr.coords[j]
+    unit = coordinate_unit(name)
+    t, x = _decimate(np.asarray(tr.t, dtype=float), np.asarray(tr.dq[:, j], dtype=float), HISTORY_POINTS)
     if tr.t.size >= 16:
-        f, X = tr.spectrum()
+        f, X = tr.spectrum(j)
     else:
         f, X = np.empty(0), np.empty(0)
     audio = audio_samples(tr.audio_velocity()[0]) if tr.t.size >= 2 else np.zeros(0, dtype=np.int16)
     s = tr.summary
-    unit = "rad" if tr.tilting else "m"
-    amp = f"{s.amplitude_final:.3g} {unit}" if math.isfinite(s.amplitude_final) else "n/a"
+    a = tr.final_amplitudes().get(name, math.nan)
+    amp = f"{a:.3g} {unit}" if math.isfinite(a) else "n/a"
     summary = (f"simulation {tr.status}: f = {s.frequency_hz:.6g} Hz, growth rate = {s.growth_rate:.4g} 1/s, "
-               f"final amplitude = {amp}" + (f"; {tr.message}" if getattr(tr, "message", "") else ""))
-    return SimulationView(t, x, f"{tr.coords[0]} − {tr.coords[0]}₀ [{unit}]", np.asarray(f), np.asarray(X), audio,
+               f"final amplitude of {name} = {amp}; {tr.stop_reason}")
+    return SimulationView(t, x, f"{name} − {name}₀ [{unit}]", np.asarray(f), np.asarray(X), audio,
                           audio.size / AUDIO_RATE, summary)
 
 

@@ -19,10 +19,12 @@ A study file is a TOML superset of a parameter file (see ``docs/sweeps.md``)::
     [output]
     store = "fig2-omega.zarr"
 
-Instead of ``[axes]``, ``[samples]`` draws ``n`` random or Latin-hypercube
-points (``method = "random" | "lhs"``, ``seed``) from ``[samples.ranges]``
-(the same range syntax without ``num``); the result then has one dimension
-``sample``.  Every problem raises a one-line
+Instead of ``[axes]``, ``[samples]`` draws ``n`` random, Latin-hypercube or
+scrambled Sobol' points (``method = "random" | "lhs" | "sobol"``, ``seed``)
+from ``[samples.ranges]`` (the same range syntax without ``num``) and/or from
+``[distributions]`` (``mu = { uniform = [0.35, 0.55] }``, normal, truncnormal,
+lognormal, beta: :mod:`brakesqueal.uq`; their support must lie in the
+parameter's allowed range); the result then has one dimension ``sample``.  Every problem raises a one-line
 :class:`~brakesqueal.errors.ParameterError` naming the file and the key.
 """
 
@@ -45,6 +47,7 @@ from ..model.parameters import Value
 if TYPE_CHECKING:
     from ..codegen.engine import Engine
     from ..model.parameters import ParameterSpace
+    from ..uq import Distribution
 
 __all__ = ["Study", "StudySource", "GridAxis", "SampleRange", "load_study", "QUANTITIES", "DEFAULT_QUANTITIES",
            "MAX_AXIS_POINTS", "MAX_POINTS", "MAX_CHUNKS", "MAX_CHUNK_POINTS"]
@@ -57,7 +60,7 @@ DEFAULT_QUANTITIES = ("stable", "margin", "max_real", "frequency")
 #: Points per chunk by default: verdict-only studies / studies with eigenvalues.
 DEFAULT_CHUNK_POINTS = (1 << 22, 1 << 18)
 _TOP_KEYS = ("name", "description", "preset", "params", "model", "parameters", "tied", "axes", "samples", "compute",
-             "execution", "output")
+             "execution", "output", "distributions")
 _MAX_SAMPLES = 10**7
 #: Size limits of a study, checked from the study's numbers before anything is allocated:
 #: points of one grid axis (its values are held in memory by every process: 0.8 GB at the limit),
@@ -92,12 +95,14 @@ class GridAxis:
 
 @dataclass(frozen=True)
 class SampleRange:
-    """The range of one sampled parameter."""
+    """The range of one sampled parameter (``distribution``: drawn from it instead, ``[distributions]``;
+    ``start``/``stop`` are then its support)."""
 
     name: str
     start: float
     stop: float
     log: bool
+    distribution: Distribution | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -201,11 +206,21 @@ class Study:
             from scipy.stats import qmc
 
             u = qmc.LatinHypercube(d=d, seed=np.random.default_rng(self.seed)).random(n)
+        elif self.method == "sobol":
+            import warnings
+
+            from scipy.stats import qmc
+
+            with warnings.catch_warnings():  # n not a power of 2: fine for a sample, not for a Sobol' index design
+                warnings.filterwarnings("ignore", message=".*balance properties.*")
+                u = qmc.Sobol(d=d, scramble=True, seed=np.random.default_rng(self.seed)).random(n)
         else:
             u = np.random.default_rng(self.seed).random((n, d))
         out = {}
         for k, r in enumerate(self.ranges):
-            if r.log:
+            if r.distribution is not None:
+                out[r.name] = r.distribution.ppf(u[:, k])
+            elif r.log:
                 lo, hi = math.log(r.start), math.log(r.stop)
                 out[r.name] = np.exp(lo + (hi - lo) * u[:, k])
             else:
@@ -232,7 +247,9 @@ class Study:
                          for a in self.axes]
         else:
             d["samples"] = {"method": self.method, "n": self.n_samples, "seed": self.seed,
-                            "ranges": [[r.name, repr(r.start), repr(r.stop), r.log] for r in self.ranges]}
+                            "ranges": [[r.name, repr(r.start), repr(r.stop), r.log]
+                                       + ([r.distribution.spec()] if r.distribution is not None else [])
+                                       for r in self.ranges]}
         return d
 
     def hash(self) -> str:
@@ -376,6 +393,25 @@ def _grid_axis(ctx: _Ctx, name: str, v: object) -> GridAxis:
     except ParameterError as exc:
         raise ctx.err(key, str(exc)) from None
     return GridAxis(name, ax.values(), "log" if log else "linear", (start, stop, num), ax.ref)
+
+
+def _distributions(ctx: _Ctx, dtab: dict[str, Any], rtab: dict[str, Any], space: ParameterSpace) -> list[SampleRange]:
+    """The ``[distributions]`` entries as sampled ranges (parsed and checked by :mod:`brakesqueal.uq`)."""
+    from ..uq import check_support, parse_distribution
+
+    out = []
+    for k, v in dtab.items():
+        if k in rtab:
+            raise ctx.err(f"distributions.{k}", f"'{k}' is also in [samples.ranges]; give it one of the two")
+        try:
+            space.check_axis(k)
+        except ParameterError as exc:
+            raise ctx.err(f"distributions.{k}", str(exc)) from None
+        dist = parse_distribution(k, v, ctx.err, ctx.number)
+        check_support(dist, space, ctx.err)
+        lo, hi, _, _ = dist.support
+        out.append(SampleRange(k, lo, hi, False, dist))
+    return out
 
 
 def _size(nbytes: float) -> str:
@@ -575,6 +611,8 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
     # ---- axes / samples
     if ("axes" in data) == ("samples" in data):
         raise ctx.err("axes", "give exactly one of [axes] (grid) or [samples] (random / Latin hypercube)")
+    if "distributions" in data and "samples" not in data:
+        raise ctx.err("distributions", "needs [samples] (n, seed): distributions are sampled, not gridded")
     axes: tuple[GridAxis, ...] = ()
     ranges: tuple[SampleRange, ...] = ()
     n_samples, seed, method = 0, 0, ""
@@ -587,8 +625,8 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
     else:
         tab = ctx.table(data["samples"], "samples", ("method", "n", "seed", "ranges"))
         method = tab.get("method", "lhs")
-        if method not in ("lhs", "random"):
-            raise ctx.err("samples.method", f"must be 'lhs' or 'random'; got {method!r}")
+        if method not in ("lhs", "random", "sobol"):
+            raise ctx.err("samples.method", f"must be 'lhs', 'random' or 'sobol'; got {method!r}")
         if "n" not in tab:
             raise ctx.err("samples.n", "missing (number of samples)")
         n_samples = tab["n"]
@@ -600,8 +638,9 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
         if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
             raise ctx.err("samples.seed", f"must be a non-negative integer; got {seed!r}")
         rtab = ctx.table(tab.get("ranges", {}), "samples.ranges")
-        if not rtab:
-            raise ctx.err("samples.ranges", "empty: give at least one parameter range")
+        dtab = ctx.table(data.get("distributions", {}), "distributions")
+        if not rtab and not dtab:
+            raise ctx.err("samples.ranges", "empty: give at least one parameter range (or [distributions])")
         rl = []
         for k, v in rtab.items():
             start, stop, _, log = _parse_range(ctx, f"samples.ranges.{k}", v, False)
@@ -610,6 +649,7 @@ def _from_data(data: dict[str, Any], source: str, text: str, base: Path) -> Stud
             if log and start <= 0:
                 raise ctx.err(f"samples.ranges.{k}", f"a log range needs positive bounds; got start = {start!r}")
             rl.append(SampleRange(k, start, stop, log))
+        rl += _distributions(ctx, dtab, rtab, space) if dtab else []
         ranges = tuple(rl)
         kind, names = "samples", [r.name for r in ranges]
     prefix = "axes" if kind == "grid" else "samples.ranges"

@@ -15,7 +15,9 @@ function that chooses among the routes.  The rule is one ordered list,
    matrices;
 6. ``eigen-bounds`` — eigenvalues of the linearization with condition-number
    bounds (any size, pads kept as states);
-7. ``extended`` — 40-digit eigenvalues with componentwise bounds (small
+7. ``pencil-refined`` — QZ eigenpairs of the pencil refined by Newton's
+   method, with componentwise bounds (beside a massless pad's own huge mode);
+8. ``extended`` — 40-digit eigenvalues with componentwise bounds (small
    systems).
 
 Each route says whether it applies to the call (model, space, axes, input
@@ -47,6 +49,7 @@ from .closed_grid import ClosedGrid
 from .closed_interval import ClosedInterval
 from .eigen_bounds import EigenBounds, state_labels
 from .extended import Extended
+from .pencil_refined import PencilRefined
 from .quartic_interval import QuarticInterval
 
 if TYPE_CHECKING:
@@ -57,7 +60,7 @@ __all__ = ["decide", "decide_model", "ROUTES", "register", "route_names", "MODES
 
 #: The routes, in the order the dispatcher tries them.
 ROUTES: list[Route] = [ClosedGrid(), CharpolyGrid(), ClosedInterval(), ClosedExact(), QuarticInterval(), EigenBounds(),
-                       Extended()]
+                       PencilRefined(), Extended()]
 #: What a verdict judges: every eigenvalue, or the disk's modes (a massless pad's own tangential-rate mode left out).
 MODES = ("all", "disk")
 

@@ -1,0 +1,85 @@
+"""``brakesqueal region``: the squeal region diagram in two parameters (issue 28).
+
+Hopf curves with ``l1`` along them and codimension-2 points
+(:func:`brakesqueal.region.region_diagram`), the certified linear stability map,
+as text or JSON, ``--out FILE.nc`` (xarray/NetCDF) and ``--plot FILE``.
+Fold-of-cycles curves are not computed yet (the output says so).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from typing import Annotated, Optional
+
+import typer
+
+from ._options import (PLOT_SUFFIXES, FormatOpt, ModelOpt, OutFormat, ParamsOpt, PresetOpt, SetOpt,
+                       refuse_set_of_axes, space_from)
+
+__all__ = ["register"]
+
+
+def region(
+    x: Annotated[str, typer.Option("--x", help="NAME=START:STOP[:log] (horizontal axis).")],
+    y: Annotated[str, typer.Option("--y", help="NAME=START:STOP[:log] (vertical axis).")],
+    model: ModelOpt = None, preset: PresetOpt = None, params: ParamsOpt = None, set_: SetOpt = None,
+    fmt: FormatOpt = OutFormat.text,
+    out: Annotated[Optional[str], typer.Option("--out", help="NetCDF file of the curves (.nc).")] = None,
+    plot: Annotated[Optional[str], typer.Option("--plot", help="Also draw the diagram (PNG, SVG or PDF).")] = None,
+    seeds: Annotated[int, typer.Option("--seeds", min=1, max=100,
+                                       help="Paths in each direction whose crossings seed the curves.")] = 5,
+    max_points: Annotated[int, typer.Option("--max-points", min=2, max=10000,
+                                            help="Largest number of curve points each way from a seed.")] = 200,
+    grid: Annotated[int, typer.Option("--grid", min=2, max=2000,
+                                      help="Points per axis of the certified stability map.")] = 41,
+) -> None:
+    """Squeal regions in two parameters: Hopf curves coloured super/subcritical (l1 with the pads' true rates),
+    generalised-Hopf, Bogdanov-Takens, zero-Hopf and double-Hopf points, on the certified stability map.
+    Fold-of-cycles curves are not computed yet: no hysteresis region is shaded."""
+    from ..analysis.maps import parse_axis
+    from ..outputs import atomic_write, check_output
+    from ..region import region_diagram
+
+    from ..errors import ParameterError
+
+    axes = []
+    for text, opt in ((x, "--x"), (y, "--y")):
+        try:
+            axes.append(parse_axis(text, with_num=False))
+        except ParameterError as exc:
+            raise ParameterError(f"{opt}: {exc}", parameter=opt) from None
+    ax_x, ax_y = axes
+    if ax_x.name == ax_y.name:
+        raise ParameterError(f"The options --x and --y must vary two different parameters; got {ax_x.name!r} for "
+                             "both", parameter="--y")
+    refuse_set_of_axes(set_, {ax_x.name: "--x", ax_y.name: "--y"})
+    if out:
+        check_output(out, what="--out", suffixes=(".nc",))
+    if plot:
+        check_output(plot, what="--plot", suffixes=PLOT_SUFFIXES)
+    space = space_from(model, preset, params, set_, axes={ax_x.name: "--x", ax_y.name: "--y"})
+    from ..api import engine
+
+    r = region_diagram(engine(space), space, ax_x, ax_y, seeds=seeds, max_points=max_points, grid=grid)
+    if out:
+        with atomic_write(out, what="--out") as tmp:
+            r.to_dataset().to_netcdf(str(tmp), engine="scipy")
+    if plot:
+        with atomic_write(plot, what="--plot") as tmp:
+            r.plot().savefig(tmp, dpi=300)
+    if fmt == OutFormat.json:
+        sys.stdout.write(json.dumps(r.to_dict(), indent=2) + "\n")
+    else:
+        sys.stdout.write(r.text())
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``region`` to ``app``.
+
+    Parameters
+    ----------
+    app : typer.Typer
+        The main application.
+    """
+    app.command("region")(region)
