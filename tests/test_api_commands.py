@@ -21,6 +21,7 @@ COMMANDS = {
     "modes": ["modes_along"], "sweep": ["run_sweep"], "plot": ["plot_sweep"], "simulate": ["simulate"],
     "export": ["export_code"], "import": ["import_matrices"], "box": ["box_eigenvalues"],
     "reduce": ["reduce_matrix_model"], "uq": ["run_uq"], "region": ["region_diagram"], "robust": ["robust_box"],
+    "design": ["run_design"],
 }
 
 

@@ -187,7 +187,7 @@ LAYERS: dict[str, int] = {
     "inputs": 0, "validation": 0,
     "model": 1, "symbolic": 2, "codegen": 3, "labels": 4, "results": 4, "plotting": 4, "analysis": 5,
     "simulation": 6, "export": 6, "nonlinear": 7, "sweep": 7, "uq": 7, "region": 7, "robust": 7, "render": 8,
-    "reproduce": 8,
+    "reproduce": 8, "design": 8,
     "api": 8, "api_nonlinear": 8, "cli": 9, "explorer": 9, "demo": 9, "__main__": 9,
 }
 

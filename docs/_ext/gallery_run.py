@@ -51,6 +51,12 @@ COMMANDS: list[tuple[str, str, list[str], str]] = [
     ("Squeal region (paper's Fig. 3)", "fig3.png", ["reproduce", "fig3", "--out", "."],
      "The critical speed versus the friction asymmetry, joined with the re-stabilisation speeds into closed "
      "squeal regions whose tips are located by bisection."),
+    ("Squeal regions in two parameters (Fig. 3's set)", "region.png",
+     ["region", "--preset", "paper-fig3", "--set", "k_ip=inf", "--set", "mu2=0.5", "--x", "mu1=0:1", "--y",
+      "Omega=10:20000:log", "--no-progress", "--plot", "region.png"],
+     "The Hopf curve over the certified map, supercritical (blue) at the onset and subcritical (red) at the upper "
+     "re-stabilisation, joined at a generalised-Hopf point (GH); the fold-of-cycles slices from GH find the "
+     "cycles losing contact (crosses) before they fold."),
     ("Mode coupling", "modes.svg",
      ["modes", "--along", "mu=0.05:1", "--out", "modes.nc", "--plot", "modes.svg"],
      "Frequencies and real parts of the modes along mu, tracked by eigenvector correlation; the dashed line "

@@ -106,6 +106,7 @@ __all__ = [
     "hopf_curves",
     "region_diagram",
     "robust_box",
+    "run_design",
 ]
 
 _LAZY = {
@@ -178,6 +179,7 @@ _LAZY = {
     "hopf_curves": "api_nonlinear",
     "region_diagram": "api_nonlinear",
     "robust_box": "api",
+    "run_design": "design",
 }
 
 

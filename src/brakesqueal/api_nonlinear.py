@@ -367,9 +367,12 @@ def hopf_curves(space: ParameterSpace, x: Axis, y: Axis, *, seeds: Annotated[int
 def region_diagram(space: ParameterSpace, x: Axis, y: Axis, *, seeds: Annotated[int, Range(1, 100)] = 5,
                    max_points: Annotated[int, Range(2, 10000)] = 200,
                    ds_max: Annotated[float, Range(1e-4, 0.5)] = 0.05, grid: Annotated[int, Range(2, 2000)] | None = 41,
-                   lyapunov: bool = True, use_cache: bool = True) -> RegionResult:
+                   lyapunov: bool = True, use_cache: bool = True, folds: bool = True,
+                   fold_points: Annotated[int, Range(1, 50)] = 6,
+                   progress: Callable[[float], None] | None = None) -> RegionResult:
     """The squeal region diagram (``brakesqueal region``): Hopf curves with ``l1`` and codimension-2 points over
-    the certified stability map (:func:`brakesqueal.region.region_diagram`; ``docs/region.md``).
+    the certified stability map, the fold-of-cycles curves of the generalised-Hopf points and the shaded regions
+    (:func:`brakesqueal.region.region_diagram`; ``docs/region.md``).
 
     Parameters
     ----------
@@ -381,6 +384,8 @@ def region_diagram(space: ParameterSpace, x: Axis, y: Axis, *, seeds: Annotated[
         As :func:`hopf_curves`.
     grid : int or None
         Points per axis of the certified map drawn beneath (``None``: no map).
+    folds, fold_points, progress
+        As :func:`brakesqueal.region.region_diagram` (fold-of-cycles curves, slices per GH point, progress).
 
     Returns
     -------
@@ -390,4 +395,5 @@ def region_diagram(space: ParameterSpace, x: Axis, y: Axis, *, seeds: Annotated[
     from .region import region_diagram as _region
 
     return _region(_engine(space, use_cache), space, x, y, seeds=seeds, max_points=max_points, ds_max=ds_max,
-                   grid=grid, lyapunov=lyapunov, use_cache=use_cache)
+                   grid=grid, lyapunov=lyapunov, use_cache=use_cache, folds=folds, fold_points=fold_points,
+                   progress=progress)

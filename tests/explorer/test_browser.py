@@ -231,3 +231,25 @@ def test_limit_cycles_end_at_the_contact_loss(page):
     assert hb.contact_loss is not None and s["cycles"]["contact_loss"] == pytest.approx(hb.contact_loss, rel=1e-9)
     assert s["cycles"]["contact_loss"] > onset.hopf.p0
     page.screenshot("cycles")
+
+
+def test_region_draws_the_hopf_curves_over_the_map(page):
+    # paper-fig3's map (Omega, mu1): one Hopf curve, supercritical at low speed, subcritical beyond its
+    # generalised-Hopf point; the page draws what `brakesqueal region` computes over the same box
+    page.open("preset=paper-fig3&nx=6&ny=5")
+    page.wait(lambda s: "map" in s and s["map"].get("points") == 30, timeout=600)
+    page.page.get_by_role("button", name="Region").click()
+    s = page.wait(lambda s: "region" in s, timeout=900)
+    assert "error" not in s["region"], s["region"]
+    assert s["region"]["curves"] >= 1 and "GH" in s["region"]["special_points"]
+    page.page.get_by_text("squeal region:").wait_for(timeout=30_000)
+    from brakesqueal import Axis, region_diagram, resolve_space
+    from brakesqueal.explorer.state import slider_range
+
+    space = resolve_space(None, "paper-fig3", None, [])
+    rx, ry = slider_range(space, "Omega"), slider_range(space, "mu1")
+    r = region_diagram(space, Axis("Omega", rx.low, rx.high, 2, rx.log),
+                       Axis("mu1", ry.low, ry.high, 2, ry.log), grid=None)
+    assert s["region"]["curves"] == len(r.curves)
+    assert sorted(s["region"]["special_points"]) == sorted(sp.type for c in r.curves for sp in c.special_points)
+    page.screenshot("region")

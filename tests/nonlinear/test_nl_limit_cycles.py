@@ -60,3 +60,20 @@ def test_refusals_name_the_option(kwargs, name):
     with pytest.raises(ParameterError) as e:
         limit_cycles(space, AXIS, **kwargs)
     assert e.value.parameter == name, e.value
+
+
+@pytest.mark.slow
+def test_a_weakly_nonlinear_hopf_point_starts_its_branch_closer_in():
+    """Fig. 3's set with rigid pads at the upper re-stabilisation (Omega = 8419.2 rad/s, l1 = 2.8e-13): the
+    normal form's first orbit at the usual amplitude is far out of range and Newton's method did not converge
+    from it ("the first cycle near the Hopf point did not converge"); the default route now starts closer in and
+    follows the branch to the contact loss, which harmonic balance with the exact pads locates independently."""
+    from brakesqueal import Axis, limit_cycles, resolve_space
+
+    space = resolve_space(None, "paper-fig3", None, ["k_ip=inf", "mu2=0.5", "mu1=0.5"])
+    axis = Axis("Omega", 2000, 20000, 2)
+    shot = limit_cycles(space, axis)
+    assert type(shot).__name__ == "SquealBranch" and shot.contact_loss is not None
+    hb = limit_cycles(space, axis, pads="exact", max_points=60, max_harmonics=40)
+    assert type(hb).__name__ == "HarmonicBranch" and hb.contact_loss is not None
+    assert shot.contact_loss == pytest.approx(hb.contact_loss, rel=1e-7)

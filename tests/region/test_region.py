@@ -129,7 +129,10 @@ def test_region_command_exact_form(capsys, tmp_path):
     assert rc == 0, err
     d = json.loads(out)
     assert isinstance(d["special_points"], list) and d["special_points"] == []  # none in this box
-    assert d["fold_of_cycles"] == "not computed"
+    # no GH point in this box: the fold-of-cycles stage ran and found no curve, nothing is shaded
+    assert d["fold_of_cycles"] == "computed" and d["fold_curves"] == []
+    assert d["regions"] == {"squeal_possible_although_linearly_stable": [], "contact_lost": []}
+    assert "no generalised-Hopf point" in d["shaded"]
     (curve,) = d["hopf_curves"]
     pts = curve["points"]
     assert len(pts) >= 20
@@ -148,15 +151,16 @@ def test_region_command_exact_form(capsys, tmp_path):
     assert last["omega_hz"] == pytest.approx(hp[0].hopf.frequency0_hz, rel=1e-9)
     ds = xr.open_dataset(nc, engine="scipy")
     assert ds.sizes["point"] == len(pts) and np.allclose(ds["mu"].values, [p["mu"] for p in pts])
-    assert ds.attrs["fold_of_cycles"] == "not computed"
+    assert ds.attrs["fold_of_cycles"] == "computed" and ds.sizes.get("fold_point", 0) == 0
     assert png.stat().st_size > 10_000
 
 
 def test_region_command_text(capsys):
     rc, out, err = _run(capsys, "region", "--preset", "paper-fig2", "--set", "k_ip=inf", "--x", "mu=0.5:1", "--y",
-                        "Omega=10:200", "--grid", "5", "--seeds", "2")
+                        "Omega=10:200", "--grid", "5", "--seeds", "2", "--no-folds")
     assert rc == 0, err
     assert "1 curve(s)" in out and "supercritical" in out and "fold-of-cycles curves: not computed" in out
+    assert "--folds computes them" in out
 
 
 @pytest.mark.parametrize("args, option", [

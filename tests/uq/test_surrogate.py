@@ -290,7 +290,7 @@ def test_cli_surrogate_beside_monte_carlo(tmp_path, capsys):
         assert ds.attrs["surrogate_loo_error"] == pytest.approx(sur["loo_error"])
     assert main(["uq", str(f), "--surrogate", "pce", "--degree", "3", "--no-progress"]) == 0
     text = capsys.readouterr().out
-    assert "surrogate of max_real (pce-ols, degree 3, 10 of 10 terms, 256 runs, leave-one-out error" in text
+    assert "surrogate of max_real (pce-ols, degree 3, 10 of 10 terms, 256 runs, 0 left out, leave-one-out error" in text
 
 
 @pytest.mark.parametrize("args, words", [
@@ -306,3 +306,53 @@ def test_cli_surrogate_bad_options(tmp_path, capsys, args, words):
     assert main(["uq", str(f), "--surrogate", "pce", *args, "--no-progress"]) == 2
     err = capsys.readouterr().err.strip()
     assert words in err and "\n" not in err, err
+
+
+@pytest.mark.slow
+def test_surrogates_of_the_onset_l1_and_amplitude_reproduce_direct_computations(tmp_path):
+    """The expensive nonlinear quantities (issue 27, item 3): l1 with the pads' true rates and the cycles' amplitude
+    coefficient at the squeal onset along Omega, over mu1, mu2 of paper-fig3.  The surrogate from 64 runs predicts
+    fresh points computed directly (critical speed, then ``hopf_points`` along Omega: the Hopf normal form there),
+    and its indices respect the model's symmetry between the two pads (equal first-order indices)."""
+    from brakesqueal import Axis, hopf_points, resolve_space
+    from brakesqueal.uq import fit_study_pce
+
+    study = {"name": "onset", "preset": "paper-fig3", "parameters": {},
+             "distributions": {"mu1": {"uniform": [0.4, 0.6]}, "mu2": {"uniform": [0.4, 0.6]}},
+             "samples": {"n": 64, "seed": 3}}
+    l1 = fit_study_pce(study, runs=64, degree=3, quantity="onset_l1")
+    amp = fit_study_pce(study, runs=64, degree=3, quantity="onset_amplitude")
+    assert l1.left_out == 0 and amp.left_out == 0
+    s = l1.summary()
+    assert "p_subcritical" in s and "p_squeal" not in s and s["p_subcritical"] == 0.0  # supercritical onsets here
+    assert amp.summary()["p_squeal"] is None
+    for fit in (l1, amp):
+        f = fit.summary()["first"]
+        assert f["mu1"] == pytest.approx(f["mu2"], abs=0.02)
+    rng = np.random.default_rng(11)
+    for m1, m2 in rng.uniform(0.42, 0.58, size=(3, 2)):
+        space = resolve_space(None, "paper-fig3", None, [f"mu1={float(m1)!r}", f"mu2={float(m2)!r}"])
+        onset = next(h for h in hopf_points(space, Axis("Omega", 1.0, 1e5, 2, True))
+                     if h.hopf is not None and h.direction == "destabilizing")
+        x = {"mu1": np.array([m1]), "mu2": np.array([m2])}
+        assert float(l1.surrogate(x)[0]) == pytest.approx(onset.hopf.l1, rel=1e-3)
+        direct = float(np.linalg.norm(onset.hopf.amplitude_coefficients[:2]))
+        assert float(amp.surrogate(x)[0]) == pytest.approx(direct, rel=1e-3)
+
+
+def test_onset_surrogates_refuse_a_matrix_model_in_one_line(tmp_path):
+    import scipy.io
+
+    from brakesqueal.errors import ParameterError
+    from brakesqueal.model.matrices import import_matrices, write_matrix_model
+    from brakesqueal.uq import fit_study_pce
+
+    rng = np.random.default_rng(0)
+    mat = tmp_path / "m.mat"
+    scipy.io.savemat(mat, {"M": np.eye(2), "D": 0.1 * np.eye(2), "K": np.diag([1.0, 2.0]) + 0.1 * rng.random((2, 2))})
+    spec = import_matrices([str(mat)], {"M": "M", "D": "s*D", "K": "K"}, parameters={"Omega": 1.0, "s": 1.0})
+    write_matrix_model(spec, str(tmp_path / "m.toml"))
+    study = {"name": "fe", "model": str(tmp_path / "m.toml"), "parameters": {},
+             "distributions": {"s": {"uniform": [0.5, 1.5]}}, "samples": {"n": 16, "seed": 1}}
+    with pytest.raises(ParameterError, match="onset_l1.*coefficient matrices"):
+        fit_study_pce(study, runs=16, degree=2, quantity="onset_l1")

@@ -249,7 +249,7 @@ def _register_plugins() -> None:
     import importlib
 
     for name in (".stability", ".modes", ".sweep", ".plot", ".cache", ".simulate", ".export", ".explore", ".fe",
-                 ".uq", ".region", ".robust"):
+                 ".uq", ".region", ".robust", ".design"):
         mod = importlib.import_module(name, __package__)
         mod.register(app)
 
@@ -281,6 +281,7 @@ SUMMARIES: dict[str, str] = {
     "uq": "Squeal as a probability: Sobol indices and P(squeal) of a study.",
     "region": "Two-parameter squeal regions: Hopf curves, l1, special points.",
     "robust": "Certified robust design windows: stable for every point of a box.",
+    "design": "Robust design: choose design variables that minimise P(squeal) or maximise the margin.",
     "cache": "Inspect or clear the code cache.",
     "explore": "The squeal explorer in the browser (live, offline).",
 }

@@ -18,7 +18,7 @@ SOURCES: tuple[str, ...] = (
     'symbolic/model.py',
 )
 #: :func:`brakesqueal.cli.closed_forms.fingerprint` of ``SOURCES`` when the texts were derived.
-FINGERPRINT = 'bd044a50105f490e39028105b79045badca3d160c7c8c2c3e1943a1aae2f33df'
+FINGERPRINT = '34cb2bcfb88d7384ab3ad653ac6de7e0a8d017d201f211354f9d8ab0a70cabe3'
 #: ``(case, format) -> derive output``.
 TEXTS: dict[tuple[str, str], str] = {
     ('general', 'text'): "Case 'general': q_m0 = 0 (valid when mu1*h10 = mu2*h20, eq. 49); all other parameters independent\nLinearized about q_m0 = 0 (eq. 47):\n\nMbar[1,1] = Theta\nMbar[1,2] = 0\nMbar[2,1] = 0\nMbar[2,2] = Theta\n\nDbar[1,1] = (N0*Omega*d1*h10*k_ip2*mu1**2*r + N0*Omega*d2*h20*k_ip1*mu2**2*r + N0*h10**2*k_ip1*k_ip2*mu1 + N0*h20**2*k_ip1*k_ip2*mu2 + Omega*d1*k_ip1*k_ip2*r**3 + Omega*d2*k_ip1*k_ip2*r**3 + Omega*d_t*k_ip1*k_ip2*r)/(Omega*k_ip1*k_ip2*r)\nDbar[1,2] = Omega*Phi\nDbar[2,1] = (N0*d1*k_ip2*mu1*r + N0*d2*k_ip1*mu2*r - Omega*Phi*k_ip1*k_ip2 - d1*h10*k_ip1*k_ip2*mu1*r - d2*h20*k_ip1*k_ip2*mu2*r)/(k_ip1*k_ip2)\nDbar[2,2] = d_t\n\nKbar[1,1] = (N0*h10*k1*k_ip2*mu1**2 + N0*h10*k_ip1*k_ip2 + N0*h20*k2*k_ip1*mu2**2 + N0*h20*k_ip1*k_ip2 + k1*k_ip1*k_ip2*r**2 + k2*k_ip1*k_ip2*r**2 + k_ip1*k_ip2*k_t)/(k_ip1*k_ip2)\nKbar[1,2] = N0*(-N0*h10*k_ip2*mu1**3 - N0*h10*k_ip2*mu1 - N0*h20*k_ip1*mu2**3 - N0*h20*k_ip1*mu2 + h10**2*k_ip1*k_ip2*mu1 + h20**2*k_ip1*k_ip2*mu2)/(k_ip1*k_ip2*r)\nKbar[2,1] = r*(N0*k1*k_ip2*mu1 + N0*k2*k_ip1*mu2 - N0*k_ip1*k_ip2*mu1 - N0*k_ip1*k_ip2*mu2 - h10*k1*k_ip1*k_ip2*mu1 - h20*k2*k_ip1*k_ip2*mu2)/(k_ip1*k_ip2)\nKbar[2,2] = (-N0**2*k_ip1*mu2**2 - N0**2*k_ip1 - N0**2*k_ip2*mu1**2 - N0**2*k_ip2 + N0*h10*k_ip1*k_ip2*mu1**2 + N0*h10*k_ip1*k_ip2 + N0*h20*k_ip1*k_ip2*mu2**2 + N0*h20*k_ip1*k_ip2 + k_ip1*k_ip2*k_t)/(k_ip1*k_ip2)\n",

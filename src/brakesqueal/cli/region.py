@@ -2,8 +2,10 @@
 
 Hopf curves with ``l1`` along them and codimension-2 points
 (:func:`brakesqueal.region.region_diagram`), the certified linear stability map,
-as text or JSON, ``--out FILE.nc`` (xarray/NetCDF) and ``--plot FILE``.
-Fold-of-cycles curves are not computed yet (the output says so).
+as text or JSON, ``--out FILE.nc`` (xarray/NetCDF) and ``--plot FILE``; the
+fold-of-cycles curve of every generalised-Hopf point and the shaded regions
+"squeal possible although linearly stable" and "contact lost" (``--folds``, the
+default; ``--fold-points`` slices each, progress on stderr).
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from ._options import (PLOT_SUFFIXES, FormatOpt, ModelOpt, OutFormat, ParamsOpt, PresetOpt, SetOpt,
+from ._options import (PLOT_SUFFIXES, FormatOpt, ModelOpt, OutFormat, ParamsOpt, PresetOpt, ProgressOpt, SetOpt,
                        refuse_set_of_axes, space_from)
 
 __all__ = ["register"]
@@ -33,10 +35,17 @@ def region(
                                             help="Largest number of curve points each way from a seed.")] = 200,
     grid: Annotated[int, typer.Option("--grid", min=2, max=2000,
                                       help="Points per axis of the certified stability map.")] = 41,
+    folds: Annotated[bool, typer.Option("--folds/--no-folds",
+                                        help="Fold-of-cycles curves from each generalised-Hopf point and the "
+                                             "shaded regions (one cycle branch per slice).")] = True,
+    fold_points: Annotated[int, typer.Option("--fold-points", min=1, max=50,
+                                             help="Slices (cycle branches) per generalised-Hopf point.")] = 6,
+    progress: ProgressOpt = None,
 ) -> None:
     """Squeal regions in two parameters: Hopf curves coloured super/subcritical (l1 with the pads' true rates),
-    generalised-Hopf, Bogdanov-Takens, zero-Hopf and double-Hopf points, on the certified stability map.
-    Fold-of-cycles curves are not computed yet: no hysteresis region is shaded."""
+    generalised-Hopf, Bogdanov-Takens, zero-Hopf and double-Hopf points, on the certified stability map; the
+    fold-of-cycles curve from each generalised-Hopf point, shading "squeal possible although linearly stable"
+    and "contact lost"."""
     from ..analysis.maps import parse_axis
     from ..outputs import atomic_write, check_output
     from ..region import region_diagram
@@ -61,7 +70,11 @@ def region(
     space = space_from(model, preset, params, set_, axes={ax_x.name: "--x", ax_y.name: "--y"})
     from ..api import engine
 
-    r = region_diagram(engine(space), space, ax_x, ax_y, seeds=seeds, max_points=max_points, grid=grid)
+    from ._progress import progress as _progress
+
+    with _progress("region (fold-of-cycles curves)", progress if folds else False) as cb:
+        r = region_diagram(engine(space), space, ax_x, ax_y, seeds=seeds, max_points=max_points, grid=grid,
+                           folds=folds, fold_points=fold_points, progress=cb)
     if out:
         with atomic_write(out, what="--out") as tmp:
             r.to_dataset().to_netcdf(str(tmp), engine="scipy")

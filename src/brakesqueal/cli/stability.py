@@ -299,7 +299,9 @@ def cycles(
                                              "loss.")] = False,
     harmonics: Annotated[int, typer.Option("--harmonics", min=1, max=200, help="Harmonic-balance route (soft "
                                            "Coulomb pads by default, or --pads exact): initial number of harmonics "
-                                           "(raised while the truncation error exceeds 1e-6).")] = 6,
+                                           "(raised while the truncation error or the off-grid residual exceeds "
+                                           "1e-6, or, where the pads allow shooting, the shooting "
+                                           "mismatch).")] = 6,
     max_harmonics: Annotated[int, typer.Option("--max-harmonics", min=1, max=400, help="Harmonic-balance route: "
                                                "largest number of harmonics (the branch stops where more are "
                                                "needed).")] = 60,
@@ -369,7 +371,7 @@ def _write_shooting(b: Any, axis: Any, *, fmt: OutFormat, plot: str | None, out:
         ds = b.data.copy()
         ds.attrs = {k: (json.dumps(v) if isinstance(v, (dict, list, tuple)) or v is None else v)
                     for k, v in ds.attrs.items()}
-        for k in ("label", "special_kind", "special_description"):
+        for k in ("label", "special_kind", "special_description", "verdict"):
             if k in ds:
                 ds[k] = ds[k].astype("S")
         _write_branch_data(ds, out)
@@ -396,15 +398,36 @@ def _write_shooting(b: Any, axis: Any, *, fmt: OutFormat, plot: str | None, out:
               if sp["kind"] != "H"]
     if b.hopf.message:
         lines.append(f"note: {b.hopf.message}")
+    lines += _floquet_lines(d.get("floquet", []), axis.name)
     summary = b.summary.text() if b.summary is not None else ""
     sys.stdout.write("\n".join(lines) + "\n" + summary)
+
+
+def _floquet_lines(rows: list[dict[str, Any]], name: str) -> list[str]:
+    """The shooting route's verified Floquet data in a few lines: the trivial multiplier, the verdicts, the
+    undecided points."""
+    if not rows:
+        return []
+    cyc = [r for r in rows if r["label"] != "H"]  # the Hopf row has no cycle: its multipliers are predicted
+    worst = max((r["trivial_multiplier_error"] for r in cyc), default=float("nan"))
+    counts = {v: sum(r["verdict"] == v for r in cyc) for v in ("stable", "unstable", "undecided")}
+    out = [f"Floquet multipliers (monodromy): the trivial multiplier within {worst:.2g} of 1 on every cycle; "
+           f"{counts['stable']} stable, {counts['unstable']} unstable, {counts['undecided']} undecided (a "
+           "non-trivial |multiplier| within the accuracy bound of 1)"]
+    for r in cyc:
+        if r["verdict"] == "undecided":
+            out.append(f"  undecided at {name} = {r['p']:.10g}{' (' + r['label'] + ')' if r['label'] else ''}: "
+                       f"largest |multiplier| {r['largest_multiplier']:.12g}, accuracy "
+                       f"{r['multiplier_accuracy']:.2g}")
+    return out
 
 
 def _write_harmonic(b: Any, axis: Any, *, fmt: OutFormat, plot: str | None, out: str | None) -> None:
     """``cycles`` by harmonic balance (exact pads): text or JSON, ``--out`` NetCDF, ``--plot`` bifurcation
     diagram."""
     if out:
-        _write_branch_data(b.data, out)
+        ds = b.data
+        _write_branch_data(ds.assign(verdict=ds["verdict"].astype("S")), out)
     if plot:
         _write_plot(b.plot(), plot)
     if fmt == OutFormat.json:
@@ -416,17 +439,29 @@ def _write_harmonic(b: Any, axis: Any, *, fmt: OutFormat, plot: str | None, out:
     lines = [f"Hopf point {axis.name} = {h.p0:.12g}: {h.criticality} (l1 = {h.l1:.6g} ± {h.l1_error:.2g}), "
              f"{h.frequency0_hz:.6g} Hz (exact pads: tangential rates kept)",
              f"{len(b.points)} branch points by harmonic balance ({branch_status_text(b.status)}: {b.message})",
-             f"stability: {b.stability}"]
+             f"stability: {b.stability}" + (", cross-checked with the monodromy of the simulated equations"
+                                             if any(pt.monodromy_verdict is not None for pt in b.points) else "")]
+    terr = [pt.trivial_multiplier_error for pt in b.points if pt.trivial_multiplier_error is not None]
+    if terr:
+        counts = {v: sum(pt.verdict == v for pt in b.points) for v in ("stable", "unstable", "undecided")}
+        lines.append(f"Floquet multipliers (Hill's method): the trivial multiplier within {max(terr):.2g} of 1 on "
+                     f"every cycle; {counts['stable']} stable, {counts['unstable']} unstable, "
+                     f"{counts['undecided']} undecided; harmonics {min(pt.harmonics for pt in b.points)}.."
+                     f"{max(pt.harmonics for pt in b.points)}, residual up to "
+                     f"{max(pt.residual for pt in b.points):.2g}")
     lines += b.summary.text(rows=0).splitlines()
     # the normal forces' range over the period: min (a pad lifts off where it reaches 0) and max (as the
     # unilateral table of the summary)
     head = (f"{axis.name:>12} {'f [Hz]':>10} {'tilt [rad]':>11} "
             + " ".join(f"{'Fn min ' + p:>10} {'Fn max ' + p:>10}" for p in b.pads)
-            + f" {'slide min':>10} {'H':>3} {'trunc':>8} {'resid':>8}  stable")
+            + f" {'slide min':>10} {'H':>3} {'trunc':>8} {'resid':>8} {'|mu0-1|':>8} {'shoot':>8}  stable")
     lines.append(head)
     for pt, ok in zip(b.points, b.valid):
         tilt = f"{pt.tilt_amplitude:11.4g}" if pt.tilt_amplitude is not None else f"{'-':>11}"
         st = "-" if pt.stable is None else ("yes" if pt.stable else "no")
+        if pt.verdict == "undecided" and (pt.hill_verdict is not None or pt.monodromy_verdict is not None):
+            st = (f"undecided (Hill: {pt.hill_verdict or '-'}, monodromy: {pt.monodromy_verdict})"
+                  if pt.monodromy_verdict is not None else "undecided")
         if not ok:  # past a contact loss the bilateral equations do not hold (the figure greys these orbits)
             st = "not valid (contact lost)"
         fmax = [f"{v:10.5g}" for v in pt.F_n_max] if len(pt.F_n_max) == len(pt.F_n_min) else [f"{'-':>10}"] * len(
@@ -434,8 +469,12 @@ def _write_harmonic(b: Any, axis: Any, *, fmt: OutFormat, plot: str | None, out:
         lines.append(f"{pt.p:12.8g} {pt.frequency_hz:10.6g} {tilt} "
                      + " ".join(f"{lo:10.5g} {hi}" for lo, hi in zip(pt.F_n_min, fmax))
                      + f" {pt.sliding_margin_min:10.4g} {pt.harmonics:3d} {pt.truncation_error:8.1e} "
-                       f"{pt.residual:8.1e}  {st}")
+                       f"{pt.residual:8.1e} {_e8(pt.trivial_multiplier_error)} {_e8(pt.shooting_mismatch)}  {st}")
     sys.stdout.write("\n".join(lines) + "\n")
+
+
+def _e8(v: float | None) -> str:
+    return f"{'-':>8}" if v is None else f"{v:8.1e}"
 
 
 def register(app: typer.Typer) -> None:

@@ -24,6 +24,13 @@ class _Surrogate(str, Enum):
     pce = "pce"
 
 
+class _SurrogateQuantity(str, Enum):
+    max_real = "max_real"
+    margin = "margin"
+    onset_l1 = "onset_l1"
+    onset_amplitude = "onset_amplitude"
+
+
 def uq(
     study: Annotated[str, typer.Argument(help="Study file (TOML) with [distributions] and [samples] n, seed.")],
     out: Annotated[Optional[str], typer.Option("--out", help="Write the indices, P(squeal) and the A/B samples "
@@ -53,6 +60,15 @@ def uq(
                                                           "pursuit (least leave-one-out error).")] = False,
     surrogate_runs: Annotated[int, typer.Option("--surrogate-runs", help="Runs the surrogate is fitted to "
                                                                          "(10-65536).")] = 256,
+    surrogate_quantity: Annotated[_SurrogateQuantity, typer.Option(
+        "--surrogate-quantity", help="What the surrogate approximates: max_real, margin, or at the squeal onset "
+                                     "along the spin rate the first Lyapunov coefficient (onset_l1: P(subcritical) "
+                                     "from its sign) or the cycles' amplitude growth coefficient "
+                                     "(onset_amplitude); the onset quantities take about 0.1 s a run.")
+                                  ] = _SurrogateQuantity.max_real,
+    modes: Annotated[bool, typer.Option("--modes", help="Also the indices of the real part and the frequency "
+                                                        "of every tracked mode (modes numbered by ascending "
+                                                        "frequency at every point).")] = False,
     progress: ProgressOpt = None,
     fmt: FormatOpt = OutFormat.text,
 ) -> None:
@@ -78,19 +94,21 @@ def uq(
 
     with _progress("uq", progress) as cb:
         run = run_uq(study, store=store, workers=workers, scheduler=scheduler, overwrite=overwrite,
-                     backend=backend.value, confidence=confidence, n_resamples=resamples, progress=cb)
+                     backend=backend.value, confidence=confidence, n_resamples=resamples, progress=cb,
+                     per_mode=modes)
     ds = run.dataset
     sur = None
     if surrogate is not None:
         from ..uq import fit_study_pce
 
-        sur = fit_study_pce(study, runs=surrogate_runs, degree=degree, sparse=sparse).summary()
+        sq = surrogate_quantity.value
+        sur = fit_study_pce(study, runs=surrogate_runs, degree=degree, sparse=sparse, quantity=sq).summary()
         names = [str(x) for x in ds["input"].values]
         ds = ds.assign(surrogate_first=("input", [_nan(sur["first"][n]) for n in names],
-                                        {"long_name": "first-order Sobol' index of max Re lambda from the "
-                                                      "polynomial chaos surrogate"}),
+                                        {"long_name": f"first-order Sobol' index of {sq} from the polynomial "
+                                                      "chaos surrogate"}),
                        surrogate_total=("input", [_nan(sur["total"][n]) for n in names],
-                                        {"long_name": "total Sobol' index of max Re lambda from the surrogate"}))
+                                        {"long_name": f"total Sobol' index of {sq} from the surrogate"}))
         ds.attrs.update({f"surrogate_{k}": ("" if v is None else v) for k, v in sur.items()
                          if k not in ("first", "total")})
     if out:
@@ -108,6 +126,10 @@ def uq(
         sys.stdout.write(json.dumps(summary, indent=2) + "\n")
         return
     sys.stdout.write(_text(summary))
+
+
+#: Tracked modes whose indices the text output lists (all of them in JSON and NetCDF).
+TEXT_MODES = 6
 
 
 def _f(x: Any) -> str:
@@ -154,11 +176,26 @@ def _text(s: dict[str, Any]) -> str:
             tlo, thi = v["total_ci"][nm]
             lines.append(f"  {nm:<{width}}  first {_f(v['first'][nm])} [{_f(lo)}, {_f(hi)}]   "
                          f"total {_f(v['total'][nm])} [{_f(tlo)}, {_f(thi)}]")
+    modes = s.get("modes", [])
+    for m in modes[:TEXT_MODES]:
+        for part in ("real", "frequency"):
+            v = m[part]
+            lo_f, hi_f = m["frequency_range"]
+            lines.append(f"mode {m['mode']} {part} ({v['rows']} rows; {_f(lo_f)} to {_f(hi_f)} Hz):")
+            for nm in s["inputs"]:
+                lo, hi = v["first_ci"][nm]
+                tlo, thi = v["total_ci"][nm]
+                lines.append(f"  {nm:<{width}}  first {_f(v['first'][nm])} [{_f(lo)}, {_f(hi)}]   "
+                             f"total {_f(v['total'][nm])} [{_f(tlo)}, {_f(thi)}]")
+    if len(modes) > TEXT_MODES:
+        lines.append(f"({len(modes) - TEXT_MODES} more modes in --format json and --out)")
     sur = s.get("surrogate")
     if sur:
-        lines.append(f"surrogate of max_real ({sur['method']}, degree {sur['degree']}, {sur['terms']} of "
-                     f"{sur['candidates']} terms, {sur['runs']} runs, leave-one-out error {sur['loo_error']:.2e}): "
-                     f"P(squeal) = {_f(sur['p_squeal'])}")
+        prob = (f": P(squeal) = {_f(sur['p_squeal'])}" if "p_squeal" in sur and sur["p_squeal"] is not None else
+                f": P(subcritical onset) = {_f(sur['p_subcritical'])}" if "p_subcritical" in sur else "")
+        lines.append(f"surrogate of {sur['quantity']} ({sur['method']}, degree {sur['degree']}, {sur['terms']} of "
+                     f"{sur['candidates']} terms, {sur['runs']} runs, {sur['left_out']} left out, leave-one-out "
+                     f"error {sur['loo_error']:.2e}){prob}")
         for nm in s["inputs"]:
             lines.append(f"  {nm:<{width}}  first {_f(sur['first'][nm])}   total {_f(sur['total'][nm])}")
     return "\n".join(lines) + "\n"

@@ -44,6 +44,7 @@ from .state import (
     LocusView,
     MapView,
     Origin,
+    RegionView,
     SimulationView,
     SliderRange,
     ViewState,
@@ -59,6 +60,7 @@ from .state import (
     locus_view,
     map_file,
     map_view,
+    region_view,
     simulation_view,
     slider_names,
     slider_range,
@@ -103,6 +105,10 @@ _MAP_PALETTE = [MAP_UNSTABLE, MAP_STABLE, "#c8c8c8", MAP_PAD_ONLY]
 #: Colours of the current point and of stable and unstable limit cycles: matplotlib's C0 and C3, as in the command
 #: line's figures (stable cycles drawn in C0, unstable ones in C3).
 _POINT, _CYCLE_STABLE, _CYCLE_UNSTABLE = "#1f77b4", "#1f77b4", "#d62728"
+#: Hopf curves on the map by criticality (the command line's region figure: C0 supercritical, C3 subcritical), and
+#: the fold-of-cycles curves.
+_HOPF_COLOURS = {"supercritical": "#1f77b4", "subcritical": "#d62728"}
+_HOPF_UNDECIDED, _FOLD_COLOUR = "#7f7f7f", "#9467bd"
 #: Look of the message line (Bootstrap's "danger" alert, as Panel's Alert pane had).
 _ALERT_STYLE = {"background-color": "#f8d7da", "color": "#721c24", "border": "1px solid #f5c6cb",
                 "border-radius": "4px", "padding": "0.5em 1em"}
@@ -148,6 +154,24 @@ def _map_key(space: ParameterSpace, state: ViewState) -> _Key:
     defs = {k: str(v) for k, v in space.definitions().items()}
     return (state.model, state.preset, state.x, state.y, state.nx, state.ny,
             tuple(sorted((k, v) for k, v in defs.items() if k not in (state.x, state.y))))
+
+
+def _region_key(space: ParameterSpace, state: ViewState) -> _Key:
+    """What the squeal region over the map depends on (the map's key without its grid)."""
+    model, preset, x, y, _nx, _ny, defs = _map_key(space, state)
+    return model, preset, x, y, defs
+
+
+def _criticality_runs(x: np.ndarray, y: np.ndarray, crit: list[str]) -> list[tuple[np.ndarray, np.ndarray, str]]:
+    """A Hopf curve cut into pieces of one criticality (neighbouring pieces share their end point)."""
+    runs: list[tuple[np.ndarray, np.ndarray, str]] = []
+    start = 0
+    for i in range(1, len(crit) + 1):
+        if i == len(crit) or crit[i] != crit[start]:
+            stop = min(i + 1, len(crit))
+            runs.append((x[start:stop], y[start:stop], crit[start]))
+            start = i
+    return runs
 
 
 def _with_axis(state: ViewState, key: str, name: str) -> ViewState:
@@ -341,6 +365,9 @@ class Explorer:
         # the long computations run in child processes that Cancel kills (started on first use)
         self.sim_child = ChildProcess("explorer-simulation")
         self.cycles_child = ChildProcess("explorer-cycles")
+        self.region_child = ChildProcess("explorer-region")
+        self._region_shown: _Key | None = None
+        self._region_data: dict[str, Any] = {}
         self.locus_lane: LatestWorker[ViewState, _Locus] = LatestWorker(
             self._compute_locus, self._show_locus, schedule, name="explorer-locus")
         self.map_lane: LatestWorker[ViewState, dict[str, Any]] = LatestWorker(
@@ -350,6 +377,9 @@ class Explorer:
         self.cycles_lane: LatestWorker[ViewState, CyclesView] = LatestWorker(
             self._compute_cycles, self._show_cycles, schedule, progress=self._cycles_progress,
             name="explorer-cycles")
+        self.region_lane: LatestWorker[ViewState, RegionView] = LatestWorker(
+            self._compute_region, self._show_region, schedule, progress=self._region_progress,
+            name="explorer-region")
         self.sim_lane: LatestWorker[ViewState, SimulationView] = LatestWorker(
             self._compute_sim, self._show_sim, schedule, progress=self._sim_progress, name="explorer-sim")
         self.page = self._layout()
@@ -436,11 +466,11 @@ class Explorer:
 
     def stop(self) -> None:
         """End the session's worker threads and child processes."""
-        lanes = ("locus_lane", "map_lane", "info_lane", "cycles_lane", "sim_lane")
+        lanes = ("locus_lane", "map_lane", "info_lane", "cycles_lane", "sim_lane", "region_lane")
         for lane in (getattr(self, n, None) for n in lanes):
             if lane is not None:
                 lane.stop()
-        for child in (getattr(self, n, None) for n in ("sim_child", "cycles_child")):
+        for child in (getattr(self, n, None) for n in ("sim_child", "cycles_child", "region_child")):
             if child is not None:
                 child.stop()
 
@@ -486,12 +516,18 @@ class Explorer:
         self.sim_button.on_click(self._on_simulate)
         self.cycles_button = pn.widgets.Button(label="Cycles", width=80)
         self.cycles_button.on_click(self._on_cycles)
+        self.region_button = pn.widgets.Button(label="Region", width=80, css_classes=["bs-region"],
+                                               description="Hopf curves (blue: supercritical, red: subcritical) and "
+                                                           "codimension-2 points over the map's box")
+        self.region_button.on_click(self._on_region)
         self.cancel_button = pn.widgets.Button(label="Cancel", width=80)
         self.cancel_button.on_click(self._on_cancel)
         self.map_progress = pn.indicators.Progress(value=0, max=100, width=150, visible=False)
         self.sim_progress = pn.indicators.Progress(value=0, max=100, width=150, visible=False)
         self.cycles_progress = pn.indicators.Progress(value=0, max=100, width=150, visible=False,
                                                       css_classes=["bs-cycles-progress"])
+        self.region_progress = pn.indicators.Progress(value=None, max=100, width=150, visible=False,
+                                                      css_classes=["bs-region-progress"])
         self.leading_text = pn.pane.HTML("", sizing_mode="stretch_width")
         self.cs_text = pn.pane.HTML("critical speed: …", sizing_mode="stretch_width")
         self.hopf_text = pn.pane.HTML("Hopf: …", sizing_mode="stretch_width")
@@ -499,6 +535,8 @@ class Explorer:
         self.sim_text = pn.pane.HTML("Press Simulate to integrate the nonlinear equations and hear the squeal.",
                                      sizing_mode="stretch_width")
         self.cycles_text = pn.pane.HTML("Press Cycles to continue the limit cycles from the Hopf point on the path.",
+                                        sizing_mode="stretch_width")
+        self.region_text = pn.pane.HTML("Press Region to draw the Hopf curves over the map (squeal regions).",
                                         sizing_mode="stretch_width")
         # export of the current view: the map's data with the library's writers, the modes along the locus's path
         # (the figures' own "save" tools write PNG files)
@@ -644,6 +682,10 @@ class Explorer:
         self.src_map = ColumnDataSource({"image": [], "x": [], "y": [], "dw": [], "dh": []})
         self.src_boundary = ColumnDataSource({"x": [], "y": []}, name="bs-boundary")
         self.src_point = ColumnDataSource({"x": [], "y": []})
+        self.src_hopf = ColumnDataSource({"xs": [], "ys": [], "color": []}, name="bs-hopf")
+        self.src_special = ColumnDataSource({"x": [], "y": [], "type": []}, name="bs-special")
+        self.src_folds = ColumnDataSource({"xs": [], "ys": []}, name="bs-folds")
+        self.src_contact = ColumnDataSource({"x": [], "y": []}, name="bs-contact")
         self.map_mapper = LinearColorMapper(palette=_MAP_PALETTE, low=-0.5, high=3.5)
         self.pane_map = pn.pane.Bokeh(self._map_figure(*self._map_logs), css_classes=['bs-map'])
 
@@ -718,6 +760,11 @@ class Explorer:
         f.image("image", x="x", y="y", dw="dw", dh="dh", source=self.src_map,
                 color_mapper=self.map_mapper)  # type: ignore[call-arg]
         f.line("x", "y", source=self.src_boundary, line_color="black", line_width=2, legend_label="boundary")
+        f.multi_line("xs", "ys", source=self.src_hopf, line_color="color", line_width=3)
+        f.multi_line("xs", "ys", source=self.src_folds, line_color=_FOLD_COLOUR, line_width=2, line_dash="dashed")
+        f.scatter("x", "y", source=self.src_contact, marker="x", size=9, line_width=2, color=_FOLD_COLOUR)
+        f.scatter("x", "y", source=self.src_special, marker="diamond", size=13, color="black")
+        f.text("x", "y", text="type", source=self.src_special, x_offset=7, y_offset=-4, text_font_size="9pt")
         f.scatter("x", "y", source=self.src_point, marker="cross", size=16, line_width=3, color=_POINT,
                   level=_MOVING)
         f.legend.location = "bottom_right"
@@ -741,7 +788,8 @@ class Explorer:
                          pn.Row(self.along_select, self.x_select, self.y_select),
                          pn.Row(self.nx_input, self.ny_input, self.map_progress),
                          pn.Row(self.t_end_input, self.sim_button),
-                         pn.Row(self.cycles_button, self.cancel_button, self.cycles_progress),
+                         pn.Row(self.cycles_button, self.region_button, self.cancel_button),
+                         pn.Row(self.cycles_progress, self.region_progress),
                          self.sim_progress,
                          width=_LEFT)
         legend = pn.pane.HTML(f"<small>map: <span style='background:{MAP_STABLE}'>&nbsp;stable&nbsp;</span> "
@@ -749,10 +797,13 @@ class Explorer:
                               "<span style='background:#c8c8c8'>&nbsp;no verdict&nbsp;</span> "
                               f"<span style='background:{MAP_PAD_ONLY}'>&nbsp;disk stable, only a pad's own 0 Hz "
                               "mode unstable&nbsp;</span>; black: the exact "
-                              "boundary (refined by bisection); blue cross: the current point</small>")
+                              "boundary (refined by bisection); blue cross: the current point; after Region: Hopf "
+                              "curves (blue supercritical, red subcritical, grey undecided), codimension-2 points "
+                              "(black diamonds), fold-of-cycles curves (dashed purple) and where cycles lose "
+                              "contact before they fold (purple crosses)</small>")
         export = pn.Row(self.map_nc_download, self.map_csv_download, self.locus_download)
         texts = pn.Column(self.leading_text, self.cs_text, self.hopf_text, self.map_text, legend, export, self.sim_text,
-                          self.cycles_text, width=_TEXTS)
+                          self.cycles_text, self.region_text, width=_TEXTS)
         views = pn.Column(pn.Row(self.pane_locus, self.pane_modes), pn.Row(self.pane_map, texts),
                           self.dynamics_box)
         return pn.Column(head, self.alert, pn.Row(left, views), self.render, sizing_mode="stretch_width")
@@ -934,7 +985,68 @@ class Explorer:
         self._mark()
 
     @_batched
+    def _on_region(self, event: Event) -> None:
+        self.region_text.object = "continuing the Hopf curves over the map's box … (Cancel stops it)"
+        self.region_progress.visible = True
+        self.region_lane.submit(self.state)
+
+    def _compute_region(self, state: ViewState, check: Callable[[float], None]) -> RegionView:
+        space = self.origin.space_of(state)
+        rx, ry = (self.ranges.get(n) or slider_range(space, n) for n in (state.x, state.y))
+        return self._in_child(self.region_child, self.region_lane, region_view, (space, state.x, state.y, rx, ry),
+                              check)
+
+    def _region_progress(self, fraction: float) -> None:
+        self.region_progress.visible = fraction < 1.0
+        self.region_progress.value = int(100 * min(max(fraction, 0.0), 1.0)) if fraction > 0 else None
+
+    def _clear_region(self) -> None:
+        self.src_hopf.data = {"xs": [], "ys": [], "color": []}
+        self.src_special.data = {"x": [], "y": [], "type": []}
+        self.src_folds.data = {"xs": [], "ys": []}
+        self.src_contact.data = {"x": [], "y": []}
+        self._region_shown = None
+
+    def _show_region(self, state: ViewState, rv: RegionView | None, error: BaseException | None) -> None:
+        self.region_progress.visible = False
+        if error is not None or rv is None:  # (a delivered view comes with no error)
+            msg = "cancelled" if isinstance(error, Cancelled) else str(error)
+            self.region_text.object = f"<b>squeal region:</b> {html.escape(msg)}"
+            self.shown["region"] = {"state": state.to_query(), "error": msg}
+            self._mark()
+            return
+        x_log, y_log = self._map_logs
+
+        def tx(v: np.ndarray) -> np.ndarray:
+            return np.log10(v) if x_log else v
+
+        def ty(v: np.ndarray) -> np.ndarray:
+            return np.log10(v) if y_log else v
+
+        xs, ys, colours = [], [], []
+        for cx, cy, crit in rv.hopf:
+            for rx_, ry_, c in _criticality_runs(cx, cy, crit):
+                xs.append(tx(rx_))
+                ys.append(ty(ry_))
+                colours.append(_HOPF_COLOURS.get(c, _HOPF_UNDECIDED))
+        self.src_hopf.data = {"xs": xs, "ys": ys, "color": colours}
+        self.src_special.data = {"x": [float(tx(np.array(s[1]))) for s in rv.special],
+                                 "y": [float(ty(np.array(s[2]))) for s in rv.special],
+                                 "type": [s[0] for s in rv.special]}
+        self.src_folds.data = {"xs": [tx(fx) for fx, _ in rv.folds], "ys": [ty(fy) for _, fy in rv.folds]}
+        self.src_contact.data = {"x": tx(rv.contact[0]), "y": ty(rv.contact[1])}
+        self._region_shown = _region_key(self.origin.space_of(state), state)
+        self._region_data = rv.data
+        self.region_text.object = f"<b>squeal region:</b> {html.escape(rv.summary)}"
+        self.shown["region"] = {"state": state.to_query(), "curves": len(rv.hopf), "pieces": len(xs),
+                                "special_points": [s[0] for s in rv.special], "fold_curves": len(rv.folds),
+                                "contact_loss_points": int(rv.contact[0].size),
+                                "summary": rv.summary}
+        self._mark()
+
+    @_batched
     def _on_cancel(self, event: Event) -> None:
+        self.region_lane.cancel()
         self.cycles_lane.cancel()
         self.sim_lane.cancel()
         self.map_lane.cancel()
@@ -1145,6 +1257,8 @@ class Explorer:
         if self._map_logs != (mv.x_log, mv.y_log) or getattr(self, "_map_axes", None) != (state.x, state.y):
             self._map_axes = (state.x, state.y)
             self.pane_map.object = self._map_figure(mv.x_log, mv.y_log)
+        if self._region_shown is not None and self._region_shown != _region_key(self.origin.space_of(state), state):
+            self._clear_region()  # drawn for other axes or parameters
         self.src_map.data = {"image": [code], "x": [tx[0] - dx / 2], "y": [ty[0] - dy / 2],
                              "dw": [tx[-1] - tx[0] + dx], "dh": [ty[-1] - ty[0] + dy]}
         bx = np.log10(mv.boundary_x) if mv.x_log else mv.boundary_x

@@ -45,7 +45,7 @@ __all__ = ["MAX_MAP_POINTS", "MAX_T_END", "LOCUS_POINTS", "AUDIO_RATE", "SliderR
            "simulation_view", "check_map_size", "check_t_end", "Origin", "audio_samples", "default_axes",
            "MAX_SLIDERS", "ROLE_RANK", "important_names", "slider_names", "MAP_FORMATS", "map_file", "locus_file",
            "stability_names", "CyclesView", "cycles_view", "LINK_KEYS", "MAX_LINK_VALUE", "MAX_LINK_SET",
-           "MAX_LINK_PARAMS", "REFUSED_KEY", "link_problem", "link_limit_message"]
+           "MAX_LINK_PARAMS", "REFUSED_KEY", "link_problem", "link_limit_message", "RegionView", "region_view"]
 
 #: Largest number of map points the explorer computes (``brakesqueal map`` has no such cap).
 MAX_MAP_POINTS = 1_000_000
@@ -885,6 +885,92 @@ class Origin:
         names = space.settable()
         return replace(state, along=state.along if state.along in names else along,
                        x=state.x if state.x in names else x, y=state.y if state.y in names else y)
+
+
+# ---------------------------------------------------------------------------------------------- squeal region
+@dataclass(frozen=True)
+class RegionView:
+    """The squeal region of the map's two parameters (:func:`brakesqueal.region_diagram`), ready to overlay.
+
+    Attributes
+    ----------
+    hopf : list of (x, y, criticality)
+        One entry per Hopf curve: its points' axis values (arrays, in the axes' units) and each point's
+        criticality (``"supercritical"``, ``"subcritical"`` or ``"undecided"``).
+    special : list of (type, x, y)
+        Codimension-2 points (``GH``, ``BT``, ``ZH``, ``HH``).
+    folds : list of (x, y)
+        Fold-of-cycles curves (their generalised-Hopf point and fold points ``LPC``), where the diagram has them.
+    contact : tuple of (x, y)
+        Points where the cycles of a slice lose contact before they fold (arrays).
+    summary : str
+        The diagram's own text summary (its first lines).
+    data : dict
+        The diagram's JSON (:meth:`~brakesqueal.region.RegionResult.to_dict`).
+    """
+
+    hopf: list[tuple[np.ndarray, np.ndarray, list[str]]]
+    special: list[tuple[str, float, float]]
+    folds: list[tuple[np.ndarray, np.ndarray]]
+    contact: tuple[np.ndarray, np.ndarray]
+    summary: str
+    data: dict[str, Any]
+
+
+def region_view(space: ParameterSpace, x: str, y: str, rx: SliderRange, ry: SliderRange, *,
+                progress: Callable[[float], None] | None = None) -> RegionView:
+    """Hopf curves with their criticality, codimension-2 points and fold-of-cycles curves over the map's box.
+
+    The same computation as ``brakesqueal region --x X=LO:HI --y Y=LO:HI`` (without its certified map: the
+    explorer's map is drawn beneath), with the map's ranges as the box.
+
+    Parameters
+    ----------
+    space : ParameterSpace
+        The model, preset and overrides.
+    x, y : str
+        The map's parameters.
+    rx, ry : SliderRange
+        Their ranges (the box of the diagram).
+    progress : callable, optional
+        ``progress(fraction)`` (0 at the start, while the fold-of-cycles curves are computed, 1 at the end); an
+        exception it raises stops the work (the explorer's Cancel also kills the child process that runs it).
+
+    Returns
+    -------
+    RegionView
+
+    Raises
+    ------
+    ParameterError
+        A model without nonlinear equations, or axes the diagram refuses (tied or equal names).
+    """
+    from ..analysis.maps import Axis
+    from ..api_nonlinear import region_diagram
+
+    if progress is not None:
+        progress(0.0)
+    ax, ay = Axis(x, rx.low, rx.high, 2, rx.log), Axis(y, ry.low, ry.high, 2, ry.log)
+    r = region_diagram(space, ax, ay, grid=None, progress=progress)
+    d = r.to_dict()
+
+    def xy(points: list[dict[str, Any]]) -> tuple[np.ndarray, np.ndarray]:
+        return (np.array([p[x] for p in points], dtype=float), np.array([p[y] for p in points], dtype=float))
+
+    hopf = [(*xy(c["points"]), [str(p["criticality"]) for p in c["points"]]) for c in d["hopf_curves"]]
+    special = [(str(s["type"]), float(s[x]), float(s[y])) for s in d["special_points"]]
+    folds, lost = [], []
+    for c in d.get("fold_curves", []):
+        pts = c.get("points", [])
+        line = [p for p in pts if p.get("kind") in ("GH", "LPC")]
+        if sum(p.get("kind") == "LPC" for p in line):
+            folds.append(xy(line))
+        lost += [p for p in pts if p.get("kind") == "contact_loss"]
+    text = r.text().splitlines()
+    summary = "; ".join(ln.strip() for ln in text[:4] if ln.strip())
+    if progress is not None:
+        progress(1.0)
+    return RegionView(hopf, special, folds, xy(lost), summary, d)
 
 
 # ---------------------------------------------------------------------------------------------- limit cycles

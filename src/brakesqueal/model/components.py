@@ -841,10 +841,17 @@ class ModelSpec:
             pr.check(self)
 
     def roles(self) -> ParameterRoles:
-        """Roles (ranges, units, descriptions) of the named parameters (:func:`.roles.parameter_roles`)."""
-        from .roles import parameter_roles
+        """Roles (ranges, units, descriptions) of the named parameters (:func:`.roles.parameter_roles`).
 
-        return parameter_roles(self)
+        Collected once per model object (they follow from its frozen components alone; every resolution of a
+        parameter set asks for them, 4 ms each on the paper's model).
+        """
+        cached = self.__dict__.get("_roles")
+        if cached is None:
+            from .roles import parameter_roles
+
+            cached = self.__dict__["_roles"] = parameter_roles(self)
+        return cached
 
     def parameter_names(self) -> list[str]:
         """Names of all parameters the components use, in first-use order."""

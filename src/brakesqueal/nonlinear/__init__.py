@@ -9,6 +9,10 @@ guards and resets (:class:`PiecewiseSystem`).  See ``docs/nonlinear.md``.
   amplitude and frequency of the emerging cycles (:class:`HopfResult`);
 * :func:`find_periodic_orbit` — (multiple) shooting with a Poincaré phase
   condition, Floquet multipliers, stability (:class:`PeriodicOrbit`);
+* :func:`hill_exponents`, :func:`stability_verdict`, :func:`cross_check` —
+  verified Floquet stability: Hill's method on a shot orbit, verdicts
+  (``"stable"``, ``"unstable"``, ``"undecided"``) bounded by the trivial
+  multiplier's error (:mod:`.floquet`);
 * :func:`continue_cycles` — pseudo-arclength continuation of cycles from a Hopf
   point or an orbit, detection and location of folds (LPC), period doubling
   (PD), Neimark–Sacker (NS), branch points (BPC), grazing (GR)
@@ -23,6 +27,7 @@ from __future__ import annotations
 from typing import Any
 
 from .continuation import SPECIAL_KINDS, CycleBranch, SpecialPoint, continue_cycles
+from .floquet import VERDICTS, HillResult, cross_check, hill_exponents, multiplier_accuracy, stability_verdict
 from .flow import Event, Flow, FlowError, FlowResult, ScipyFlow
 from .hopf import CycleGuess, HopfResult, first_lyapunov
 from .periodic import PeriodicOrbit, ShootingError, find_periodic_orbit, floquet_multipliers
@@ -33,6 +38,7 @@ __all__ = [
     "first_lyapunov", "HopfResult", "CycleGuess",
     "Flow", "FlowResult", "FlowError", "Event", "ScipyFlow", "CompiledFlow", "compiled_system",
     "find_periodic_orbit", "PeriodicOrbit", "ShootingError", "floquet_multipliers",
+    "hill_exponents", "HillResult", "stability_verdict", "multiplier_accuracy", "cross_check", "VERDICTS",
     "continue_cycles", "CycleBranch", "SpecialPoint", "SPECIAL_KINDS",
 ]  # fmt: skip
 

@@ -61,6 +61,8 @@ __all__ = ["CycleBranch", "SpecialPoint", "continue_cycles", "SPECIAL_KINDS"]
 
 #: Labels of the special points that :func:`continue_cycles` can detect.
 SPECIAL_KINDS: tuple[str, ...] = ("H", "LPC", "PD", "NS", "BPC", "GR", "EP")
+#: Amplitudes tried for the first orbit off a Hopf point (each a quarter of the one before).
+FIRST_ORBIT_TRIES = 6
 
 
 class _NoConvergence(Exception):
@@ -126,6 +128,8 @@ class CycleBranch:
         (dim ``coord``), ``stable``, ``n_unstable``, ``floquet_re``,
         ``floquet_im``, ``floquet_abs`` (dim ``floquet``: non-trivial
         multipliers by decreasing modulus), ``trivial_multiplier_error``,
+        ``multiplier_accuracy``, ``multiplier_change``, ``largest_multiplier``, ``verdict``
+        (``"stable"``, ``"unstable"`` or ``"undecided"``, :mod:`.floquet`),
         ``label`` (special-point kind or ``""``), ``arclength``, ``orbit``
         (dims ``point, phase, coord``: one period, uniformly sampled).
         Special points along dim ``special``: ``special_kind``,
@@ -724,19 +728,32 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
         T0 = hopf.period0
         sv = np.concatenate([np.tile(xs, m), [T0, width]])
         eng = _Engine(flow, m, n, sv, xs, tol, n_samples, max_newton)
-        # first orbit at amplitude start_amplitude * xs, along the predicted branch
+        # first orbit at amplitude start_amplitude * xs, along the predicted branch; where the normal form's
+        # prediction is out of its range at that amplitude (a weakly nonlinear Hopf point: a tiny l1 makes the
+        # predicted amplitude grow fast), Newton's method does not converge from it, and the first orbit is tried
+        # again closer to the Hopf point (the amplitude quartered, up to FIRST_ORBIT_TRIES times)
         r1 = start_amplitude * math.sqrt(reach * abs(hopf.dRe_lambda_dp / hopf.c1.real))
-        y1 = _hopf_y(hopf, r1, m)
-        dr = 1e-4 * r1
-        tp = (_hopf_y(hopf, r1 + dr, m) - _hopf_y(hopf, r1 - dr, m)) / eng.sv
-        tp /= np.linalg.norm(tp)
-        y1_ref = y1.copy()
-        try:
-            first = eng.point(y1, tp, y1_ref)
-        except _NoConvergence as exc:
-            from .periodic import ShootingError
+        got: _Point | None = None
+        for attempt in range(FIRST_ORBIT_TRIES):
+            y1 = _hopf_y(hopf, r1, m)
+            dr = 1e-4 * r1
+            with np.errstate(all="ignore"):
+                tp = (_hopf_y(hopf, r1 + dr, m) - _hopf_y(hopf, r1 - dr, m)) / eng.sv
+                tp /= np.linalg.norm(tp)
+            try:
+                if not np.all(np.isfinite(tp)):
+                    raise _NoConvergence("no finite tangent along the predicted branch")
+                got = eng.point(y1, tp, y1.copy())
+                break
+            except _NoConvergence as exc:
+                if attempt + 1 == FIRST_ORBIT_TRIES:
+                    from .periodic import ShootingError
 
-            raise ShootingError(f"the first cycle near the Hopf point did not converge: {exc}") from None
+                    raise ShootingError(f"the first cycle near the Hopf point did not converge: {exc} (tried "
+                                        f"{FIRST_ORBIT_TRIES} amplitudes down to {r1:.3g})") from None
+                r1 /= 4.0
+        assert got is not None
+        first = got
         yH, flH = _hopf_row(hopf, m, n - 1)
         hopf_orbit = PeriodicOrbit(
             x=np.tile(hopf.x0, (m, 1)), period=T0, p=hopf.p0, multipliers=np.concatenate([[1.0 + 0j], flH]),
@@ -744,7 +761,8 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
             trivial_multiplier_error=0.0, t=first.orbit.t * (T0 / first.orbit.period),
             samples=np.tile(hopf.x0, (first.orbit.samples.shape[0], 1)), amplitude=np.zeros(n), mean=hopf.x0.copy(),
             x_max=hopf.x0.copy(), x_min=hopf.x0.copy(), state_names=tuple(system.state_names),
-            parameter_name=system.parameter_name,
+            parameter_name=system.parameter_name, multiplier_accuracy=first.orbit.multiplier_accuracy,
+            verdict="undecided",  # the critical pair on the unit circle: no side to report
         )  # fmt: skip
         add(_Point(y=yH, tangent=first.tangent, orbit=hopf_orbit, iterations=0, label="H",
                    events=first.events))  # fmt: skip
@@ -838,6 +856,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
             found = [f for f in found if f[0] < (_s_of(eng, a, pt) if pt is not None else ds_cur)]
             for s, pt_s, kind, desc in sorted(found, key=lambda f: f[0]):
                 pt_s.label = kind
+                _at_crossing(pt_s)
                 add(eng.with_samples(pt_s))
                 special.append((kind, len(points) - 1, desc))
             if pt is not None:
@@ -848,6 +867,7 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
             break
         for s, pt_s, kind, desc in sorted(found, key=lambda f: f[0]):
             pt_s.label = kind
+            _at_crossing(pt_s)
             add(eng.with_samples(pt_s))
             special.append((kind, len(points) - 1, desc))
         b = eng.rephase(b)
@@ -871,6 +891,15 @@ def continue_cycles(system: Any, start: HopfResult | PeriodicOrbit, p_range: Seq
         ds_cur = ds_next
     tracker.done()
     return _build(eng, points, special, status, message, hopf, system)
+
+
+def _at_crossing(pt: _Point) -> None:
+    """A located fold, period doubling, Neimark-Sacker or branch point is where a multiplier crosses the unit
+    circle: its verdict is ``"undecided"`` whatever side the located multiplier is computed on."""
+    from dataclasses import replace
+
+    if pt.label in ("LPC", "PD", "NS", "BPC"):
+        pt.orbit = replace(pt.orbit, verdict="undecided")
 
 
 def _s_of(eng: _Engine, a: _Point, b: _Point) -> float:
@@ -916,6 +945,17 @@ def _build(eng: _Engine, points: list[_Point], special_rows: list[tuple[str, int
             "floquet_im": (("point", "floquet"), fl.imag),
             "floquet_abs": (("point", "floquet"), np.abs(fl)),
             "trivial_multiplier_error": ("point", np.array([o.trivial_multiplier_error for o in orbits])),
+            "multiplier_accuracy": ("point", np.array([o.multiplier_accuracy for o in orbits]),
+                                    {"long_name": "distance from the unit circle a multiplier needs for a verdict"}),
+            "multiplier_change": ("point", np.array([o.multiplier_change for o in orbits]),
+                                  {"long_name": "change of the largest non-trivial |multiplier| at a 100 times "
+                                                "smaller tolerance (close calls; NaN: not checked)"}),
+            "largest_multiplier": ("point", np.array([float(np.max(np.abs(o.floquet))) if o.floquet.size else 0.0
+                                                      for o in orbits]),
+                                   {"long_name": "largest non-trivial |multiplier|"}),
+            "verdict": ("point", np.array([o.verdict for o in orbits], dtype=object).astype(str),
+                        {"long_name": "stable, unstable or undecided (a multiplier within multiplier_accuracy "
+                                      "of the unit circle)"}),
             "label": ("point", np.array([pt.label for pt in points], dtype=object).astype(str)),
             "arclength": ("point", arcl),
             "newton_iterations": ("point", np.array([pt.iterations for pt in points], dtype=int)),
@@ -951,6 +991,9 @@ def _build(eng: _Engine, points: list[_Point], special_rows: list[tuple[str, int
         f"rtol={getattr(eng.flow, 'rtol', '')}",
         "newton_tol": eng.tol,
         "stable_definition": "all non-trivial Floquet multipliers strictly inside the unit circle",
+        "verdict_definition": "stable: every non-trivial |mu| < 1 - multiplier_accuracy; unstable: some |mu| > 1 + "
+                              "multiplier_accuracy; else undecided; multiplier_accuracy = max(10 "
+                              "trivial_multiplier_error, 10 segments rtol)",
         "hopf_point_row": "label H: zero amplitude, multipliers exp(lambda_i T0) with the critical pair as 1; "
                           "'stable' copied from the emerging cycles",
     }  # fmt: skip

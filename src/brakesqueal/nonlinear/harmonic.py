@@ -102,6 +102,25 @@ class HarmonicPoint:
         What decided ``stable``: ``"Hill's method"``, or ``"normal form"`` where an exponent lies within
         :func:`hill_accuracy` of 0 (its printed sign is then not meaningful, e.g. a tiny positive radial
         exponent of a stable cycle next to a supercritical onset); ``None`` without a verdict.
+    F_n_max : tuple of float
+        Per pad, the largest normal force over the period [N].
+    trivial_multiplier_error : float or None
+        ``|exp(trivial_exponent T) - 1|``: the trivial (phase) multiplier's distance from 1 (``None`` without
+        Hill's method).
+    hill_verdict : str or None
+        ``"stable"``, ``"unstable"`` or ``"undecided"`` from ``stable`` (Hill's method or the normal form).
+    monodromy_verdict : str or None
+        The verdict of the monodromy matrix of the simulated equations from the orbit's state at ``t = 0``
+        (:func:`~.floquet.stability_verdict`), where the pads allow shooting (the simulated equations keep every
+        pad's rate); ``None`` elsewhere.
+    multipliers : ndarray or None
+        Non-trivial multipliers of that monodromy, by decreasing modulus.
+    shooting_mismatch : float or None
+        ``max |phi(x(0), T) - x(0)|`` over the states' amplitudes: the harmonic-balance orbit integrated over one
+        period by the simulated equations; ``None`` where the pads do not allow shooting.
+    verdict : str
+        The point's verdict: Hill's (or the normal form's) and the monodromy's where both exist
+        (:func:`~.floquet.cross_check`: they must agree, else ``"undecided"``); ``"undecided"`` without one.
     """
 
     p: float
@@ -120,6 +139,12 @@ class HarmonicPoint:
     trivial_exponent: float | None = None
     stability_from: str | None = None
     F_n_max: tuple[float, ...] = ()
+    trivial_multiplier_error: float | None = None
+    hill_verdict: str | None = None
+    monodromy_verdict: str | None = None
+    multipliers: np.ndarray | None = field(default=None, repr=False)
+    shooting_mismatch: float | None = None
+    verdict: str = "undecided"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready fields (no coefficients)."""
@@ -132,7 +157,12 @@ class HarmonicPoint:
                 "hill_accuracy": None if self.trivial_exponent is None else hill_accuracy(self.omega,
                                                                                           self.trivial_exponent),
                 "floquet_exponents": None if self.floquet_exponents is None else
-                [[float(v.real), float(v.imag)] for v in self.floquet_exponents]}
+                [[float(v.real), float(v.imag)] for v in self.floquet_exponents],
+                "trivial_multiplier_error": self.trivial_multiplier_error, "hill_verdict": self.hill_verdict,
+                "monodromy_verdict": self.monodromy_verdict, "shooting_mismatch": self.shooting_mismatch,
+                "multipliers": None if self.multipliers is None else
+                [[float(v.real), float(v.imag)] for v in self.multipliers],
+                "verdict": self.verdict}
 
     def series(self, t: np.ndarray) -> np.ndarray:
         """``u(t) = (Q, L)(t)`` at times ``t`` [s] (``t = 0``: the phase where ``b_1`` of the reference is 0).
@@ -263,7 +293,8 @@ class HarmonicBranch:
                   "tilt_amplitude": math.nan if pt.tilt_amplitude is None else pt.tilt_amplitude,
                   "F_n_max": list(pt.F_n_max), "F_n_min": list(pt.F_n_min),
                   "duty_cycle": [1.0 if v else None] * len(self.pads), "stable": pt.stable,
-                  "sliding_reversal": pt.sliding_margin_min <= 0} for pt, v in zip(pts, valid)]
+                  "sliding_reversal": pt.sliding_margin_min <= 0, "verdict": pt.verdict}
+                 for pt, v in zip(pts, valid)]
         return SquealSummary(self.parameter, float(h.p0), h.criticality, rng, hyst, folds, "bilateral",
                              self.contact_loss, self.sliding_reversal, table, self.pads)
 
@@ -273,7 +304,8 @@ class HarmonicBranch:
 
         Variables ``p``, ``frequency`` [Hz], ``amplitude`` (first harmonic of every ``Q`` and ``L``),
         ``tilt_amplitude`` [rad], ``F_n_min`` [N], ``sliding_margin_min`` [m/s], ``residual``,
-        ``truncation_error``, ``harmonics`` and ``stable`` (1 stable, 0 unstable, -1 not computed); the
+        ``truncation_error``, ``harmonics``, ``stable`` (1 stable, 0 unstable, -1 not computed),
+        ``trivial_multiplier_error``, ``shooting_mismatch`` (NaN where not computed) and ``verdict``; the
         attributes hold the parameter, the status and message, the located events and the Hopf point.
         """
         import xarray as xr
@@ -298,7 +330,14 @@ class HarmonicBranch:
              "truncation_error": ("point", np.array([pt.truncation_error for pt in pts], dtype=float)),
              "harmonics": ("point", np.array([pt.harmonics for pt in pts], dtype=np.int32)),
              "stable": ("point", stab, {"flag_values": [-1, 0, 1],
-                                        "flag_meanings": "not_computed unstable stable"})},
+                                        "flag_meanings": "not_computed unstable stable"}),
+             "trivial_multiplier_error": ("point", np.array([nan if pt.trivial_multiplier_error is None else
+                                                             pt.trivial_multiplier_error for pt in pts], dtype=float)),
+             "shooting_mismatch": ("point", np.array([nan if pt.shooting_mismatch is None else pt.shooting_mismatch
+                                                      for pt in pts], dtype=float)),
+             "verdict": ("point", np.array([pt.verdict for pt in pts], dtype=object).astype(str),
+                         {"long_name": "stable, unstable or undecided (Hill's and the monodromy's verdicts "
+                                       "cross-checked)"})},
             coords={"coord": list(self.coords), "pad": list(self.pads)},
             attrs={"parameter": self.parameter, "status": self.status, "message": self.message,
                    "method": "harmonic balance on the implicit equations (exact massless Coulomb pads)",
@@ -441,6 +480,7 @@ class _Balance:
         self.N = self.n + self.m
         self.ref, self.scale = ref, scale
         self._pv: dict[float, list[float]] = {}
+        self.check: _ShootingCheck | None = None  # the simulated equations' flow, where the pads allow shooting
         self.set_harmonics(H)
 
     def set_harmonics(self, H: int) -> None:
@@ -592,7 +632,8 @@ def harmonic_branch(engine: Engine, space: ParameterSpace, axis: Axis, *, harmon
                     ds: float = 0.05, ds_max: float = 0.2, start_offset: float = 1e-4,
                     stability: bool = True, use_cache: bool = True,
                     stop_at_contact_loss: bool = True,
-                    progress: Callable[[float], None] | None = None) -> HarmonicBranch:
+                    progress: Callable[[float], None] | None = None, residual_tol: float | None = None,
+                    mismatch_tol: float = 1e-6, shooting_check: bool = True) -> HarmonicBranch:
     """Limit cycles of the implicit equations (exact massless Coulomb pads) by harmonic balance.
 
     Parameters
@@ -604,7 +645,10 @@ def harmonic_branch(engine: Engine, space: ParameterSpace, axis: Axis, *, harmon
     axis : Axis
         The path: the first Hopf point with a cycle prediction in ``[start, stop]`` is continued within it.
     harmonics : int
-        Initial number of harmonics ``H`` (>= 1); raised while the truncation error exceeds ``harmonic_tol``.
+        Initial number of harmonics ``H`` (>= 1); raised (by half, at least 2) while the truncation error exceeds
+        ``harmonic_tol``, the residual of the truncated series in the equations at 10x more off-grid phases
+        exceeds ``residual_tol`` or, where the pads allow shooting, the shooting mismatch exceeds
+        ``mismatch_tol``.
     max_harmonics : int
         Largest number of harmonics (>= ``harmonics``).
     max_points : int
@@ -634,6 +678,18 @@ def harmonic_branch(engine: Engine, space: ParameterSpace, axis: Axis, *, harmon
         at a fold), with the last fraction before each orbit of the location of the contact loss or the
         sliding reversal, and with 1.0 at the end.  An exception it raises stops the continuation and
         propagates (the explorer's Cancel).
+    residual_tol : float, optional
+        Largest accepted residual (:attr:`HarmonicPoint.residual`, relative to the linear terms), in ``(0, 1)``;
+        default ``harmonic_tol``.
+    mismatch_tol : float
+        Largest accepted shooting mismatch (:attr:`HarmonicPoint.shooting_mismatch`: the orbit's state integrated
+        over one period by the simulated equations, relative to the states' amplitudes), in ``(0, 1)``; only
+        where the pads allow shooting (the simulated equations keep every pad's rate, :func:`~.models.cycle_route`
+        would shoot).  At least ``1e3`` times the integrator's ``rtol`` (its floor); a mismatch that a raise of
+        the harmonics does not halve is accepted (the integration's error, not the series', dominates).
+    shooting_check : bool
+        Where the pads allow shooting, integrate every orbit over one period: the mismatch, and the monodromy's
+        verdict cross-checked with Hill's (:attr:`HarmonicPoint.verdict`).
 
     Returns
     -------
@@ -659,7 +715,8 @@ def harmonic_branch(engine: Engine, space: ParameterSpace, axis: Axis, *, harmon
                              f"got {max_harmonics!r}")
     for nm, fv, lo_, hi_ in (("harmonic_tol", harmonic_tol, 0.0, 1.0), ("tol", tol, 0.0, 1e-3),
                              ("ds", ds, 0.0, 1.0), ("ds_max", ds_max, 0.0, 1.0),
-                             ("start_offset", start_offset, 0.0, 0.5)):
+                             ("start_offset", start_offset, 0.0, 0.5), ("mismatch_tol", mismatch_tol, 0.0, 1.0),
+                             ("residual_tol", harmonic_tol if residual_tol is None else residual_tol, 0.0, 1.0)):
         if not (isinstance(fv, (int, float)) and math.isfinite(fv) and lo_ < fv <= hi_):
             raise ParameterError(f"The option '{nm}' must be in ({lo_:g}, {hi_:g}]; got {fv!r}")
     if axis.name not in space.settable():
@@ -691,7 +748,12 @@ def harmonic_branch(engine: Engine, space: ParameterSpace, axis: Axis, *, harmon
     coords = tuple(cm.coords) + tuple(cm.algebraic)
     pads = tuple(p.name for p in space.resolve({}).model.pads)
     bal = _Balance(space, axis.name, sim, harmonics, ref, scale)
+    if shooting_check:
+        bal.check = _shooting_check(engine, space, axis, coords, use_cache)
     cont = _Continuation(bal, h.omega0, dist, tol)
+    rtol_ = harmonic_tol if residual_tol is None else float(residual_tol)
+    met = [True]  # whether the last adapt() met every tolerance
+    why = [""]
     K = bal.K
 
     def pack(C: np.ndarray, omega: float, p: float) -> np.ndarray:
@@ -729,17 +791,35 @@ def harmonic_branch(engine: Engine, space: ParameterSpace, axis: Axis, *, harmon
         return eq
 
     def adapt(y: np.ndarray, extra: Any) -> tuple[np.ndarray, float]:
-        """Raise the harmonics until the truncation error is below ``harmonic_tol`` (re-solving)."""
+        """Raise the harmonics until the truncation error, the off-grid residual and (where the pads allow
+        shooting) the shooting mismatch meet their tolerances (re-solving).  The mismatch's tolerance is at least
+        ``1e3`` times the flow's ``rtol`` (its integration floor), and a mismatch that more harmonics do not halve
+        is accepted (the floor, e.g. an unstable orbit amplifying the integration error)."""
+        prev_mis = math.inf
         while True:
-            err = _truncation(y[:-2].reshape(bal.N, bal.K), scale, bal.H)
-            if err <= harmonic_tol or bal.H >= max_harmonics:
+            Cy, wy, py = bal.unpack(y)
+            err = _truncation(Cy, scale, bal.H)
+            why[0] = f"the truncation error {err:.3g} exceeds harmonic_tol = {harmonic_tol:g}"
+            ok = err <= harmonic_tol
+            if ok:
+                res = _fine_residual(bal, Cy, wy, py)[0]
+                ok = res <= rtol_
+                why[0] = f"the residual {res:.3g} exceeds residual_tol = {rtol_:g}"
+            if ok and bal.check is not None:
+                mis = bal.check.mismatch(Cy, wy, py)
+                mtol = max(mismatch_tol, 1e3 * bal.check.rtol)
+                ok = mis <= mtol or mis > 0.5 * prev_mis
+                prev_mis = mis
+                why[0] = f"the shooting mismatch {mis:.3g} exceeds {mtol:g} (mismatch_tol or 1e3 rtol)"
+            met[0] = ok
+            if ok or bal.H >= max_harmonics:
                 return y, err
             Hold, Hnew = bal.H, min(max_harmonics, max(bal.H + 2, int(1.5 * bal.H)))
             bal.set_harmonics(Hnew)
             y, _ = cont.newton(resized(y, Hold, Hnew), extra)
 
     y, err = adapt(y, fixed_p(float(y[-1])))
-    stop_tol = min(1.0, 2 * harmonic_tol) if err > harmonic_tol else None
+    stop_tol = None if met[0] else why[0]
 
     def point(y: np.ndarray, err: float) -> HarmonicPoint:
         C, omega, p = bal.unpack(y)
@@ -764,8 +844,8 @@ def harmonic_branch(engine: Engine, space: ParameterSpace, axis: Axis, *, harmon
 
     if stop_tol is not None:
         status = "truncation"
-        message = (f"the truncation error {err:.3g} exceeds harmonic_tol = {harmonic_tol:g} with "
-                   f"max_harmonics = {max_harmonics} at the first orbit")
+        message = f"{stop_tol} with max_harmonics = {max_harmonics} at the first orbit"
+
     while status == "max_points" and len(points) < max_points:
         t = cont.tangent(y, t_prev)
         if t_prev is None and len(points) == 1 and t[ref * bal.K + 1] < 0:  # away from the Hopf point
@@ -830,11 +910,10 @@ def harmonic_branch(engine: Engine, space: ParameterSpace, axis: Axis, *, harmon
             K_new = (y_new.size - 2) // bal.N
             if K_new != bal.K:  # the location raised the harmonics: carry the new orbit over
                 y_new = resized(y_new, (K_new - 1) // 2, bal.H)
-        if bal.H == max_harmonics and err > harmonic_tol:
+        if bal.H == max_harmonics and not met[0]:
             accept(P)
             status = "truncation"
-            message = (f"the truncation error {err:.3g} exceeds harmonic_tol = {harmonic_tol:g} with "
-                       f"max_harmonics = {max_harmonics} at {axis.name} = {P.p:.10g}; raise max_harmonics")
+            message = f"{why[0]} with max_harmonics = {max_harmonics} at {axis.name} = {P.p:.10g}; raise max_harmonics"
             break
         accept(P)
         t_prev = t if bal.H == Hcur else _resize_vec(t, bal.N, 2 * Hcur + 1, bal.K)
@@ -842,10 +921,27 @@ def harmonic_branch(engine: Engine, space: ParameterSpace, axis: Axis, *, harmon
         if its <= 3:
             step = min(ds_max, 1.5 * step)
     if stability:
-        points = _near_onset_verdicts(points, ex.hopf, coords)
+        points = [_with_verdict(pt, stability) for pt in _near_onset_verdicts(points, ex.hopf, coords)]
     tracker.done()
     return HarmonicBranch(axis.name, ex, tuple(points), status, message, loss, rev, coords, pads,
                           "Hill's method" if stability else "not computed")
+
+
+def _shooting_check(engine: Engine, space: ParameterSpace, axis: Axis, coords: tuple[str, ...],
+                    use_cache: bool) -> _ShootingCheck | None:
+    """The simulated equations' flow where the pads allow shooting (no massless Coulomb pad the simulation would
+    make quasi-static, :func:`~.models.soft_quasi_static_pads`) and their states are values or rates of the
+    series; else ``None``."""
+    from .models import model_system, soft_quasi_static_pads
+    from .periodic import _make_flow
+
+    if soft_quasi_static_pads(space, axis):
+        return None
+    system = model_system(engine, space, axis.name, use_cache=use_cache)
+    try:
+        return _ShootingCheck(system, coords, _make_flow(system, None))
+    except KeyError:
+        return None
 
 
 def _near_onset_verdicts(points: list[HarmonicPoint], h: Any, coords: tuple[str, ...]) -> list[HarmonicPoint]:
@@ -892,24 +988,100 @@ def _truncation(C: np.ndarray, scale: np.ndarray, H: int) -> float:
     return float(np.max(top / np.maximum(den, 1e-300)))
 
 
-def _make_point(bal: _Balance, sim: SimulationModel, C: np.ndarray, omega: float, p: float, err: float,
-                coords: tuple[str, ...], stability: bool) -> HarmonicPoint:
-    cm, n = bal.cm, bal.n
-    H = bal.H
-    # fine grid (16x the collocation grid) and its off-grid half-step shift for the residual check
+class _ShootingCheck:
+    """The simulated equations' flow from a harmonic-balance orbit's state at ``t = 0`` (where the pads allow
+    shooting): the shooting mismatch over one period and the monodromy's verdict."""
+
+    def __init__(self, system: Any, coords: tuple[str, ...], flow: Any) -> None:
+        self.system, self.flow = system, flow
+        cols: list[tuple[int, int]] = []
+        for nm in system.state_names:  # Q, dQ, the dynamic pads' L: values or rates of the series
+            if nm in coords:
+                cols.append((coords.index(nm), 0))
+            elif nm.startswith("d") and nm[1:] in coords:
+                cols.append((coords.index(nm[1:]), 1))
+            else:
+                raise KeyError(nm)
+        self.cols = cols
+        rt = getattr(flow, "rtol", None)
+        self.rtol = float(rt) if isinstance(rt, (int, float)) else 1e-11
+
+    def state(self, C: np.ndarray, omega: float) -> tuple[np.ndarray, np.ndarray]:
+        """The state at ``t = 0`` and a per-state scale (half its range over the period, floored)."""
+        H = (C.shape[1] - 1) // 2
+        th = 2 * np.pi * np.arange(64) / 64
+        U, Ud = _basis(th, H, 0) @ C.T, omega * (_basis(th, H, 1) @ C.T)
+        X = np.column_stack([(U if d == 0 else Ud)[:, i] for i, d in self.cols])
+        half = 0.5 * (X.max(axis=0) - X.min(axis=0))
+        top = float(np.max(half)) if half.size and np.max(half) > 0 else 1.0
+        return X[0].copy(), np.maximum(half, 1e-6 * top)
+
+    def mismatch(self, C: np.ndarray, omega: float, p: float) -> float:
+        """``max |phi(x0, T) - x0| / scale`` (``inf`` if the flow fails)."""
+        from .flow import FlowError
+
+        x0, sc = self.state(C, omega)
+        try:
+            fr = self.flow(x0, 2 * np.pi / omega, p, sensitivities=False, scale=sc)
+        except FlowError:
+            return math.inf
+        return float(np.max(np.abs(fr.x - x0) / sc))
+
+    def verdict(self, C: np.ndarray, omega: float, p: float) -> tuple[float, np.ndarray | None, str | None]:
+        """``(mismatch, non-trivial multipliers, verdict)``; the accuracy bound includes ``10 mismatch``."""
+        from .floquet import multiplier_accuracy, stability_verdict
+        from .flow import FlowError
+        from .periodic import ShootingError, floquet_multipliers
+
+        x0, sc = self.state(C, omega)
+        try:
+            fr = self.flow(x0, 2 * np.pi / omega, p, sensitivities=True, scale=sc)
+            _, red, terr = floquet_multipliers(fr.monodromy, self.system.rhs(x0, p))
+        except (FlowError, ShootingError):
+            return math.inf, None, None
+        mis = float(np.max(np.abs(fr.x - x0) / sc))
+        acc = max(multiplier_accuracy(terr, getattr(self.flow, "rtol", None), method=fr.monodromy_method),
+                  10 * mis)
+        return mis, red, stability_verdict(red, acc)
+
+
+def _fine_residual(bal: _Balance, C: np.ndarray, omega: float, p: float) -> tuple[float, list[np.ndarray], int]:
+    """The largest residual of the truncated series in the equations at 10x more (off-grid) phases than the
+    collocation grid, relative to the linear terms' magnitude; with the states there and their number."""
+    n = bal.n
+    H = (C.shape[1] - 1) // 2
     Mf = 10 * (4 * H + 4)
     thf = 2 * np.pi * (np.arange(Mf) + 0.5) / Mf
     Ef = [_basis(thf, H, k) for k in range(3)]
     r = bal.residual_time(C, omega, p, Ef)
     x = bal.states(C, omega, Ef)
-    pv = bal.pvec(p)
     J0 = bal.jac_time(C, omega, p, [e[:1] for e in Ef])[:, :, 0]
     amp = np.hypot(C[:, 1], C[:, 2])
     a = np.maximum(amp, 1e-6 * bal.scale)  # a coordinate that does not move (rigid pads: L = 0) keeps a scale
     xs = np.concatenate([a[:n], omega * a[:n], omega * omega * a[:n], a[n:], omega * a[n:]])
     rowscale = np.abs(J0) @ xs
     rowscale[rowscale == 0] = 1.0
-    resid = float(np.max(np.abs(r) / rowscale[:, None]))
+    return float(np.max(np.abs(r) / rowscale[:, None])), x, Mf
+
+
+def _with_verdict(pt: HarmonicPoint, stability: bool) -> HarmonicPoint:
+    """``pt`` with its Hill verdict (from ``stable``) and the cross-checked verdict."""
+    from dataclasses import replace
+
+    from .floquet import cross_check
+
+    hv = None if not stability else ("undecided" if pt.stable is None else "stable" if pt.stable else "unstable")
+    return replace(pt, hill_verdict=hv, verdict=cross_check(hv, pt.monodromy_verdict))
+
+
+def _make_point(bal: _Balance, sim: SimulationModel, C: np.ndarray, omega: float, p: float, err: float,
+                coords: tuple[str, ...], stability: bool) -> HarmonicPoint:
+    cm, n = bal.cm, bal.n
+    H = bal.H
+    # fine grid (10x the collocation grid), off-grid by half a step, for the residual check
+    resid, x, Mf = _fine_residual(bal, C, omega, p)
+    pv = bal.pvec(p)
+    amp = np.hypot(C[:, 1], C[:, 2])
     ct = cm.vectorized.contact(x, pv)
     npad = len(ct) // 7
     ct = np.array([np.broadcast_to(np.asarray(v, dtype=float), (Mf,)) for v in ct]).reshape(npad, 7, Mf)
@@ -928,10 +1100,17 @@ def _make_point(bal: _Balance, sim: SimulationModel, C: np.ndarray, omega: float
     tilt = float(max(amp[i] for i in tilts)) if tilts else None
     ampd = {c: float(a) for c, a in zip(coords, amp)}
     fl = st = tr = None
+    terr = None
     if stability:
         fl, st, tr = _hill(bal, C, omega, p)
-    return HarmonicPoint(float(p), float(omega), float(omega / (2 * np.pi)), ampd, tilt, fmin, smin, resid,
-                         float(err), H, C.copy(), fl, st, tr, None if st is None else "Hill's method", fmax)
+        terr = float(abs(math.expm1(tr * 2 * math.pi / omega)))
+    mis = red = mv = None
+    if bal.check is not None:
+        mis, red, mv = bal.check.verdict(C, omega, p)
+    pt = HarmonicPoint(float(p), float(omega), float(omega / (2 * np.pi)), ampd, tilt, fmin, smin, resid,
+                       float(err), H, C.copy(), fl, st, tr, None if st is None else "Hill's method", fmax,
+                       trivial_multiplier_error=terr, monodromy_verdict=mv, multipliers=red, shooting_mismatch=mis)
+    return _with_verdict(pt, stability)
 
 
 def _pmin(v: np.ndarray) -> np.ndarray:
@@ -1004,6 +1183,8 @@ def _hill(bal: _Balance, C: np.ndarray, omega: float, p: float) -> tuple[np.ndar
             if abs(strip[j] - strip[i]) > 1e-6 * omega:
                 continue
             s = int(round((lam[j] - lam[i]).imag / omega))
+            if s == 0:  # two eigenvalues in the same copy of the strip are distinct exponents, not copies (the
+                continue  # trivial and the radial exponent near a Hopf point have nearly parallel eigenvectors)
             a, b = Vr[:, :, i], Vr[:, :, j]
             if abs(s) < ks.size:
                 a = np.roll(a, -s, axis=1)

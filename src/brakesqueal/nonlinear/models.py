@@ -434,7 +434,8 @@ def cycle_space(space: ParameterSpace, *, pads: str = "auto", pad_slope: float |
 _ROUTE_OPTIONS: dict[str, frozenset[str]] = {
     "shooting": frozenset({"use_cache", "tol", "ds", "ds_max", "flow_method"}),
     "harmonic balance": frozenset({"use_cache", "tol", "ds", "ds_max", "harmonics", "max_harmonics",
-                                   "harmonic_tol", "start_offset", "stability", "stop_at_contact_loss"}),
+                                   "harmonic_tol", "start_offset", "stability", "stop_at_contact_loss",
+                                   "residual_tol", "mismatch_tol", "shooting_check"}),
 }
 
 
@@ -469,7 +470,8 @@ def limit_cycles(engine: Engine, space: ParameterSpace, axis: Axis, *, contact: 
         Options of the route taken: shooting (:func:`~.squeal.squeal_branch`): ``use_cache``, ``tol``, ``ds``,
         ``ds_max``, ``flow_method``; harmonic balance
         (:func:`~.harmonic.harmonic_branch`): ``use_cache``, ``tol``, ``ds``, ``ds_max``, ``harmonics``,
-        ``max_harmonics``, ``harmonic_tol``, ``start_offset``, ``stability``, ``stop_at_contact_loss``.
+        ``max_harmonics``, ``harmonic_tol``, ``start_offset``, ``stability``, ``stop_at_contact_loss``,
+        ``residual_tol``, ``mismatch_tol``, ``shooting_check``.
 
     Returns
     -------

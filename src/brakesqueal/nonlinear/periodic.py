@@ -17,7 +17,9 @@ and those of the reduced matrix ``V^T M V`` (``V``: orthonormal basis of
 ``f(X_0)^perp``), which are the non-trivial Floquet multipliers (conjugate
 pairs stay together).  The orbit is stable when all of them lie strictly
 inside the unit circle.  The distance of the eigenvalue of ``M`` nearest to 1
-from 1 is reported as a check (``trivial_multiplier_error``).
+from 1 is reported as a check (``trivial_multiplier_error``) and bounds the
+verdict (``verdict``: ``"undecided"`` where a non-trivial multiplier lies within
+``multiplier_accuracy`` of the unit circle; :mod:`.floquet`).
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import BrakesquealError, ParameterError
+from .floquet import multiplier_accuracy, stability_verdict
 from .flow import Event, FlowError, FlowResult, ScipyFlow
 from .hopf import CycleGuess
 from .system import PiecewiseSystem, SmoothSystem
@@ -89,6 +92,17 @@ class PeriodicOrbit:
         Coordinate names.
     parameter_name : str
         Parameter name.
+    multiplier_accuracy : float
+        How far from the unit circle a non-trivial multiplier must lie for its side to count
+        (:func:`~.floquet.multiplier_accuracy`: from ``trivial_multiplier_error`` and the integration tolerance).
+    verdict : str
+        ``"stable"``, ``"unstable"`` or ``"undecided"`` (:func:`~.floquet.stability_verdict`): ``stable`` and
+        ``n_unstable`` count the multipliers' computed side of the unit circle, the verdict only a side farther
+        than ``multiplier_accuracy``.
+    multiplier_change : float
+        For a close call (the largest non-trivial ``|mu|`` within :data:`CLOSE_CALL` times the accuracy of 1):
+        how much it changes when the monodromy is integrated again at a 100 times smaller tolerance; it widens
+        ``multiplier_accuracy`` to at least twice that.  ``nan`` where not checked.
     """
 
     x: np.ndarray
@@ -113,6 +127,9 @@ class PeriodicOrbit:
     sample_modes: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=int), repr=False)
     state_names: tuple[str, ...] = ()
     parameter_name: str = "p"
+    multiplier_accuracy: float = float("nan")
+    verdict: str = "undecided"
+    multiplier_change: float = float("nan")
 
     @property
     def omega(self) -> float:
@@ -141,6 +158,9 @@ class PeriodicOrbit:
             "floquet": [[float(m.real), float(m.imag)] for m in self.floquet],
             "stable": self.stable,
             "trivial_multiplier_error": self.trivial_multiplier_error,
+            "multiplier_accuracy": self.multiplier_accuracy,
+            "verdict": self.verdict,
+            "multiplier_change": self.multiplier_change,
             "monodromy_method": self.monodromy_method,
             "events": [e.name for e in self.events],
         }
@@ -271,13 +291,54 @@ def _orbit_from(flow: Any, X: np.ndarray, T: float, p: float, ev: _Eval, scale: 
     f0 = _vector_field(system, X[0], p)
     lam, red, terr = floquet_multipliers(M, f0)
     n_unst = int(np.count_nonzero(np.abs(red) > 1.0))
+    method = ev.flows[0].monodromy_method
+    accuracy = multiplier_accuracy(terr, getattr(flow, "rtol", None), method=method, segments=X.shape[0])
+    verdict = stability_verdict(red, accuracy)
+    change = math.nan
+    if verdict != "undecided" and red.size and abs(float(np.max(np.abs(red))) - 1.0) < CLOSE_CALL * accuracy:
+        # a close call: the monodromy again at a 100 times smaller tolerance; the change bounds the error too
+        change = _tolerance_change(flow, X, T, p, red, f0, scale)
+        if math.isfinite(change):
+            accuracy = max(accuracy, 2.0 * change)
+            verdict = stability_verdict(red, accuracy)
     return PeriodicOrbit(
         x=X.copy(), period=float(T), p=float(p), multipliers=lam, floquet=red, monodromy=M,
         stable=bool(n_unst == 0), n_unstable=n_unst, trivial_multiplier_error=terr, residual=float(residual),
-        iterations=iterations, monodromy_method=ev.flows[0].monodromy_method,
+        iterations=iterations, monodromy_method=method,
         state_names=tuple(system.state_names), parameter_name=system.parameter_name,
+        multiplier_accuracy=accuracy, verdict=verdict, multiplier_change=change,
         **_sampled(flow, X, T, p, scale, n_samples, ev.flows),
     )  # fmt: skip
+
+
+#: A decided verdict whose largest non-trivial ``|mu|`` lies within this many times the accuracy bound of 1 is
+#: checked by a second monodromy at a 100 times smaller integration tolerance (:attr:`PeriodicOrbit.multiplier_change`).
+CLOSE_CALL: float = 1e4
+
+
+def _tolerance_change(flow: Any, X: np.ndarray, T: float, p: float, red: np.ndarray, f0: np.ndarray,
+                      scale: np.ndarray) -> float:
+    """Change of the largest non-trivial ``|mu|`` when the monodromy is integrated at ``rtol / 100`` (at least
+    ``1e-13``); ``nan`` for a flow without a dataclass ``rtol`` or already at the floor, or if the flow fails."""
+    import dataclasses
+
+    rt = getattr(flow, "rtol", None)
+    if not dataclasses.is_dataclass(flow) or isinstance(flow, type) or not isinstance(rt, (int, float)):
+        return math.nan
+    tight = max(float(rt) / 100.0, 1e-13)
+    if tight >= float(rt):
+        return math.nan
+    try:
+        fine: Any = dataclasses.replace(flow, rtol=tight)
+        m, n = X.shape
+        M = np.eye(n)
+        for i in range(m):
+            fr = fine(X[i], T / m, p, sensitivities=True, scale=scale)
+            M = fr.monodromy @ M
+        _, red2, _ = floquet_multipliers(M, f0)
+    except (FlowError, ParameterError, ShootingError):
+        return math.nan
+    return float(abs(np.max(np.abs(red)) - np.max(np.abs(red2))))
 
 
 def _resampled(flow: Any, orbit: PeriodicOrbit, scale: np.ndarray, n_samples: int) -> PeriodicOrbit:

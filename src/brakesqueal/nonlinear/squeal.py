@@ -207,7 +207,8 @@ class SquealSummary:
         Per branch point: ``p``, ``frequency_hz``, ``tilt_amplitude`` [rad] (largest first-harmonic tilt),
         ``F_n_max``, ``F_n_min`` [N] per pad (acting force), ``duty_cycle`` per pad (``None`` where a
         bilateral branch is not valid: a pad would pull), ``stable`` (``None``: no verdict, harmonic balance),
-        ``sliding_reversal``.
+        ``sliding_reversal``, ``verdict`` (``"stable"``, ``"unstable"`` or ``"undecided"``: a multiplier within
+        the computation's accuracy of the unit circle, or two methods disagreeing; :mod:`.floquet`).
     pads : tuple of str
         Pad names.
     """
@@ -269,6 +270,8 @@ class SquealSummary:
             cells = " ".join(f"{r['F_n_max'][j]:11.5g} " + (f"{r['duty_cycle'][j]:7.3f}" if r["duty_cycle"][j]
                                                                 is not None else f"{'-':>7}") for j in range(len(pads)))
             flag = "-" if r["stable"] is None else "yes" if r["stable"] else "no"
+            if r.get("verdict") == "undecided":  # a multiplier within the monodromy's accuracy of the unit circle
+                flag = "undecided" if r["stable"] is None else f"undecided ({flag})"
             if r["sliding_reversal"]:
                 flag += " (sliding reverses)"
             lines.append(f"{r['p']:12.8g} {r['frequency_hz']:10.6g} {r['tilt_amplitude']:11.4g} {cells}  {flag}")
@@ -332,6 +335,7 @@ class SquealBranch:
                                zip(ds["special_kind"].values, ds["special_p"].values)],
             "hysteresis_range": ds.attrs.get("hysteresis_range"), "contact": self.contact,
             "summary": None if self.summary is None else self.summary.to_dict(),
+            "floquet": _floquet_rows(ds),
         }
 
     def plot(self, coord: str | int | None = None) -> Any:
@@ -343,6 +347,17 @@ class SquealBranch:
             fig.axes[0].annotate("contact loss", (self.contact_loss, 0.95), xycoords=("data", "axes fraction"),
                                  color="tab:red", fontsize="small", ha="left", va="top")
         return fig
+
+
+def _floquet_rows(ds: Any) -> list[dict[str, Any]]:
+    """Per branch point: the verified Floquet data of the shooting route (:mod:`.floquet`)."""
+    if "verdict" not in ds:
+        return []
+    cols = ("trivial_multiplier_error", "multiplier_accuracy", "largest_multiplier", "multiplier_change")
+    return [{"p": float(ds["p"].values[i]), "label": str(ds["label"].values[i]),
+             **{c: float(ds[c].values[i]) if c in ds else math.nan for c in cols},
+             "stable": bool(ds["stable"].values[i]),
+             "verdict": str(ds["verdict"].values[i])} for i in range(ds["p"].size)]
 
 
 #: Shooting methods of :func:`squeal_branch` (``flow_method``; ``None``: the automatic choice).
@@ -661,7 +676,8 @@ def squeal_summary(branch: SquealBranch) -> SquealSummary:
                     "F_n_min": [float(max(v, 0.0)) if branch.contact == "unilateral" else float(v)
                                 for v in ds["F_n_min"].values[i]],
                     "duty_cycle": [float(v) if math.isfinite(v) else None for v in ds["duty_cycle"].values[i]],
-                    "stable": bool(stable[i]), "sliding_reversal": bool(rev[i])})
+                    "stable": bool(stable[i]), "sliding_reversal": bool(rev[i]),
+                    "verdict": str(ds["verdict"].values[i]) if "verdict" in ds else None})
     crit = h.criticality if h is not None else "unknown"
     return SquealSummary(str(ds.attrs.get("parameter", branch.hopf.parameter)), onset, crit, rng, hyst, folds,
                          branch.contact, branch.contact_loss, validity_end, tab, branch.pads)

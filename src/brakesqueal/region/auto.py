@@ -41,7 +41,8 @@ if TYPE_CHECKING:
     from ..codegen.engine import Engine
     from ..model.parameters import ParameterSpace
 
-__all__ = ["AutoCurve", "auto_dir", "auto_available", "auto_source", "auto_hopf_curve", "to_unit", "from_unit"]
+__all__ = ["AutoCurve", "AutoCycles", "auto_dir", "auto_available", "auto_source", "auto_hopf_curve",
+           "auto_cycle_branch", "to_unit", "from_unit"]
 
 
 def auto_dir() -> Path:
@@ -284,6 +285,36 @@ class AutoCurve:
     special: tuple[tuple[str, float, float], ...] = ()
 
 
+@dataclass(frozen=True)
+class AutoCycles:
+    """A branch of periodic orbits from a Hopf point computed by AUTO-07p (the bilateral equations: AUTO knows
+    nothing of contact loss).
+
+    Attributes
+    ----------
+    name : str
+        The continuation parameter (``PAR(2)``).
+    hopf : float
+        The Hopf point AUTO found on the equilibrium branch.
+    p : ndarray
+        The parameter along the branch (AUTO's order, from the Hopf point).
+    max_state : ndarray
+        ``(point, state)``: AUTO's ``MAX U(i)`` (the largest value of each state over the orbit, AUTO's scaled
+        state: displacements in SI units, rates divided by the time scale).
+    period : ndarray
+        The period [s].
+    fold : float or None
+        AUTO's first fold of cycles (``LP``) on the branch, or ``None``.
+    """
+
+    name: str
+    hopf: float
+    p: np.ndarray
+    max_state: np.ndarray
+    period: np.ndarray
+    fold: float | None
+
+
 _TY = {0: "", 1: "BP", -2: "CP", 2: "LP", 3: "HB", -3: "ZH", -1: "BT", -32: "GH", 4: "RG", -4: "UZ", 9: "EP",
        -9: "MX"}
 
@@ -351,6 +382,110 @@ def _parse_fort7(text: str) -> list[dict[str, float]]:
     return rows
 
 
+def _to_first_hopf(src: str, tmp: Path, x: Axis, y: Axis, x0: float, y_start: float, points: int,
+                   timeout: float) -> tuple[Path, dict[str, object], int, float]:
+    """Build the user functions in ``tmp`` and continue the equilibrium in ``y`` from ``y_start`` to the first
+    Hopf point (run 1, its ``fort.8`` kept as ``s.eq``): the executable, the common constants, the HB label and
+    ``y`` there."""
+    (tmp / "bsq.c").write_text(src)
+    cc = shutil.which("gcc") or shutil.which("cc") or "gcc"
+    inc = _include_dir()
+    cmd = [cc, "-O2", "-fPIC", f"-I{inc}", "-o", str(tmp / "bsq.exe"), str(tmp / "bsq.c"),
+           *sorted(str(p) for p in (auto_dir() / "lib").glob("*.o")), str(auto_dir() / "lib" / "libauto_c.a"),
+           str(_libgfortran()), "-fopenmp", "-lm"]
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    if p.returncode != 0:
+        first = next((ln for ln in p.stderr.splitlines() if "error" in ln), p.stderr.strip()[:200])
+        raise BrakesquealError(f"building the AUTO-07p user functions failed: {first}")
+    exe = tmp / "bsq.exe"
+    ndim = int(src.rsplit("state dimension ", 1)[1].split()[0])
+    common: dict[str, object] = dict(NDIM=ndim, IPS=1, ILP=0, NTST=20, NCOL=4, IAD=3, ISP=1, IPLT=0, NBC=0, NINT=0,
+                                     NPR=100000, MXBF=0, IID=0, ITMX=8, ITNW=12, NWTN=3, JAC=0, EPSL="1e-10",
+                                     EPSU="1e-10", EPSS="1e-8", DSMIN="1e-10", IADS=1, NPAR=2, NMX=points)
+    # run 1: the equilibrium in y from y_start, stop at the first Hopf point
+    c1 = _constants(**common, IRS=0, ICP="[2]", ISW=1, DS="0.001", DSMAX="0.01", STOP="['HB1']",
+                    UZSTOP="{2: [0.0, 1.0]}")
+    b7, _ = _run(tmp, exe, c1, None, timeout)
+    rows = _parse_fort7(b7)
+    hb = [r for r in rows if _ty(int(r.get("TY", 0))) == "HB"]
+    if not hb:
+        raise BrakesquealError(f"AUTO-07p found no Hopf point on the equilibrium branch at {x.name} = {x0:.10g} "
+                               f"from {y.name} = {y_start:.10g}")
+    shutil.copy(tmp / "fort.8", tmp / "s.eq")
+    return exe, common, int(hb[0]["LAB"]), from_unit(y, hb[0].get("PAR(2)", math.nan))
+
+
+@validated
+def auto_cycle_branch(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0: float, y_start: float, *,
+                      direction: Annotated[int, Range(-1, 1)] = 1, ntst: Annotated[int, Range(5, 500)] = 40,
+                      points: Annotated[int, Range(10, 100000)] = 400,
+                      timeout: Annotated[float, Range(1, 3600, open_low=False)] = 300.0,
+                      keep: str | None = None) -> AutoCycles:
+    """The periodic orbits born at the first Hopf point above ``y_start`` at ``x = x0``, continued in ``y`` by
+    AUTO-07p to its first fold of cycles (``LP``) or the box's edge (the check of :func:`~.folds.fold_curves`).
+
+    Parameters
+    ----------
+    engine : Engine
+        The model's engine.
+    space : ParameterSpace
+        The model (with nonlinear equations), preset and overrides.
+    x, y : Axis
+        The fixed parameter and the continuation parameter, with their boxes.
+    x0 : float
+        The fixed ``x``.
+    y_start : float
+        Where the equilibrium branch starts (below the Hopf point, inside ``y``).
+    direction : {1, -1}
+        Sign of AUTO's first step on the cycle branch (``DS``).
+    ntst : int
+        Mesh intervals of AUTO's collocation (``NTST``).
+    points : int
+        Largest number of steps of each run (``NMX``).
+    timeout : float
+        Seconds each AUTO run may take.
+    keep : str, optional
+        A directory to keep AUTO's files in.
+
+    Returns
+    -------
+    AutoCycles
+
+    Raises
+    ------
+    BrakesquealError
+        AUTO-07p is not installed, the build or a run fails, or no Hopf point.
+    """
+    why = auto_available()
+    if why:
+        raise BrakesquealError(why)
+    if direction == 0:
+        raise ParameterError("The option 'direction' must be 1 or -1; got 0", parameter="direction")
+    src = auto_source(engine, space, x, y, x0, y_start)
+    tmp = Path(keep) if keep else Path(tempfile.mkdtemp(prefix="brakesqueal-auto-"))
+    tmp.mkdir(parents=True, exist_ok=True)
+    try:
+        exe, common, lab, y_h = _to_first_hopf(src, tmp, x, y, x0, y_start, points, timeout)
+        # run 2: the cycles from the Hopf point (branch switching), folds detected, stop at the first
+        c2 = _constants(**{**common, "IPS": 2, "ILP": 1, "ISP": 2, "NTST": ntst, "NPAR": 11, "EPSS": "1e-6",
+                           "DSMIN": "1e-12"}, IRS=lab, ICP="[2, 11]", ISW=1, DS=repr(direction * 1e-4),
+                        DSMAX="0.01", STOP="['LP1']", UZSTOP="{2: [0.0, 1.0]}")
+        b7, _ = _run(tmp, exe, c2, tmp / "s.eq", timeout)
+        rows = [r for r in _parse_fort7(b7) if "PAR(2)" in r]
+        n = int(common["NDIM"])  # type: ignore[call-overload]
+        p = np.array([from_unit(y, r["PAR(2)"]) for r in rows])
+        mx = np.array([[r.get(f"MAX U({i + 1})", math.nan) for i in range(n)] for r in rows])
+        per = np.array([r.get("PERIOD", math.nan) for r in rows])
+        # on a branch of periodic orbits AUTO's type 5 is a fold (LP; 2 on equilibria)
+        lps = [from_unit(y, r["PAR(2)"]) for r in rows if abs(int(r.get("TY", 0))) % 10 in (2, 5)]
+        # AUTO's period is in its time tau = W t
+        w = float(src.rsplit("time scaled by W = ", 1)[1].split()[0]) if "time scaled by W = " in src else 1.0
+        return AutoCycles(y.name, y_h, p, mx, per / w, lps[0] if lps else None)
+    finally:
+        if not keep:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
 @validated
 def auto_hopf_curve(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0: float, y_start: float, *,
                     time_scale: Annotated[float, Range(0, open_low=True)] | None = None,
@@ -397,33 +532,7 @@ def auto_hopf_curve(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0:
     tmp = Path(keep) if keep else Path(tempfile.mkdtemp(prefix="brakesqueal-auto-"))
     tmp.mkdir(parents=True, exist_ok=True)
     try:
-        (tmp / "bsq.c").write_text(src)
-        cc = shutil.which("gcc") or shutil.which("cc") or "gcc"
-        inc = _include_dir()
-        cmd = [cc, "-O2", "-fPIC", f"-I{inc}", "-o", str(tmp / "bsq.exe"), str(tmp / "bsq.c"),
-               *sorted(str(p) for p in (auto_dir() / "lib").glob("*.o")), str(auto_dir() / "lib" / "libauto_c.a"),
-               str(_libgfortran()), "-fopenmp", "-lm"]
-        p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
-        if p.returncode != 0:
-            first = next((ln for ln in p.stderr.splitlines() if "error" in ln), p.stderr.strip()[:200])
-            raise BrakesquealError(f"building the AUTO-07p user functions failed: {first}")
-        exe = tmp / "bsq.exe"
-        ndim = int(src.rsplit("state dimension ", 1)[1].split()[0])
-        common = dict(NDIM=ndim, IPS=1, ILP=0, NTST=20, NCOL=4, IAD=3, ISP=1, IPLT=0, NBC=0, NINT=0, NPR=100000,
-                      MXBF=0, IID=0, ITMX=8, ITNW=12, NWTN=3, JAC=0, EPSL="1e-10", EPSU="1e-10", EPSS="1e-8",
-                      DSMIN="1e-10", IADS=1, NPAR=2, NMX=points)
-        # run 1: the equilibrium in y from y_start, stop at the first Hopf point
-        c1 = _constants(**common, IRS=0, ICP="[2]", ISW=1, DS="0.001", DSMAX="0.01", STOP="['HB1']",
-                        UZSTOP="{2: [0.0, 1.0]}")
-        b7, _ = _run(tmp, exe, c1, None, timeout)
-        rows = _parse_fort7(b7)
-        hb = [r for r in rows if _ty(int(r.get("TY", 0))) == "HB"]
-        if not hb:
-            raise BrakesquealError(f"AUTO-07p found no Hopf point on the equilibrium branch at {x.name} = {x0:.10g} "
-                                   f"from {y.name} = {y_start:.10g}")
-        lab = int(hb[0]["LAB"])
-        y_h = from_unit(y, hb[0].get("PAR(2)", math.nan))
-        shutil.copy(tmp / "fort.8", tmp / "s.eq")
+        exe, common, lab, y_h = _to_first_hopf(src, tmp, x, y, x0, y_start, points, timeout)
         xs: list[float] = []
         ys: list[float] = []
         labels: list[tuple[str, float, float]] = []

@@ -9,10 +9,13 @@ skips crossings of a real eigenvalue (static divergence, not Hopf).
 boundary (:func:`~brakesqueal.analysis.maps.stability_map`) and returns a
 :class:`RegionResult` (JSON, text, xarray/NetCDF, figure).
 
-Fold-of-cycles curves (issue 28 item 2) are not computed: the region where
-squeal is possible although the silent motion is linearly stable (between the
-fold-of-cycles curve and a subcritical Hopf curve) is not shaded, and the
-results say so (``fold_of_cycles = "not computed"``).
+With ``folds=True`` (default) it also computes the fold-of-cycles curve born at
+every generalised-Hopf point (:func:`~.folds.fold_curves`) and the regions it
+bounds: "squeal possible although linearly stable" (between a fold-of-cycles
+curve and its subcritical Hopf curve) and "contact lost" (between the subcritical
+Hopf curve and the contact loss of its cycles, where the pads lose contact
+before the branch folds).  With ``folds=False`` the results say
+``fold_of_cycles = "not computed"``.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Annotated, Any
 
 import numpy as np
@@ -27,6 +31,7 @@ import numpy as np
 from ..errors import BrakesquealError, ParameterError
 from ..validation import Range, validated
 from .curves import SPECIAL_TYPES, HopfCurve, continue_hopf_curve
+from .folds import FOLD_KINDS, FoldCurve, fold_curves
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -37,12 +42,18 @@ if TYPE_CHECKING:
     from ..model.parameters import ParameterSpace
     from ..results import StabilityMap
 
-__all__ = ["RegionResult", "hopf_curves", "region_diagram", "FOLD_OF_CYCLES"]
+__all__ = ["RegionResult", "hopf_curves", "region_diagram", "FOLD_OF_CYCLES", "REGIONS"]
 
-#: What the results say about fold-of-cycles curves (issue 28 item 2, not built).
+#: What the results say about fold-of-cycles curves when they are not asked for (``folds=False``).
 FOLD_OF_CYCLES = "not computed"
 _NOT_SHADED = ("squeal possible although linearly stable: not shaded (needs the fold-of-cycles curves, not "
-               "computed)")
+               "computed: --folds)")
+_SHADED = ("squeal possible although linearly stable: shaded between each fold-of-cycles curve and its "
+           "subcritical Hopf curve; contact lost: shaded between the subcritical Hopf curve and the contact loss "
+           "of its cycles where the pads lose contact before the branch folds (the fold is not computed there)")
+_NO_GH = "no generalised-Hopf point in the box: no fold-of-cycles curve, nothing shaded"
+#: Names of the shaded regions (keys of ``regions`` in the JSON).
+REGIONS = {"LPC": "squeal_possible_although_linearly_stable", "contact_loss": "contact_lost"}
 
 
 def _check(engine: Engine, space: ParameterSpace, x: Axis, y: Axis) -> None:
@@ -211,6 +222,8 @@ class RegionResult:
         What was skipped and why.
     seconds : float
         Wall time of the computation.
+    folds : list of FoldCurve or None
+        The fold-of-cycles curves of the GH points (:func:`~.folds.fold_curves`); ``None``: not computed.
     """
 
     space: ParameterSpace
@@ -220,6 +233,24 @@ class RegionResult:
     stability_map: StabilityMap | None
     notes: list[str] = field(default_factory=list)
     seconds: float = 0.0
+    folds: list[FoldCurve] | None = None
+
+    @property
+    def fold_status(self) -> str:
+        """``"computed"`` or :data:`FOLD_OF_CYCLES` (``"not computed"``)."""
+        return FOLD_OF_CYCLES if self.folds is None else "computed"
+
+    @property
+    def shaded(self) -> str:
+        """What the figure shades (or why nothing)."""
+        if self.folds is None:
+            return _NOT_SHADED
+        return _SHADED if self.folds else _NO_GH
+
+    def regions(self) -> dict[str, list[list[tuple[float, float]]]]:
+        """The shaded polygons ``[(x, y), ...]`` by region name (:data:`REGIONS`)."""
+        return {name: [poly for f in (self.folds or []) for poly in f.regions(kind)]
+                for kind, name in REGIONS.items()}
 
     def _units(self) -> tuple[str, str]:
         from ..labels import unit
@@ -251,8 +282,10 @@ class RegionResult:
             "y": {"name": yn, "start": self.y.start, "stop": self.y.stop, "log": self.y.log, "unit": uy},
             "hopf_curves": curves,
             "special_points": specials,
-            "fold_of_cycles": FOLD_OF_CYCLES,
-            "shaded": _NOT_SHADED,
+            "fold_of_cycles": self.fold_status,
+            "fold_curves": [self._fold_dict(f) for f in (self.folds or [])],
+            "regions": {k: [[{xn: a, yn: b} for a, b in poly] for poly in v] for k, v in self.regions().items()},
+            "shaded": self.shaded,
             "method": ("Hopf curves: pseudo-arclength continuation of Re lambda_c = 0 on the exact linearization "
                        "(every mode), seeded at the exact stability crossings; l1: exact_lyapunov (pads' true "
                        "rates, MatCont normalisation: l1 < 0 supercritical); codim-2 points located by bisection "
@@ -266,6 +299,17 @@ class RegionResult:
                                          "stable_fraction": float(np.mean(ds["stable"].values)),
                                          "method": str(ds.attrs.get("method", ""))}
         return d
+
+    def _fold_dict(self, f: FoldCurve) -> dict[str, Any]:
+        xn, yn = self.x.name, self.y.name
+        pts = [{xn: p.x, yn: p.y, "kind": p.kind, "amplitude": p.amplitude, "period": p.period, "route": p.route,
+                "contact_lost": p.contact_lost, f"hopf_{f.along}": p.hopf, "description": FOLD_KINDS[p.kind],
+                **({"message": p.message} if p.message else {})} for p in f.points]
+        return {"curve": f.curve, "gh": {xn: f.gh[0], yn: f.gh[1]}, "along": f.along, "points": pts,
+                "notes": list(f.notes),
+                "method": (f"slices: at values of the other axis stepping away from the GH point, the cycle branch "
+                           f"from the slice's subcritical Hopf point continued along {f.along} (the route of "
+                           "`cycles`), its first fold before any contact loss, else its contact loss")}
 
     def text(self) -> str:
         """A summary for people."""
@@ -283,7 +327,23 @@ class RegionResult:
                              f"{yn} = {s.y:.10g}")
         if not any(c.special_points for c in self.curves):
             lines.append("no codimension-2 point (generalised Hopf, Bogdanov-Takens, zero-Hopf, double Hopf) found")
-        lines.append(f"fold-of-cycles curves: {FOLD_OF_CYCLES}; {_NOT_SHADED}")
+        if self.folds is None:
+            lines.append(f"fold-of-cycles curves: {FOLD_OF_CYCLES} (--folds computes them); {_NOT_SHADED}")
+        elif not self.folds:
+            lines.append(f"fold-of-cycles curves: {_NO_GH}")
+        for f in self.folds or []:
+            n_f = sum(p.kind == "LPC" for p in f.points)
+            n_c = sum(p.kind == "contact_loss" for p in f.points)
+            lines.append(f"fold-of-cycles curve from GH at {xn} = {f.gh[0]:.8g}, {yn} = {f.gh[1]:.8g} (branches along "
+                         f"{f.along}): {n_f} fold(s), {n_c} slice(s) where contact is lost before the fold")
+            for p in f.points[1:]:
+                amp = max(p.amplitude.values(), default=float("nan"))
+                what = "fold of cycles" if p.kind == "LPC" else "contact lost (no fold before)"
+                gap = abs((p.x if f.axis == "x" else p.y) - p.hopf)
+                lines.append(f"  {what} at {xn} = {p.x:.10g}, {yn} = {p.y:.10g} ({gap:.3g} from the Hopf point "
+                             f"{f.along} = {p.hopf:.10g}; amplitude {amp:.4g}, period {p.period:.6g} s; {p.route})")
+        if self.folds is not None:
+            lines.append(self.shaded)
         lines += [f"note: {n}" for n in self.notes]
         return "\n".join(lines) + "\n"
 
@@ -315,9 +375,24 @@ class RegionResult:
                 f"special_{xn}": ("special", arr([s.x for _, s in sps]), {"units": ux}),
                 f"special_{yn}": ("special", arr([s.y for _, s in sps]), {"units": uy}),
             },
-            attrs={"space": self.space.label, "x": xn, "y": yn, "fold_of_cycles": FOLD_OF_CYCLES,
-                   "shaded": _NOT_SHADED, "notes": "; ".join(self.notes)},
+            attrs={"space": self.space.label, "x": xn, "y": yn, "fold_of_cycles": self.fold_status,
+                   "shaded": self.shaded, "notes": "; ".join(self.notes)},
         )
+        fps = [(i, f, p) for i, f in enumerate(self.folds or []) for p in f.points]
+        ds["fold_curve"] = ("fold_point", np.array([i for i, _, _ in fps], dtype=np.int32),
+                            {"long_name": "index of the fold-of-cycles curve"})
+        ds[f"fold_{xn}"] = ("fold_point", arr([p.x for _, _, p in fps]), {"units": ux})
+        ds[f"fold_{yn}"] = ("fold_point", arr([p.y for _, _, p in fps]), {"units": uy})
+        ds["fold_kind"] = ("fold_point", np.array([p.kind for _, _, p in fps], dtype="S"),
+                           {"long_name": "GH, LPC (fold of cycles) or contact_loss (contact lost before the fold)"})
+        ds["fold_hopf"] = ("fold_point", arr([p.hopf for _, _, p in fps]),
+                           {"long_name": "the slice's subcritical Hopf point on the axis of fold_along"})
+        ds["fold_along"] = ("fold_point", np.array([f.along for _, f, _ in fps], dtype="S"))
+        ds["fold_amplitude"] = ("fold_point", arr([max(p.amplitude.values(), default=0.0) for _, _, p in fps]),
+                                {"long_name": "largest first-harmonic amplitude of the displacement coordinates"})
+        ds["fold_period"] = ("fold_point", arr([p.period for _, _, p in fps]), {"units": "s"})
+        ds["fold_route"] = ("fold_point", np.array([p.route for _, _, p in fps], dtype="S"))
+        ds["fold_contact_lost"] = ("fold_point", np.array([p.contact_lost for _, _, p in fps], dtype=np.int8))
         return ds
 
     def plot(self) -> Figure:
@@ -370,7 +445,39 @@ class RegionResult:
                 if pts:
                     ax.plot([s.x for s in pts], [s.y for s in pts], mk, color="k", ms=5, mfc="w", zorder=5)
                     handles.append(Line2D([], [], marker=mk, color="k", mfc="w", ls="", label=kind))
-            handles.append(Line2D([], [], ls="", label="fold of cycles: not computed (no hysteresis shading)"))
+            if self.folds is None:
+                handles.append(Line2D([], [], ls="", label="fold of cycles: not computed (--folds)"))
+            elif not self.folds:
+                handles.append(Line2D([], [], ls="", label="fold of cycles: no GH point in the box"))
+            else:
+                from matplotlib.patches import Patch
+
+                fills = {"LPC": ("tab:orange", "squeal possible although linearly stable"),
+                         "contact_loss": ("tab:purple", "contact lost (before the fold)")}
+                for kind, (col, label) in fills.items():
+                    polys = [poly for f in self.folds for poly in f.regions(kind)]
+                    for poly in polys:
+                        ax.fill([a for a, _ in poly], [b for _, b in poly], color=col, alpha=0.35, lw=0.8,
+                                ec=col, zorder=3)
+                    if polys:
+                        handles.append(Patch(fc=col, ec=col, alpha=0.35, label=label))
+                drawn = set()
+                for f in self.folds:
+                    lpc = [p for p in f.points if p.kind in ("GH", "LPC")]
+                    if len(lpc) > 1:
+                        ax.plot([p.x for p in lpc], [p.y for p in lpc], color="tab:green", lw=1.6, zorder=4)
+                        drawn.add("LPC")
+                    cl = [p for p in f.points if p.kind == "contact_loss"]
+                    if cl:
+                        ax.plot([p.x for p in cl], [p.y for p in cl], "x", color="tab:purple", ms=4, zorder=4)
+                        drawn.add("CL")
+                if "LPC" in drawn:
+                    handles.append(Line2D([], [], color="tab:green", lw=1.6, label="fold of cycles"))
+                if "CL" in drawn:
+                    handles.append(Line2D([], [], color="tab:purple", marker="x", ls="", ms=4,
+                                          label="contact loss of the cycles (no fold before)"))
+                if not drawn:
+                    handles.append(Line2D([], [], ls="", label="fold of cycles: no slice converged"))
             ax.legend(handles=handles, loc="lower left", bbox_to_anchor=(0.0, 1.02), ncols=2, frameon=False,
                       borderaxespad=0.0, handlelength=1.5, fontsize="x-small")
             return fig  # type: ignore[return-value]
@@ -382,7 +489,8 @@ class RegionResult:
 def region_diagram(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, *, seeds: Annotated[int, Range(1, 100)] = 5,
            max_points: Annotated[int, Range(2, 10000)] = 200, ds_max: Annotated[float, Range(1e-4, 0.5)] = 0.05,
            grid: Annotated[int, Range(2, 2000)] | None = 41, lyapunov: bool = True,
-           use_cache: bool = True) -> RegionResult:
+           use_cache: bool = True, folds: bool = True, fold_points: Annotated[int, Range(1, 50)] = 6,
+           progress: Callable[[float], None] | None = None) -> RegionResult:
     """The squeal region diagram: Hopf curves with ``l1`` and codimension-2 points, and the certified map.
 
     Parameters
@@ -405,6 +513,13 @@ def region_diagram(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, *, s
         Compute ``l1`` along the curves.
     use_cache : bool
         Use the on-disk code cache.
+    folds : bool
+        Compute the fold-of-cycles curve of every generalised-Hopf point (needs ``lyapunov``) and the shaded
+        regions (:func:`~.folds.fold_curves`).
+    fold_points : int
+        Slices (cycle branches) per GH point.
+    progress : callable, optional
+        ``progress(fraction)`` while the fold-of-cycles curves are computed.
 
     Returns
     -------
@@ -425,4 +540,8 @@ def region_diagram(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, *, s
     if grid is not None:
         m = stability_map(eng, space, _Axis(x.name, x.start, x.stop, grid, x.log),
                           _Axis(y.name, y.start, y.stop, grid, y.log), boundary=True)
-    return RegionResult(space, x, y, curves, m, notes, time.perf_counter() - t0)
+    fc = None
+    if folds and lyapunov:
+        fc, fnotes = fold_curves(eng, space, x, y, curves, points=fold_points, progress=progress)
+        notes = notes + fnotes
+    return RegionResult(space, x, y, curves, m, notes, time.perf_counter() - t0, fc)

@@ -60,7 +60,7 @@ DEFAULT_QUANTITIES = ("stable", "margin", "max_real", "frequency")
 #: Points per chunk by default: verdict-only studies / studies with eigenvalues.
 DEFAULT_CHUNK_POINTS = (1 << 22, 1 << 18)
 _TOP_KEYS = ("name", "description", "preset", "params", "model", "parameters", "tied", "axes", "samples", "compute",
-             "execution", "output", "distributions")
+             "execution", "output", "distributions", "design")
 _MAX_SAMPLES = 10**7
 #: Size limits of a study, checked from the study's numbers before anything is allocated:
 #: points of one grid axis (its values are held in memory by every process: 0.8 GB at the limit),

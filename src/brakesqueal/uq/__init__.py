@@ -8,7 +8,8 @@
   intervals; :func:`probability_interval` — a probability with its Wilson interval;
 * :func:`run_uq` — the whole study (``brakesqueal uq``): design, evaluation through the sweep machinery (in
   memory or a resumable Zarr store on Dask), indices of max Re λ, the squeal indicator and the frequency, and
-  P(squeal), as an :class:`xarray.Dataset`; :func:`uq_summary` its JSON form; :func:`plot_uq` its figure;
+  P(squeal), as an :class:`xarray.Dataset` (``per_mode=True``: also Re λ and the frequency of every tracked mode,
+  modes numbered by ascending frequency); :func:`uq_summary` its JSON form; :func:`plot_uq` its figure;
 * :func:`fit_pce` — a polynomial chaos surrogate (:class:`PCESurrogate`: inputs standardised by their
   distributions, least squares or sparse, leave-one-out error, Sobol' indices from the coefficients, P(squeal)
   by sampling it); :func:`fit_study_pce` the same for a study's quantity from a few hundred runs

@@ -59,13 +59,14 @@ def plot_uq(ds: Any) -> Figure:
     names = [f"${symbol(str(x))}$" for x in ds["input"].values]
     shown = {"max_real": r"max Re $\lambda$", "squeal": "squeal (0/1)", "frequency": "frequency"}
     x = np.arange(len(names))
-    width = 0.8 / ds.sizes["quantity"]
+    shown_q = [q for q in ds["quantity"].values if str(q) in shown]  # per-mode indices: in the JSON and dataset
+    width = 0.8 / len(shown_q)
     for ax, var in ((ax_s, "first"), (ax_t, "total")):
-        for k, q in enumerate(ds["quantity"].values):
+        for k, q in enumerate(shown_q):
             val = np.asarray(ds[var].sel(quantity=q).values, dtype=float)
             ci = np.asarray(ds[f"{var}_ci"].sel(quantity=q).values, dtype=float)
             err = np.abs(np.stack([val - ci[:, 0], ci[:, 1] - val]))
-            ax.bar(x + (k - (ds.sizes["quantity"] - 1) / 2) * width, np.nan_to_num(val), width,
+            ax.bar(x + (k - (len(shown_q) - 1) / 2) * width, np.nan_to_num(val), width,
                    yerr=np.nan_to_num(err), capsize=2, label=shown.get(str(q), str(q)))
         ax.set_xticks(x, names)
         ax.set_xlabel("input parameter [-]")

@@ -21,9 +21,15 @@ from ._surrogate import PCESurrogate, fit_pce
 
 __all__ = ["pce_design", "StudySurrogate", "fit_study_pce", "SURROGATE_QUANTITIES"]
 
-#: Quantities of the sweep evaluator a study surrogate can be fitted to (real-valued, smooth where the leading
-#: mode does not change): max Re λ [1/s] and the damping ratio ``margin``; P(squeal) is read from their sign.
-SURROGATE_QUANTITIES = ("max_real", "margin")
+#: Quantities a study surrogate can be fitted to (real-valued, smooth where the leading mode does not change): of the
+#: sweep evaluator, max Re λ [1/s] and the damping ratio ``margin`` (P(squeal) is read from their sign); and, at the
+#: squeal onset along the spin rate (the first destabilising crossing in ``ONSET_RANGE``), the expensive nonlinear
+#: ones: ``onset_l1``, the first Lyapunov coefficient with the pads' true rates (its sign: sub- or supercritical,
+#: read as P(subcritical onset)), and ``onset_amplitude``, the growth coefficient ``a`` of the limit cycles' tilt
+#: amplitude ``a sqrt(|Omega - Omega_crit|)`` (the norm over the model's coordinates).
+SURROGATE_QUANTITIES = ("max_real", "margin", "onset_l1", "onset_amplitude")
+#: The spin-rate range [rad/s] searched for the onset of the ``onset_*`` quantities.
+ONSET_RANGE = (1.0, 1e5)
 
 
 @validated
@@ -72,7 +78,8 @@ class StudySurrogate:
     left_out : int
         Of them, points without a verdict or a finite value (never fitted).
     p_squeal : float
-        ``P(max Re λ > 0)`` (``P(margin <= 0)``) from ``samples`` evaluations of the surrogate.
+        ``P(max Re λ > 0)`` (``P(margin <= 0)``) from ``samples`` evaluations of the surrogate; for ``onset_l1``
+        the probability of a subcritical onset ``P(l1 > 0)``; NaN for ``onset_amplitude``.
     samples : int
         Evaluations of the surrogate behind ``p_squeal``.
     """
@@ -85,9 +92,41 @@ class StudySurrogate:
     samples: int
 
     def summary(self) -> dict[str, Any]:
-        """JSON form (:meth:`PCESurrogate.summary` with the study's counts and ``p_squeal``)."""
+        """JSON form (:meth:`PCESurrogate.summary` with the study's counts and ``p_squeal``; for ``onset_l1``
+        ``p_subcritical`` instead)."""
+        key = "p_subcritical" if self.quantity == "onset_l1" else "p_squeal"
+        p = None if not math.isfinite(self.p_squeal) else self.p_squeal
         return {"quantity": self.quantity, **self.surrogate.summary(), "design_runs": self.runs,
-                "left_out": self.left_out, "p_squeal": self.p_squeal, "p_squeal_samples": self.samples}
+                "left_out": self.left_out, key: p, f"{key}_samples": self.samples}
+
+
+def _onset_values(space: Any, values: Mapping[str, np.ndarray], quantity: str) -> np.ndarray:
+    """``onset_l1`` or ``onset_amplitude`` at every design point (NaN: no onset in :data:`ONSET_RANGE`, an
+    undecided search, or no normal form there)."""
+    from ..analysis.crossings import critical_speeds_many, omega_name
+    from ..errors import BrakesquealError
+    from ..nonlinear.implicit import exact_lyapunov
+    from ..status import PointStatus
+    from ..sweep.compute import engine_of
+
+    engine = engine_of(space).require_nonlinear(f"the surrogate quantity {quantity!r}")
+    spin = omega_name(space)
+    lo, hi = ONSET_RANGE
+    at = {k: np.asarray(v, dtype=float) for k, v in values.items() if k != spin}
+    roots, dirs, counts, _, cst = critical_speeds_many(engine, space, at, lo, hi, return_status=True)
+    k = np.arange(roots.shape[1])
+    onset = (dirs == -1) & (k[None, :] < counts[:, None])
+    out = np.full(roots.shape[0], np.nan)
+    n = engine.caps.n
+    for i in np.flatnonzero(onset.any(axis=1) & (cst == int(PointStatus.OK))):
+        w = float(roots[i, int(np.argmax(onset[i]))])
+        sp = space.with_values({name: float(v[i]) for name, v in at.items()})
+        try:
+            h = exact_lyapunov(engine, sp, spin, w).hopf
+        except (BrakesquealError, np.linalg.LinAlgError, ValueError):
+            continue
+        out[i] = float(h.l1) if quantity == "onset_l1" else float(np.linalg.norm(h.amplitude_coefficients[:n]))
+    return out
 
 
 @validated
@@ -148,10 +187,17 @@ def fit_study_pce(study: Union[Study, str, Path, Mapping[str, Any]], *, runs: in
         raise ParameterError(f"study file '{st.source}': key 'distributions': design points give parameters outside "
                              "their allowed ranges (through the ties), e.g. "
                              + ", ".join(f"{k} = {v[j]:.6g}" for k, v in values.items()))
-    res = compute_chunk(spec, values)
-    y = np.asarray(res[quantity], dtype=float)
-    ok = np.isin(np.asarray(res["status"]), [int(s) for s in DECIDED]) & np.isfinite(y)
+    if quantity.startswith("onset_"):
+        y = _onset_values(space, values, quantity)
+        ok = np.isfinite(y)
+    else:
+        res = compute_chunk(spec, values)
+        y = np.asarray(res[quantity], dtype=float)
+        ok = np.isin(np.asarray(res["status"]), [int(s) for s in DECIDED]) & np.isfinite(y)
     fit = fit_pce({k: v[ok] for k, v in values.items()}, y[ok], dists, degree=degree, sparse=sparse, q=q)
-    above = fit.probability(0.0, n=samples, seed=st.seed)
-    p = above if quantity == "max_real" else 1.0 - above  # margin = -Re λ / |λ| <= 0: squeal
+    if quantity == "onset_amplitude":
+        p = math.nan
+    else:
+        above = fit.probability(0.0, n=samples, seed=st.seed)
+        p = 1.0 - above if quantity == "margin" else above  # margin = -Re λ / |λ| <= 0: squeal; l1 > 0: subcritical
     return StudySurrogate(fit, quantity, runs, int((~ok).sum()), p, samples)

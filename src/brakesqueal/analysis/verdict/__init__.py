@@ -14,8 +14,8 @@ from ._base import (
     DECIDED, STABLE, UNDECIDED, UNSTABLE, Context, Grid, LinearGroup, Points, Result, Route, Verdicts, carrier_labels,
     compact, valid_points,
 )
-from ._dispatch import MODES, ROUTES, decide, decide_model, register, route_names
+from ._dispatch import MODES, ROUTES, decide, decide_model, point_eigenvalues, register, route_names
 
-__all__ = ["decide", "decide_model", "register", "route_names", "ROUTES", "MODES", "Points", "Grid", "Verdicts",
-           "Route", "Result", "Context", "LinearGroup", "carrier_labels", "valid_points", "compact", "STABLE",
-           "UNSTABLE", "UNDECIDED", "DECIDED"]
+__all__ = ["decide", "decide_model", "point_eigenvalues", "register", "route_names", "ROUTES", "MODES", "Points",
+           "Grid", "Verdicts", "Route", "Result", "Context", "LinearGroup", "carrier_labels", "valid_points", "compact",
+           "STABLE", "UNSTABLE", "UNDECIDED", "DECIDED"]

@@ -56,7 +56,7 @@ if TYPE_CHECKING:
     from ...codegen.engine import Engine
     from ...model.parameters import ParameterSpace
 
-__all__ = ["decide", "decide_model", "ROUTES", "register", "route_names", "MODES"]
+__all__ = ["decide", "decide_model", "point_eigenvalues", "ROUTES", "register", "route_names", "MODES"]
 
 #: The routes, in the order the dispatcher tries them.
 ROUTES: list[Route] = [ClosedGrid(), CharpolyGrid(), ClosedInterval(), ClosedExact(), QuarticInterval(), EigenBounds(),
@@ -175,6 +175,60 @@ def _decide_chunks(engine: Engine, space: ParameterSpace, points: Points, chunk:
 
     return Verdicts(cat("status"), cat("code"), cat("max_real"), cat("frequency"), cat("bound"), cat("carrier"),
                     cat("method"), parts[0].carriers, parts[0].methods)
+
+
+def point_eigenvalues(engine: Engine, space: ParameterSpace, points: Points) -> np.ndarray:
+    """Every eigenvalue of the linear system at each point, batched (floating point; no verdict).
+
+    The linear systems are those :func:`decide` builds (:func:`~._linear.linear_groups`: batched zero-state
+    Jacobians of trivial silent motions, the compiled Jacobian at non-trivial ones, a matrix model's
+    matrices), their state matrices' eigenvalues computed one batch at a time.  Used for per-mode outputs
+    (``brakesqueal uq --modes``).
+
+    Parameters
+    ----------
+    engine : Engine
+        The model's engine.
+    space : ParameterSpace
+        The parameter space of the points.
+    points : Points
+        The points.
+
+    Returns
+    -------
+    ndarray of complex, shape (points.size, m)
+        Per flat point the eigenvalues of its state matrix (``m`` the largest state size, smaller systems padded
+        with NaN); a row of NaN where the point has no silent motion, invalid parameters or an unusable system.
+    """
+    size = points.size
+    chunk = batch_points(engine)
+    parts: list[tuple[np.ndarray, np.ndarray]] = []
+    if size > chunk:
+        shape = points.shape
+        flat = {k: np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for k, v in points.arrays.items()}
+        sett = {k: np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for k, v in points.settable.items()}
+        valid = np.broadcast_to(points.valid, shape).reshape(-1)
+        subs = [(s0, Points(space, {k: v[s0:s0 + chunk] for k, v in flat.items()}, points.names,
+                            valid=valid[s0:s0 + chunk], settable={k: v[s0:s0 + chunk] for k, v in sett.items()}))
+                for s0 in range(0, size, chunk)]
+    else:
+        subs = [(0, points)]
+    for s0, sub in subs:
+        ctx = Context(engine, space, sub, sub.size, eigen=True, modes="all")
+        ctx.closed = bool(engine.closed_route(space, sub.names)) if engine.caps.closed_form else False
+        operating_points(ctx)
+        idx = np.flatnonzero(np.isin(ctx.status, DECIDED))
+        for g in linear_groups(ctx, idx) if idx.size else []:
+            S, good = g.states_matrices()
+            if good.any():
+                with np.errstate(all="ignore"):
+                    parts.append((s0 + g.idx[good], np.linalg.eigvals(S[good])))
+    width = max((lam.shape[1] for _, lam in parts), default=0)
+    out = np.full((size, width), np.nan + 0j)
+    for i, lam in parts:
+        out[i, :lam.shape[1]] = lam
+    out[np.any(np.isinf(out), axis=1)] = np.nan  # an infinite eigenvalue: an unusable system
+    return out
 
 
 def decide_model(lm: Any, *, eigen: bool = True, modes: str = "all") -> Verdicts:
