@@ -77,3 +77,32 @@ def test_a_weakly_nonlinear_hopf_point_starts_its_branch_closer_in():
     hb = limit_cycles(space, axis, pads="exact", max_points=60, max_harmonics=40)
     assert type(hb).__name__ == "HarmonicBranch" and hb.contact_loss is not None
     assert shot.contact_loss == pytest.approx(hb.contact_loss, rel=1e-7)
+
+
+def test_where_shooting_cannot_start_the_default_route_falls_back_to_harmonic_balance():
+    """A slice of Fig. 3's set next to its generalised-Hopf point (rigid pads, Omega = 3221 rad/s, along mu1):
+    the shooting route cannot start its first orbit there; ``limit_cycles`` (the one owner of the route) does not
+    refuse a branch that harmonic balance with the exact pads computes, and says which route ran and why.  The
+    contact loss it finds lies next to the subcritical Hopf point, on the side the normal form predicts."""
+    from brakesqueal import hopf_points, resolve_space
+    from brakesqueal.nonlinear.periodic import ShootingError
+
+    space = resolve_space(None, "paper-fig3", None, ["k_ip=inf", "mu2=0.5", "Omega=3221.023016"])
+    axis = Axis("mu1", 0.23, 0.26)
+    with pytest.raises(ShootingError, match="first cycle near the Hopf point"):
+        squeal_branch(space, axis)
+    b = limit_cycles(space, axis)
+    assert isinstance(b, HarmonicBranch) and b.to_dict()["route"] == "harmonic balance"
+    assert b.message.startswith("shooting did not converge") and "harmonic balance with the exact pads" in b.message
+    (h,) = [p for p in hopf_points(space, axis) if p.hopf is not None]
+    assert h.hopf.criticality == "subcritical" and b.contact_loss is not None
+    assert (b.contact_loss - h.value) * h.hopf.side > 0  # on the side where the normal form puts the cycles
+    assert abs(b.contact_loss - h.value) < 1e-4 * h.value
+    from typer.testing import CliRunner
+
+    from brakesqueal.cli import app
+
+    r = CliRunner().invoke(app, ["cycles", "--preset", "paper-fig3", "--set", "k_ip=inf", "--set", "mu2=0.5", "--set",
+                                 "Omega=3221.023016", "--along", "mu1=0.23:0.26"])
+    assert r.exit_code == 0, r.output
+    assert "by harmonic balance" in r.output and "shooting did not converge" in r.output

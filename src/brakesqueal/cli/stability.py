@@ -350,7 +350,7 @@ def cycles(
     with _progress(title, progress) as cb:
         b = limit_cycles(engine, space, axis, contact=contact, pads=pads, max_points=max_points, progress=cb,
                          **options)
-    if route == "harmonic balance":
+    if b.to_dict()["route"] == "harmonic balance":  # the route that ran (shooting may fall back to it)
         _write_harmonic(b, axis, fmt=fmt, plot=plot, out=out)
     else:
         _write_shooting(b, axis, fmt=fmt, plot=plot, out=out)

@@ -507,9 +507,30 @@ def limit_cycles(engine: Engine, space: ParameterSpace, axis: Axis, *, contact: 
         from .harmonic import harmonic_branch
 
         return harmonic_branch(engine, space, axis, progress=progress, **kw)
+    from .periodic import ShootingError
     from .squeal import squeal_branch
 
-    return squeal_branch(engine, space, axis, contact=contact, progress=progress, **kw)
+    try:
+        return squeal_branch(engine, space, axis, contact=contact, progress=progress, **kw)
+    except ShootingError as exc:
+        # The default route must not refuse a branch that the other route computes: where the shooting cannot
+        # start (Newton's method does not converge to the first orbit) and the pads allow harmonic balance with
+        # their exact rates (bilateral contact, only options that route has), the branch comes from it, saying so.
+        if pads != "auto" or contact != "bilateral" or set(kw) - _ROUTE_OPTIONS["harmonic balance"] - {"max_points"}:
+            raise
+        import dataclasses
+
+        from .harmonic import harmonic_branch
+
+        from ..errors import BrakesquealError
+
+        try:
+            hb = harmonic_branch(engine, space, axis, progress=progress, **kw)
+        except BrakesquealError as exc2:
+            raise ShootingError(f"{exc}; harmonic balance with the exact pads did not compute the branch either: "
+                                f"{exc2}") from None
+        return dataclasses.replace(hb, message=f"shooting did not converge ({exc}); harmonic balance with the "
+                                               f"exact pads instead: {hb.message}")
 
 
 def _hopf_dict(h: HopfResult) -> dict[str, Any]:

@@ -273,7 +273,7 @@ def fold_curves(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, curves:
         The curves and notes (GH points without a curve and why).
     """
     from ..analysis.maps import Axis as _Axis
-    from ..nonlinear.models import cycle_route, limit_cycles
+    from ..nonlinear.models import limit_cycles
 
     ghs = [(i, s) for i, c in enumerate(curves) for s in c.special_points if s.type == "GH"]
     out: list[FoldCurve] = []
@@ -326,20 +326,17 @@ def fold_curves(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, curves:
                     raise BrakesquealError("no stability crossing on the slice")
                 h, lo, hi = rng
                 ax = _Axis(bax.name, lo, hi, 2, bax.log)
-                route = cycle_route(sp, ax)
                 msg = ""
-                r = None
-                try:
-                    b = limit_cycles(engine, sp, ax, max_points=max_branch_points)
-                    r = _branch_point(b)
-                    if r is None and route == "shooting":
-                        msg = (f"the shooting branch ended ({b.to_dict()['message']}) before a fold or a contact "
-                               "loss; harmonic balance with the exact pads")
-                except BrakesquealError as exc:
-                    if route != "shooting":
-                        raise
-                    msg = f"shooting did not converge ({exc}); harmonic balance with the exact pads"
+                # the route of `cycles` (limit_cycles owns it, including its fallback to harmonic balance where
+                # the shooting cannot start: the branch's own `route` and `message` say which ran)
+                b = limit_cycles(engine, sp, ax, max_points=max_branch_points)
+                route = str(b.to_dict()["route"])
+                r = _branch_point(b)
+                if route == "harmonic balance" and str(b.message).startswith("shooting did not converge"):
+                    msg = str(b.message)
                 if r is None and route == "shooting":
+                    msg = (f"the shooting branch ended ({b.to_dict()['message']}) before a fold or a contact "
+                           "loss; harmonic balance with the exact pads")
                     route = "harmonic balance"
                     b = limit_cycles(engine, sp, ax, pads="exact", max_points=max_branch_points)
                     r = _branch_point(b)
