@@ -19,15 +19,18 @@ install: $(STAMP)
 demo: $(STAMP)
 	$(BIN)/python -m brakesqueal.demo
 
-# the quick suite (tests marked slow excluded); CI runs both
+# the quick suite (tests marked slow excluded); CI runs both.  pytest-xdist runs the files on PYTEST_WORKERS
+# processes (each file's tests on one of them, so module fixtures are built once); PYTEST_WORKERS=0 runs in one.
+PYTEST_WORKERS ?= 2
+XDIST = -n $(PYTEST_WORKERS) --dist loadfile
 test: $(STAMP)
-	$(BIN)/python -m pytest -q -m "not slow"
+	$(BIN)/python -m pytest -q -m "not slow" $(XDIST)
 
 test-slow: $(STAMP)
-	$(BIN)/python -m pytest -q -m slow
+	$(BIN)/python -m pytest -q -m slow $(XDIST)
 
 test-all: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q $(XDIST)
 
 lint: $(STAMP)
 	$(BIN)/ruff check src benchmarks

@@ -356,3 +356,25 @@ def test_calculix_matrices_give_ccx_eigenfrequencies(tmp_path):
             digits = len(mantissa.split(".")[1])  # 0.1000459E+04: 7 printed digits
             half_unit = 0.5 * 10 ** (math.floor(math.log10(abs(ref))) + 1 - digits)
             assert abs(ours - ref) <= half_unit * 1.001 + 1e-9 * abs(ref), (mode, text, ours)
+
+
+def test_reading_nastran_files_keeps_numpys_print_options(tmp_path):
+    """pyyeti sets numpy's legacy (12-digit) float printing when imported; reading and writing OP4 and DMIG in a
+    fresh process leaves the process's print options, and so every CSV or text written after it, as they were."""
+    pytest.importorskip("pyyeti")
+    import sys
+
+    code = (
+        "import numpy as np, pandas as pd\n"
+        "from brakesqueal.model.matrix_files import read_matrix_file, write_matrix_file\n"
+        "before = np.get_printoptions()\n"
+        f"p = {str(tmp_path / 'm.op4')!r}\n"
+        "write_matrix_file(p, {'K': np.eye(3)}, 'op4')\n"
+        "read_matrix_file(p)\n"
+        "assert np.get_printoptions() == before, np.get_printoptions()\n"
+        "x = -0.34336942644540613\n"
+        "assert str(np.float64(x)) == repr(x)\n"
+        "assert float(pd.DataFrame({'a': [x]}).to_csv(index=False).split()[1]) == x\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr[-2000:]

@@ -289,7 +289,8 @@ def _synthetic_branch(ps, stable, fmin, criticality="subcritical"):
     from brakesqueal.nonlinear.harmonic import HarmonicBranch, HarmonicPoint
 
     pts = tuple(HarmonicPoint(p, 10.0, 10.0 / (2 * np.pi), {"q1": 1e-3 * (i + 1)}, 1e-3 * (i + 1), (f, f), 1.0,
-                              1e-12, 1e-9, 6, np.zeros((1, 13)), None, st, None, None, (3000.0, 3000.0))
+                              1e-12, 1e-9, 6, np.zeros((1, 13)), None, st, None, None, (3000.0, 3000.0),
+                              verdict="undecided" if st is None else "stable" if st else "unstable")
                 for i, (p, st, f) in enumerate(zip(ps, stable, fmin)))
     h = SimpleNamespace(p0=0.0, criticality=criticality, side=1, omega0=10.0, frequency0_hz=1.6, l1=1.0,
                         l1_error=0.0)
@@ -312,6 +313,11 @@ def test_the_summary_reads_folds_verdicts_and_contact_like_shooting():
     assert lifted.to_dict()["in_contact_up_to"] == 0.3
     # a branch without verdicts says so rather than "no stable limit cycle"
     none = _synthetic_branch(ps[:3], [None] * 3, [2000.0] * 3, "supercritical")
+    # an orbit flagged stable whose verdict is undecided (Hill and the monodromy disagree) bounds no squeal range
+    from dataclasses import replace
+
+    und = replace(b, points=tuple(replace(pt, verdict="undecided") if pt.stable else pt for pt in b.points))
+    assert und.summary.squeal_range is None and "stability undecided" in und.summary.text(rows=0)
     text = none.summary.text(rows=0)
     assert "stability not computed" in text and "no stable limit cycle" not in text
     assert none.to_dict()["route"] == "harmonic balance" and none.to_dict()["n_points"] == 3

@@ -170,3 +170,33 @@ def test_squeal_branch_finds_contact_loss(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "squeal onset (linear): Omega = 35.740780" in text and "stable squeal" in text and "duty" in text
     assert main(["cycles", "--along", "Omega=30:40", "--contact", "sometimes"]) == 2
+
+
+def test_an_undecided_orbit_is_not_counted_in_the_squeal_range():
+    """The squeal range spans the orbits certified stable: an interior orbit whose Floquet verdict is undecided
+    (a multiplier within the accuracy of the unit circle) bounds it no more, and the text says so; the Hopf
+    point (undecided by construction) still bounds it."""
+    from dataclasses import replace
+
+    from brakesqueal import squeal_branch
+    from brakesqueal.nonlinear.squeal import squeal_summary
+
+    space = ParameterSpace.from_preset("paper-fig3", {"mu1": 0.5, "mu2": 0.5, "k_ip": math.inf})
+    b = squeal_branch(space, Axis("Omega", 30.0, 40.0), max_points=12)
+    sm = squeal_summary(b)
+    assert sm.squeal_range is not None and sm.squeal_range[0] == pytest.approx(sm.onset)
+    assert "undecided" not in sm.text(rows=0)
+    ds = b.data
+    p = ds["p"].values
+    located = {int(i) for i in ds["special_index"].values}
+    inside = [i for i in range(p.size) if i not in located and p[i] <= sm.squeal_range[1] and ds["stable"].values[i]]
+    assert len(inside) >= 3
+    cut = inside[1]  # every orbit from the second interior one on: undecided, still flagged stable
+    data = ds.copy()
+    verdict = data["verdict"].values.astype(object)
+    verdict[cut:] = "undecided"
+    data["verdict"] = ("point", verdict.astype(str))
+    b2 = replace(b, branch=replace(b.branch, data=data))
+    sm2 = squeal_summary(b2)
+    assert sm2.squeal_range == (pytest.approx(sm.onset), pytest.approx(float(p[inside[0]])))
+    assert "stability undecided (not counted in the range)" in sm2.text(rows=0)

@@ -43,7 +43,10 @@ def unilateral(space):
 
 
 def test_shooting_and_harmonic_balance_agree_on_the_contact_loss(space, unilateral):
-    hb = harmonic_branch(space, AXIS, max_points=60)
+    # stability=False: no Hill's-method Floquet exponents (90 % of this branch's time); they only decorate the
+    # points with verdicts and steer neither the continuation, the harmonics nor the located contact loss,
+    # which is all this test compares (the shooting check that does steer the harmonics still runs)
+    hb = harmonic_branch(space, AXIS, max_points=60, stability=False)
     assert hb.status == "contact_loss", hb.message
     assert unilateral.hopf.branch_start is not None
     assert abs(hb.hopf.hopf.p0 - unilateral.hopf.branch_start.p0) < 1e-9 * hb.hopf.hopf.p0
@@ -100,7 +103,11 @@ def test_the_damper_regularises_the_paper_pads_contact_loss_converges_as_it_vani
     assert exact.status == "contact_loss"
     errors, onsets = [], []
     for d in (1.0, 0.3):
-        b = harmonic_branch(damped_pads(base, d), axis, max_points=200, max_harmonics=200, stability=False)
+        # shooting_check=False: the check only cross-checks each orbit by integration (mismatch and monodromy
+        # verdict); here the truncation error sets the harmonics (141), so the contact losses and onsets are
+        # bit-identical without it (measured 2026-11-29) and the check cost 20 % of these two branches
+        b = harmonic_branch(damped_pads(base, d), axis, max_points=200, max_harmonics=200, stability=False,
+                            shooting_check=False)
         assert b.status == "contact_loss", b.message
         errors.append(abs(b.contact_loss - exact.contact_loss))
         onsets.append(abs(b.hopf.hopf.p0 - exact.hopf.hopf.p0))

@@ -131,7 +131,8 @@ def test_region_command_exact_form(capsys, tmp_path):
     assert isinstance(d["special_points"], list) and d["special_points"] == []  # none in this box
     # no GH point in this box: the fold-of-cycles stage ran and found no curve, nothing is shaded
     assert d["fold_of_cycles"] == "computed" and d["fold_curves"] == []
-    assert d["regions"] == {"squeal_possible_although_linearly_stable": [], "contact_lost": []}
+    assert d["regions"] == {"squeal_possible_although_linearly_stable": [], "contact_lost": [],
+                            "bilateral_equations_fold_band": []}
     assert "no generalised-Hopf point" in d["shaded"]
     (curve,) = d["hopf_curves"]
     pts = curve["points"]

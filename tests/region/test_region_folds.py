@@ -232,3 +232,41 @@ def test_fold_of_cycles_of_the_generalised_hopf_normal_form(monkeypatch, beta):
     assert b1 == pytest.approx(-beta ** 2 / 4, abs=1e-8)
     assert amp["x1"] == pytest.approx(math.sqrt(beta / 2), abs=1e-8)
     assert period == pytest.approx(2 * math.pi, rel=1e-8)
+
+
+def test_bad_fold_contact_is_one_line(capsys):
+    rc = main(["region", "--preset", "paper-fig2", "--set", "k_ip=inf", "--x", "mu=0.5:1", "--y", "Omega=10:200",
+               "--fold-contact", "sticky"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--fold-contact" in err and "stop or bilateral" in err and "Traceback" not in err
+
+
+@pytest.mark.slow
+def test_region_command_follows_bilateral_folds_past_the_contact_loss(tmp_path, capsys, fig3_region):
+    """``--fold-contact bilateral``: each slice that loses contact (as the default run finds) is followed on to
+    the fold of the bilateral equations, farther from its Hopf point than the contact loss, which the JSON and the
+    NetCDF keep; the default run's contact-loss points are those of this one's slices."""
+    import xarray as xr
+
+    _, r_stop = fig3_region
+    out = tmp_path / "r.nc"
+    rc = main(["region", "--preset", "paper-fig3", "--set", "k_ip=inf", "--set", "mu2=0.5", "--x", "mu1=0:1",
+               "--y", "Omega=10:20000:log", "--grid", "3", "--fold-points", "3", "--fold-contact", "bilateral",
+               "--no-progress", "--format", "json", "--out", str(out)])
+    res = capsys.readouterr()
+    assert rc == 0, res.err
+    d = json.loads(res.out)
+    (fc,) = d["fold_curves"]
+    (f_stop,) = r_stop.folds
+    pts = fc["points"][1:]
+    assert [p["kind"] for p in pts] == ["LPC_bilateral"] * 3
+    for p, q in zip(pts, f_stop.points[1:]):
+        assert p["contact_lost"] and p["Omega"] == pytest.approx(q.y, rel=1e-12)
+        assert p["contact_loss"] == pytest.approx(q.x, rel=1e-6)  # where the default run stops
+        # the fold lies beyond the contact loss, on the linearly stable side of the slice's Hopf point
+        assert p["mu1"] < p["contact_loss"] < p["hopf_mu1"]
+    assert d["regions"]["bilateral_equations_fold_band"]
+    with xr.open_dataset(out, engine="scipy") as ds:
+        kinds = [k.decode() if isinstance(k, bytes) else str(k) for k in ds["fold_kind"].values]
+        assert kinds.count("LPC_bilateral") == 3
+        np.testing.assert_allclose(ds["fold_contact_loss"].values[1:], [p["contact_loss"] for p in pts], rtol=1e-12)

@@ -37,7 +37,8 @@ if TYPE_CHECKING:
     from ..codegen.engine import Engine
 
 __all__ = ["ModalMixin", "LinearModel", "linearize", "state_matrix", "jacobian_blocks_at", "pad_rate_eigenvalues",
-           "PAD_RATES", "accurate_jacobian", "eliminate_algebraic", "descriptor_eigenvalues", "qep_eigenvalues"]
+           "PAD_RATES", "accurate_jacobian", "eliminate_algebraic", "descriptor_eigenvalues", "qep_eigenvalues",
+           "sort_eigenvalues"]
 
 #: Treatments of the pads' tangential rates (see the module docstring).
 PAD_RATES = ("kept", "quasi-static")
@@ -259,7 +260,9 @@ def eliminate_algebraic(E: np.ndarray, A: np.ndarray, k: int) -> tuple[np.ndarra
     return E2, A2
 
 
-def _sort(lam: np.ndarray) -> np.ndarray:
+def sort_eigenvalues(lam: np.ndarray) -> np.ndarray:
+    """Eigenvalues in the order every linear model lists them: decreasing real part, then decreasing imaginary
+    part."""
     return lam[np.lexsort((-lam.imag, -lam.real))]
 
 
@@ -284,7 +287,7 @@ class ModalMixin:
     def eigenvalues(self) -> np.ndarray:
         """Eigenvalues [1/s], sorted by decreasing real part, then imaginary part."""
         if not self._eig:
-            self._eig.append(_sort(np.linalg.eigvals(self.A)))
+            self._eig.append(sort_eigenvalues(np.linalg.eigvals(self.A)))
         return self._eig[0]
 
     @property
@@ -411,7 +414,7 @@ class LinearModel(ModalMixin):
                 lam = np.linalg.eigvals(self.A)
             else:  # every scale right at once (extreme parameters, huge pad modes): extended precision
                 lam = descriptor_eigenvalues(*self.reduced_descriptor)
-            self._eig.append(_sort(lam))
+            self._eig.append(sort_eigenvalues(lam))
         return self._eig[0]
 
     def characteristic_polynomial(self) -> np.ndarray:

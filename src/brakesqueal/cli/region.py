@@ -40,6 +40,9 @@ def region(
                                              "shaded regions (one cycle branch per slice).")] = True,
     fold_points: Annotated[int, typer.Option("--fold-points", min=1, max=50,
                                              help="Slices (cycle branches) per generalised-Hopf point.")] = 6,
+    fold_contact: Annotated[str, typer.Option(
+        "--fold-contact", help="stop: a slice whose cycles lose contact ends there (the brake); bilateral: followed "
+                               "on to the fold of the smooth bilateral equations (as AUTO-07p).")] = "stop",
     progress: ProgressOpt = None,
 ) -> None:
     """Squeal regions in two parameters: Hopf curves coloured super/subcritical (l1 with the pads' true rates),
@@ -63,6 +66,9 @@ def region(
         raise ParameterError(f"The options --x and --y must vary two different parameters; got {ax_x.name!r} for "
                              "both", parameter="--y")
     refuse_set_of_axes(set_, {ax_x.name: "--x", ax_y.name: "--y"})
+    if fold_contact not in ("stop", "bilateral"):
+        raise ParameterError(f"The option --fold-contact must be stop or bilateral; got {fold_contact!r}",
+                             parameter="--fold-contact")
     if out:
         check_output(out, what="--out", suffixes=(".nc",))
     if plot:
@@ -74,7 +80,7 @@ def region(
 
     with _progress("region (fold-of-cycles curves)", progress if folds else False) as cb:
         r = region_diagram(engine(space), space, ax_x, ax_y, seeds=seeds, max_points=max_points, grid=grid,
-                           folds=folds, fold_points=fold_points, progress=cb)
+                           folds=folds, fold_points=fold_points, fold_contact=fold_contact, progress=cb)
     if out:
         with atomic_write(out, what="--out") as tmp:
             r.to_dataset().to_netcdf(str(tmp), engine="scipy")

@@ -442,12 +442,20 @@ def _read_calculix(path: str) -> tuple[dict[str, Any], tuple[str, ...] | None, s
 
 
 def _pyyeti(what: str) -> Any:
+    import numpy as np
+
+    # pyyeti's modules call np.set_printoptions(legacy="1.13") when imported, which makes str() of every numpy
+    # float 12 significant digits for the whole process (pandas' CSV writer, for one, then rounds what it writes):
+    # keep the process's print options as they were
+    options = np.get_printoptions()
     try:
         import pyyeti.nastran.bulk as bulk
         import pyyeti.nastran.op4 as op4
     except ImportError:
         raise _Fail(f"{what} needs the optional package pyyeti; install it with "
                     "pip install 'brakesqueal[fe]'") from None
+    finally:
+        np.set_printoptions(**options)
     return bulk, op4
 
 

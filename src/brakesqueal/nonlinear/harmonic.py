@@ -56,7 +56,8 @@ if TYPE_CHECKING:
     from ..simulation import SimulationModel
     from .implicit import PadHopf
 
-__all__ = ["HarmonicPoint", "HarmonicBranch", "harmonic_branch", "pad_mode_rates", "hill_accuracy"]
+__all__ = ["HarmonicPoint", "HarmonicBranch", "harmonic_branch", "pad_mode_rates", "hill_accuracy",
+           "shooting_flow"]
 
 
 
@@ -268,17 +269,17 @@ class HarmonicBranch:
         The branch is valid (bilateral contact) from the onset up to its first orbit on which a pad lifts off:
         every pad's smallest normal force at least ``-1e-6`` times that orbit's largest (the located contact-loss
         orbit, at ``F_n = 0`` to rounding, included).  The squeal range spans the stable valid orbits; orbits
-        without a stability verdict count as neither.  The hysteresis range, as for shooting, lies between a
-        subcritical Hopf point and the first fold (:attr:`folds`) where the unstable cycles turn into stable ones
-        (the first orbit with a verdict after the turn is stable; right at the fold an exponent crosses 0 and the
-        orbits have no verdict), here only if the branch is valid up to there.
+        without a stability verdict, or whose verdict is undecided, count as neither.  The hysteresis range, as
+        for shooting, lies between a subcritical Hopf point and the first fold (:attr:`folds`) where the unstable
+        cycles turn into stable ones (the first orbit with a verdict after the turn is stable; right at the fold an
+        exponent crosses 0 and the orbits have no verdict), here only if the branch is valid up to there.
         """
         from .squeal import SquealSummary
 
         h = self.hopf.hopf
         pts = self.points
         valid = self.valid
-        ok = [pt.p for pt, v in zip(pts, valid) if v and pt.stable]
+        ok = [pt.p for pt, v in zip(pts, valid) if v and pt.stable and pt.verdict != "undecided"]
         rng = (min(ok), max(ok)) if ok else None
         folds = self.folds
         hyst = None
@@ -749,7 +750,7 @@ def harmonic_branch(engine: Engine, space: ParameterSpace, axis: Axis, *, harmon
     pads = tuple(p.name for p in space.resolve({}).model.pads)
     bal = _Balance(space, axis.name, sim, harmonics, ref, scale)
     if shooting_check:
-        bal.check = _shooting_check(engine, space, axis, coords, use_cache)
+        bal.check = shooting_flow(engine, space, axis, coords, use_cache)
     cont = _Continuation(bal, h.omega0, dist, tol)
     rtol_ = harmonic_tol if residual_tol is None else float(residual_tol)
     met = [True]  # whether the last adapt() met every tolerance
@@ -927,11 +928,16 @@ def harmonic_branch(engine: Engine, space: ParameterSpace, axis: Axis, *, harmon
                           "Hill's method" if stability else "not computed")
 
 
-def _shooting_check(engine: Engine, space: ParameterSpace, axis: Axis, coords: tuple[str, ...],
-                    use_cache: bool) -> _ShootingCheck | None:
+def shooting_flow(engine: Engine, space: ParameterSpace, axis: Axis, coords: tuple[str, ...],
+                  use_cache: bool) -> _ShootingCheck | None:
     """The simulated equations' flow where the pads allow shooting (no massless Coulomb pad the simulation would
     make quasi-static, :func:`~.models.soft_quasi_static_pads`) and their states are values or rates of the
-    series; else ``None``."""
+    series; else ``None``.
+
+    The result checks a harmonic-balance orbit by integration (its mismatch over one period and its monodromy)
+    and converts its Fourier coefficients into the simulated state at ``t = 0`` (``.state(coefficients,
+    omega)``), from which a shooting continuation can start (:mod:`brakesqueal.region.folds`).
+    """
     from .models import model_system, soft_quasi_static_pads
     from .periodic import _make_flow
 

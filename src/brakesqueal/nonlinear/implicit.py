@@ -55,6 +55,7 @@ end of the model's validity: Coulomb friction would stick).
 
 from __future__ import annotations
 
+import cmath
 import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -70,7 +71,7 @@ if TYPE_CHECKING:
     from ..model.parameters import ParameterSpace
     from ..simulation import SimulationModel
 
-__all__ = ["PadHopf", "exact_lyapunov"]
+__all__ = ["PadHopf", "exact_lyapunov", "lyapunov_at_hopf"]
 
 
 @dataclass(frozen=True)
@@ -198,50 +199,205 @@ def exact_lyapunov(engine: Engine, space: ParameterSpace, name: str, p0: float, 
         raise BrakesquealError(f"no complex eigenvalue pair at {name} = {p0:.12g}: not a Hopf point")
     lam = complex(cand[np.argmin(np.abs(cand.real) if omega is None else np.abs(cand.imag - omega))])
 
-    def lam_at(p: float, target: complex) -> complex:
-        return _track(_Point(space, sim, name, p).eigenvalues(), target)
+    p = float(p0)
+    dl = _dlam(space, sim, name, p, lam)
+    pt, lam, refined = _refine(space, sim, name, pt, lam, dl)
+    if abs(pt.p - p) > 1e-9 * max(abs(pt.p), 1e-3):  # moved: the derivative at the Hopf point itself
+        dl = _dlam(space, sim, name, pt.p, lam)
+    h, X1, phi = _normal_form(space, sim, name, pt, lam, pt.lm.eigenvalues, dl, refined, silent_derivative=True)
+    loss, rev, t_loss, t_rev = _events(pt, sim, h, lam.imag, X1, phi)
+    if not _valid(space, name, loss):  # a leading-order extrapolation out of the parameter's range
+        loss, t_loss = None, None
+    if not _valid(space, name, rev):
+        rev, t_rev = None, None
+    return PadHopf(h, loss, rev, t_loss, t_rev)
 
-    def dlam(p: float, target: complex) -> complex:
-        h = 1e-4 * max(abs(p), 1e-3)
-        d1 = lam_at(p + h, target) - lam_at(p - h, target)
-        d2 = lam_at(p + 2 * h, target) - lam_at(p - 2 * h, target)
-        return (8 * d1 - d2) / (12 * h)
 
-    # chord iterations on Re lambda(p) = 0 with the derivative at the start (the crossing is close)
-    p, refined = float(p0), False
-    d = dl = dlam(p, lam)
+def _dlam(space: ParameterSpace, sim: SimulationModel, name: str, p: float, target: complex) -> complex:
+    """``d lambda / dp`` of the eigenvalue nearest ``target``: fourth-order central differences (step
+    ``1e-4 |p|``) of the double-precision eigenvalues."""
+
+    def lam_at(q: float) -> complex:
+        return _track(_Point(space, sim, name, q).eigenvalues(), target)
+
+    h = 1e-4 * max(abs(p), 1e-3)
+    d1 = lam_at(p + h) - lam_at(p - h)
+    d2 = lam_at(p + 2 * h) - lam_at(p - 2 * h)
+    return (8 * d1 - d2) / (12 * h)
+
+
+def _refine(space: ParameterSpace, sim: SimulationModel, name: str, pt: _Point, lam: complex,
+            d: complex) -> tuple[_Point, complex, bool]:
+    """Chord iterations on ``Re lambda(p) = 0`` from ``pt`` with the derivative ``d`` (a fresh one where they
+    stop contracting away from the eigenvalues' rounding level): the point, its eigenvalue, whether refined."""
     if d.real == 0:
         raise BrakesquealError("cannot refine the Hopf point: dRe(lambda)/dp = 0 (not transversal)")
-    prev = math.inf
+    p, prev = pt.p, math.inf
     for _ in range(30):
         step = -lam.real / d.real
         if abs(step) >= 0.5 * prev:  # not contracting: at the eigenvalues' rounding level, or far away
             if abs(lam.real) <= 1e-9 * abs(lam):
-                refined = True
-                break
-            d = dlam(p, lam)  # Newton step with a fresh derivative
+                return pt, lam, True
+            d = _dlam(space, sim, name, p, lam)  # Newton step with a fresh derivative
             step = -lam.real / d.real
         pt = _Point(space, sim, name, p + step)
         p, lam, prev = pt.p, _track(pt.eigenvalues(), lam), abs(step)
         if abs(step) <= 8 * EPS * max(1.0, abs(p)) or abs(lam.real) <= 1e-13 * abs(lam):
-            refined = True
-            break
-    else:
-        raise BrakesquealError(f"the Hopf point did not converge (last Re lambda = {lam.real:.3g} at "
-                               f"{name} = {p:.12g})")  # fmt: skip
-    if abs(p - float(p0)) > 1e-9 * max(abs(p), 1e-3):  # moved: the derivative at the Hopf point itself
-        dl = dlam(p, lam)
+            return pt, lam, True
+    raise BrakesquealError(f"the Hopf point did not converge (last Re lambda = {lam.real:.3g} at "
+                           f"{name} = {p:.12g})")  # fmt: skip
+
+
+def lyapunov_at_hopf(engine: Engine, space: ParameterSpace, name: str, p: float, eigenvalue: complex,
+                     dlambda_dp: complex, *, use_cache: bool = True) -> HopfResult:
+    """The normal form at a point already on the stability boundary (a Hopf curve's point), given ``d lambda/dp``.
+
+    :func:`exact_lyapunov` selects the pair in extended precision, refines the crossing by chord iterations
+    with a finite-difference ``d lambda / dp`` (four linearizations a derivative, one more at the end) and
+    lists the eigenvalues in extended precision again
+    (:func:`~brakesqueal.analysis.linear.descriptor_eigenvalues`).  A caller that has corrected the point
+    onto ``Re lambda = 0`` and knows ``d lambda / dp`` (:func:`brakesqueal.region.curves.continue_hopf_curve`)
+    passes both.  Where ``|Re lambda| <= 1e-12 |lambda|`` (the curve's corrector tolerance) the point is taken
+    as it is: the chord iterations there only move ``p`` within the rounding noise of ``Re lambda`` (about
+    ``1e-12`` relative), which changes ``l1`` by its finite differences' rounding, far inside ``l1_error``;
+    elsewhere they run, with the caller's derivative.  The double-precision eigenvalues replace the extended
+    ones where their error bounds decide every check made with them (:func:`_checked_eigenvalues`).  ``l1``,
+    its error and the criticality are computed as there; ``dx0_dp`` is NaN (not computed).
+
+    Parameters
+    ----------
+    engine : Engine
+        The model's engine.
+    space : ParameterSpace
+        The model, preset and overrides.
+    name : str
+        The path parameter (settable in ``space``).
+    p : float
+        Its value at the Hopf point.
+    eigenvalue : complex
+        The critical eigenvalue there (``Im > 0``), e.g. from the double-precision eigenvalues of the exact
+        linearization; the one of the point nearest it is taken.
+    dlambda_dp : complex
+        ``d lambda / dp`` there (transversality, side, frequency slope).
+    use_cache : bool
+        Use the on-disk code cache.
+
+    Returns
+    -------
+    HopfResult
+        As ``exact_lyapunov(...).hopf``, with ``dx0_dp`` NaN.
+
+    Raises
+    ------
+    ParameterError
+        ``name`` is not settable, or ``p``, ``eigenvalue`` or ``dlambda_dp`` is not finite.
+    BrakesquealError
+        No complex pair, the refinement does not converge, or a zero eigenvalue at the point.
+    """
+    from ..simulation import simulation_model
+
+    if name not in space.settable():
+        space.resolve({name: 1.0})  # the one message for unknown or tied names
+    for label, v in (("p", p), ("eigenvalue", eigenvalue), ("dlambda_dp", dlambda_dp)):
+        if not cmath.isfinite(complex(v)):
+            raise ParameterError(f"The argument {label} must be finite; got {v!r}", parameter=label)
+    sim = simulation_model(engine, use_cache=use_cache)
+    pt = _Point(space, sim, name, float(p))
+    lam = _track(pt.eigenvalues(), complex(eigenvalue))
+    dl, refined = complex(dlambda_dp), True
+    if not abs(lam.real) <= 1e-12 * abs(lam):  # not on the boundary to rounding: exact_lyapunov's refinement
+        pt, lam, refined = _refine(space, sim, name, pt, lam, dl)
+        if abs(pt.p - float(p)) > 1e-9 * max(abs(pt.p), 1e-3):  # moved: the derivative at the Hopf point
+            dl = _dlam(space, sim, name, pt.p, lam)
+    return _normal_form(space, sim, name, pt, lam, _checked_eigenvalues(pt, lam), dl, refined,
+                        silent_derivative=False)[0]
+
+
+def _checked_eigenvalues(pt: _Point, lam: complex) -> np.ndarray:
+    r"""The eigenvalues :func:`_normal_form`'s checks read: double precision where it provably decides them.
+
+    The checks are: which eigenvalues are the critical pair (within ``1e-9 |lam|`` of ``lam`` or its
+    conjugate), whether one is zero (``|mu| <= 1e-12 |lam|``) and whether another lies on the imaginary axis
+    (``|Re mu| <= 1e-8 |lam|``).  The eigenpairs of ``E^-1 A`` (:attr:`LinearModel.reduced_descriptor`) are
+    computed in double precision with left vectors and each eigenvalue gets an a-posteriori bound
+
+    .. math::
+
+       \delta_i = 10\,\frac{\left(\|(A - \mu_i E) x_i\| + \|r_i^{\rm rnd}\|\right)\|y_i\|}{|y_i^H E x_i|},
+       \qquad r_i^{\rm rnd} = (m + 2)\,\epsilon\,(|A| + |\mu_i| |E|) |x_i|,
+
+    (the residual in the float pencil, its own rounding, the eigenvalue's condition; first order, hence the
+    factor 10 and the requirement that ``delta_i`` is below a tenth of the distance to every other
+    eigenvalue).  Where every check gives the same answer for every value within the bounds, those
+    eigenvalues are returned; otherwise (a huge pad mode spoiling the slow ones, a near-defective pair, a
+    singular ``E``, a bound straddling a threshold) the extended-precision list
+    (:attr:`LinearModel.eigenvalues <brakesqueal.analysis.linear.LinearModel.eigenvalues>`), as
+    :func:`exact_lyapunov` uses everywhere.
+    """
+    import scipy.linalg
+
+    from ..analysis.linear import sort_eigenvalues
+
+    try:
+        E, A = (np.asarray(a, dtype=float) for a in pt.lm.reduced_descriptor)
+        if not (np.all(np.isfinite(E)) and np.all(np.isfinite(A))):
+            return pt.lm.eigenvalues
+        mu, yl, xr = scipy.linalg.eig(np.linalg.solve(E, A), left=True, right=True)
+        yl = np.linalg.solve(E.conj().T, yl)  # left vectors of the pencil: y^H A = mu y^H E
+    except (np.linalg.LinAlgError, ValueError):
+        return pt.lm.eigenvalues
+    m = mu.size
+    if m == 0 or not np.all(np.isfinite(mu)):
+        return pt.lm.eigenvalues
+    R = A @ xr - (E @ xr) * mu[None, :]
+    rnd = (m + 2) * EPS * (np.abs(A) @ np.abs(xr) + (np.abs(E) @ np.abs(xr)) * np.abs(mu)[None, :])
+    den = np.abs(np.einsum("ij,ij->j", np.conj(yl), E @ xr))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        delta = 10 * (np.linalg.norm(R, axis=0) + np.linalg.norm(rnd, axis=0)) * np.linalg.norm(yl, axis=0) / den
+    if not np.all(np.isfinite(delta)):
+        return pt.lm.eigenvalues
+    gap = np.abs(mu[:, None] - mu[None, :]) + np.diag(np.full(m, np.inf))
+    if np.any(delta >= 0.1 * gap.min(axis=1)):
+        return pt.lm.eigenvalues
+    a = abs(lam)
+
+    def decided(v: np.ndarray, tol: float) -> bool:  # "v <= tol" the same for every value within delta
+        return bool(np.all((v - delta > tol) | (v + delta <= tol)))
+
+    crit = np.minimum(np.abs(mu - lam), np.abs(mu - np.conj(lam)))
+    other = crit - delta > 1e-9 * a
+    if not (decided(crit, 1e-9 * a) and decided(np.abs(mu), 1e-12 * a)
+            and decided(np.where(other, np.abs(mu.real), np.inf), 1e-8 * a)):
+        return pt.lm.eigenvalues
+    lams = mu.astype(complex)
+    tiny = np.abs(lams.imag) <= delta  # a real eigenvalue's rounding-level imaginary part, as the extended list
+    lams[tiny] = lams[tiny].real
+    return sort_eigenvalues(lams)
+
+
+def _normal_form(space: ParameterSpace, sim: SimulationModel, name: str, pt: _Point, lam: complex,
+                 lams: np.ndarray, dl: complex, refined: bool, *,
+                 silent_derivative: bool) -> tuple[HopfResult, np.ndarray, np.ndarray]:
+    """The normal form at a Hopf point ``pt`` with critical eigenvalue ``lam`` (on the imaginary axis).
+
+    ``lams`` are the eigenvalues read by the checks (a zero eigenvalue, other eigenvalues on the axis),
+    ``dl = d lambda / dp``; ``silent_derivative=False`` leaves ``dx0_dp`` NaN (two silent motions fewer).
+    Returns the result, ``X1`` (scaled back) and ``phi`` (for :func:`_events`).
+    """
     w0 = lam.imag
-    lams = pt.lm.eigenvalues
     if np.min(np.abs(lams)) <= 1e-12 * abs(lam):
         raise BrakesquealError("a zero eigenvalue at the Hopf point (fold-Hopf): l1 is not defined")
     phi, psi, q, pv = _vectors(pt, w0)
     sv = np.linalg.svd(pt.P(1j * w0), compute_uv=False)
     kvec = float(sv[0] / sv[-2]) if sv.size > 1 else 1.0  # condition of the null vectors phi, psi
     c1, c1_err, h20, h11, X1 = _c1(pt, w0, phi, psi, kvec)
-    # the silent motion's derivative along the path, in the state
-    hp = 1e-6 * max(abs(p), 1e-3)
-    dy0 = (_Point(space, sim, name, p + hp).y0() - _Point(space, sim, name, p - hp).y0()) / (2 * hp)
+    p = pt.p
+    y0 = pt.y0()
+    if silent_derivative:  # the silent motion's derivative along the path, in the state
+        hp = 1e-6 * max(abs(p), 1e-3)
+        dy0 = (_Point(space, sim, name, p + hp).y0() - _Point(space, sim, name, p - hp).y0()) / (2 * hp)
+    else:
+        dy0 = np.full(y0.size, np.nan)
     warnings: list[str] = []
     others = lams[(np.abs(lams - lam) > 1e-9 * abs(lam)) & (np.abs(lams - np.conj(lam)) > 1e-9 * abs(lam))]
     near = others[np.abs(others.real) <= 1e-8 * abs(lam)]
@@ -250,15 +406,10 @@ def exact_lyapunov(engine: Engine, space: ParameterSpace, name: str, p0: float, 
                         "(codimension-2 point; the centre manifold is larger than 2-D)")  # fmt: skip
     coords = tuple(sim.coords)
     names = (*coords, *(f"d{c}" for c in coords), *pt.lm.pad_states)
-    h = hopf_result(pt.y0(), p, lams, lam, q, pv, c1, c1_err, dl, dy0, pt.state(h20, 2j * w0),
+    h = hopf_result(y0, p, lams, lam, q, pv, c1, c1_err, dl, dy0, pt.state(h20, 2j * w0),
                     pt.state(h11.astype(complex), 0.0).real, multilinear="finite-difference", refined=refined,
                     state_names=names, parameter_name=name, warnings=warnings)  # fmt: skip
-    loss, rev, t_loss, t_rev = _events(pt, sim, h, w0, X1, phi)
-    if not _valid(space, name, loss):  # a leading-order extrapolation out of the parameter's range
-        loss, t_loss = None, None
-    if not _valid(space, name, rev):
-        rev, t_rev = None, None
-    return PadHopf(h, loss, rev, t_loss, t_rev)
+    return h, X1, phi
 
 
 def _valid(space: ParameterSpace, name: str, value: float | None) -> bool:
@@ -300,8 +451,20 @@ def _c1(pt: _Point, w0: float, phi: np.ndarray, psi: np.ndarray,
         r = lam / w0
         return np.concatenate([v[:n], r * v[:n], r * r * v[:n], v[n:], r * v[n:]])
 
+    # the four bilinear forms share the directions Re X1, Im X1 (and X1b's are their mirror images), the
+    # trilinear form's mixed directions repeat, and a step 4x smaller reuses a point of the larger one: every
+    # distinct point is evaluated once (the values are those of the unshared evaluations, bit for bit; the
+    # generated code runs on Python floats, the same IEEE operations and libm calls as on NumPy scalars)
+    memo: dict[bytes, np.ndarray] = {}
+    shape = (n + m, pt.cm.nx)
+
     def jac(xi: np.ndarray, _p: float) -> np.ndarray:
-        return pt.cm.jacobian_matrix(pt.x0 + T * xi, pt.pvec) * T[None, :]
+        key = xi.tobytes()
+        J = memo.get(key)
+        if J is None:
+            vals = pt.cm.jacobians((pt.x0 + T * xi).tolist(), pt.pvec)
+            J = memo[key] = np.asarray(vals, dtype=float).reshape(shape) * T[None, :]
+        return J
 
     z = np.zeros(T.size)
     X1 = X(phi, 1j * w0)

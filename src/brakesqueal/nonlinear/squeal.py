@@ -189,8 +189,9 @@ class SquealSummary:
     criticality : str
         ``"supercritical"`` (soft onset), ``"subcritical"`` (hard onset) or ``"degenerate"``.
     squeal_range : (float, float) or None
-        Parameter range of the computed branch where a *stable* limit cycle exists (squeal can be heard);
-        ``None`` when no computed cycle is stable.
+        Parameter range of the computed branch where a *stable* limit cycle exists (squeal can be heard): the
+        span of the orbits whose Floquet verdict is ``"stable"`` (an ``"undecided"`` orbit counts as neither);
+        ``None`` when no computed cycle is certified stable.
     hysteresis_range : (float, float) or None
         Range below (or above) the linear onset where the silent motion is stable but stable squeal coexists
         (between a fold of cycles and the Hopf point); ``None`` when the branch has no such fold.
@@ -208,7 +209,9 @@ class SquealSummary:
         ``F_n_max``, ``F_n_min`` [N] per pad (acting force), ``duty_cycle`` per pad (``None`` where a
         bilateral branch is not valid: a pad would pull), ``stable`` (``None``: no verdict, harmonic balance),
         ``sliding_reversal``, ``verdict`` (``"stable"``, ``"unstable"`` or ``"undecided"``: a multiplier within
-        the computation's accuracy of the unit circle, or two methods disagreeing; :mod:`.floquet`).
+        the computation's accuracy of the unit circle, or two methods disagreeing; :mod:`.floquet`), ``located``
+        (shooting: the Hopf point or a located fold, period doubling or torus point, where a multiplier is on the
+        unit circle by construction).
     pads : tuple of str
         Pad names.
     """
@@ -237,6 +240,8 @@ class SquealSummary:
         P = self.parameter
         lines = [f"squeal onset (linear): {P} = {self.onset:.10g}, {self.criticality} "
                  f"({'soft onset' if self.criticality == 'supercritical' else 'hard onset: jump to large squeal'})"]
+        undecided = [r["p"] for r in self.table
+                     if r.get("verdict") == "undecided" and r["stable"] is not None and not r.get("located")]
         if self.squeal_range is None and self.table and all(r["stable"] is None for r in self.table):
             lines.append("stability not computed (or no verdict) on the computed branch")
         elif self.squeal_range is None:
@@ -244,6 +249,9 @@ class SquealSummary:
         else:
             lines.append(f"stable squeal on the computed branch for {P} in [{self.squeal_range[0]:.8g}, "
                          f"{self.squeal_range[1]:.8g}]")
+        if undecided:
+            lines.append(f"stability undecided (not counted in the range) at {len(undecided)} of {len(self.table)} "
+                         f"computed orbits, {P} in [{min(undecided):.8g}, {max(undecided):.8g}]")
         if self.hysteresis_range is not None:
             lines.append(f"hysteresis: squeal can persist where the linear analysis says stable, {P} in "
                          f"({self.hysteresis_range[0]:.8g}, {self.hysteresis_range[1]:.8g})")
@@ -643,14 +651,20 @@ def squeal_summary(branch: SquealBranch) -> SquealSummary:
     p = ds["p"].values
     stable = ds["stable"].values.astype(bool)
     valid = np.ones(p.size, dtype=bool) if branch.contact == "unilateral" else ds["in_contact"].values.astype(bool)
-    ok = stable & valid
+    # an orbit whose Floquet verdict is undecided (a multiplier within the accuracy of the unit circle, not at a
+    # located crossing) counts as neither stable nor unstable: the range spans the orbits certified stable; the
+    # Hopf point and the located folds (a multiplier on the unit circle by construction) bound it as before
+    decided = ds["verdict"].values.astype(str) != "undecided" if "verdict" in ds else np.ones(p.size, dtype=bool)
+    decided[[int(i) for i in ds["special_index"].values if 0 <= int(i) < p.size]] = True
+    ok = stable & valid & decided
     h = branch.hopf.branch_start  # the normal form of the continued (simulated) equations
     onset = float(h.p0) if h is not None else float(branch.hopf.value)
     rng = (float(p[ok].min()), float(p[ok].max())) if ok.any() else None
     loss = branch.contact_loss
     if rng is not None and branch.contact == "bilateral" and loss is not None:
         last = int(np.flatnonzero(ok)[-1])
-        if last + 1 < p.size and stable[last + 1] and not valid[last + 1] and min(p[last], p[last + 1]) <= loss:
+        if last + 1 < p.size and stable[last + 1] and decided[last + 1] and not valid[last + 1] \
+                and min(p[last], p[last + 1]) <= loss:
             rng = (min(rng[0], loss), max(rng[1], loss))  # stable up to the located contact loss
     folds = [float(v) for k, v in zip(ds["special_kind"].values, ds["special_p"].values) if str(k) == "LPC"]
     hyst = branch.branch.hysteresis_range
@@ -668,6 +682,7 @@ def squeal_summary(branch: SquealBranch) -> SquealSummary:
     stick = ds.attrs.get("stick_slip") == "regularised"  # a sliding reversal is then ordinary motion
     validity_end = located_end if math.isfinite(located_end) else (float(p[np.flatnonzero(rev)[0]])
                                                                     if rev.any() and not stick else None)
+    located = {int(i) for i in ds["special_index"].values}
     tab = []
     for i in range(p.size):
         tab.append({"p": float(p[i]), "frequency_hz": float(ds["frequency"].values[i]),
@@ -677,7 +692,8 @@ def squeal_summary(branch: SquealBranch) -> SquealSummary:
                                 for v in ds["F_n_min"].values[i]],
                     "duty_cycle": [float(v) if math.isfinite(v) else None for v in ds["duty_cycle"].values[i]],
                     "stable": bool(stable[i]), "sliding_reversal": bool(rev[i]),
-                    "verdict": str(ds["verdict"].values[i]) if "verdict" in ds else None})
+                    "verdict": str(ds["verdict"].values[i]) if "verdict" in ds else None,
+                    "located": bool(i in located)})
     crit = h.criticality if h is not None else "unknown"
     return SquealSummary(str(ds.attrs.get("parameter", branch.hopf.parameter)), onset, crit, rng, hyst, folds,
                          branch.contact, branch.contact_loss, validity_end, tab, branch.pads)

@@ -17,6 +17,13 @@ so that AUTO sees eigenvalues of order one.
 from ``(x0, y_start)`` to the first Hopf bifurcation (``HB``, ``ISW=1``), then
 the Hopf point in ``(y, x)`` both ways (``ISW=2``) until it leaves the box
 (``UZSTOP``), and returns AUTO's curve points read from its ``fort.7``.
+
+:func:`auto_cycle_branch` continues the periodic orbits from that Hopf point (``IPS=2``) to their first fold
+(``LP``); :func:`auto_fold_curve` continues that fold in two parameters (``ISW=2``: AUTO's start run, then both
+ways from it, as AUTO's demo ``plp``), with user points (``UZR``) at given values of the second parameter.  Both
+see the smooth bilateral equations: compare with :func:`~.folds.fold_curves` ``contact="bilateral"``.  With
+``jac=1`` the user functions supply the Jacobian (``JAC=1``) by central differences with the step
+``eps^(1/3) (1 + |u_j|)`` instead of AUTO's ``1e-7 (1 + max |u|)``.
 """
 
 from __future__ import annotations
@@ -42,7 +49,7 @@ if TYPE_CHECKING:
     from ..model.parameters import ParameterSpace
 
 __all__ = ["AutoCurve", "AutoCycles", "auto_dir", "auto_available", "auto_source", "auto_hopf_curve",
-           "auto_cycle_branch", "to_unit", "from_unit"]
+           "auto_cycle_branch", "auto_fold_curve", "to_unit", "from_unit"]
 
 
 def auto_dir() -> Path:
@@ -129,7 +136,8 @@ def from_unit(ax: Axis, u: float) -> float:
 
 @validated
 def auto_source(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0: float, y0: float, *,
-                time_scale: float | None = None, state_scale: Sequence[float] | np.ndarray | None = None) -> str:
+                time_scale: float | None = None, state_scale: Sequence[float] | np.ndarray | None = None,
+                scale: float = 1.0, precision: str = "double") -> str:
     """The model as AUTO-07p C user functions with ``PAR(1)``, ``PAR(2)`` the axes ``x``, ``y`` in the unit box.
 
     AUTO's state is ``u = y / s`` and its time ``tau = W t`` (``y`` the simulation's state ``(Q, Qdot, L)`` in
@@ -153,6 +161,18 @@ def auto_source(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0: flo
         ``W`` [rad/s] (positive).
     state_scale : sequence of float, optional
         ``s`` (positive, one per state).
+    scale : float
+        A factor on the default ``s`` (positive; ignored with ``state_scale``).  AUTO's finite differences of the
+        nonlinear terms (the third derivatives of its ``l1``) step ``1.2e-4`` along the unit eigenvector in its
+        units: a smaller ``scale`` makes that step smaller against the model's nonlinearity (the error falls as
+        ``scale^2``) until the rounding of the forces takes over; see ``precision``.
+    precision : {"double", "long double"}
+        The arithmetic of the exported model's right-hand side: ``"long double"`` (x87 extended, the C export
+        compiled with ``<tgmath.h>``) cuts the rounding of the large, cancelling forces by ~2000, so that a smaller
+        ``scale`` pays (the six-dof model: AUTO's GH point within 1e-6 of the box at ``scale = 0.03``, 2e-4 with
+        the defaults).  The best ``scale`` depends on the model (about ``min(1, 10 Omega / W)``, ``Omega`` the
+        disk's speed: six-dof, Omega ~ 37 rad/s, W ~ 1e4 rad/s; Fig. 3's set, Omega ~ 3000 rad/s, is best at 1, its
+        GH point within 4e-8 of ours, and 1e-5 off at 0.1).
 
     Returns
     -------
@@ -178,9 +198,11 @@ def auto_source(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0: flo
         lams = np.linalg.eigvals(J)
         cand = lams[lams.imag > 0] if np.any(lams.imag > 0) else lams
         time_scale = float(abs(cand[np.argmin(np.abs(cand.real) / np.maximum(np.abs(cand), 1e-300))])) or 1.0
-    if state_scale is None:  # rates in units of W: (Q, Qdot / W, the pads' states)
+    if not (isinstance(scale, (int, float)) and math.isfinite(scale) and scale > 0):
+        raise ParameterError(f"The option 'scale' must be positive and finite; got {scale!r}", parameter="scale")
+    if state_scale is None:  # rates in units of W: (Q, Qdot / W, the pads' states), times `scale`
         nq = len(sim.coords)
-        state_scale = [1.0] * nq + [float(time_scale)] * nq + [1.0] * (n - 2 * nq)
+        state_scale = [float(scale)] * nq + [float(scale * time_scale)] * nq + [float(scale)] * (n - 2 * nq)
     sc = np.asarray(state_scale, dtype=float).ravel()
     if not (math.isfinite(time_scale) and time_scale > 0):
         raise ParameterError(f"The option 'time_scale' must be positive and finite; got {time_scale!r}",
@@ -205,7 +227,14 @@ def auto_source(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0: flo
     uscale = [float(v) for v in sc]  # physical state = u * these
     fscale = [w * v for v in uscale]  # AUTO's field = f / these
     u0 = "\n".join(f"    u[{i}] = {float(v) / uscale[i]!r};" for i, v in enumerate(ystate))
+    if precision not in ("double", "long double"):
+        raise ParameterError(f"The option 'precision' must be double or long double; got {precision!r}",
+                             parameter="precision")
+    if precision == "long double":  # the exported model in extended precision (type-generic math)
+        body = ("#include <math.h>\n#include <tgmath.h>\n#define double long double\n" + body
+                + "\n#undef double\n#undef complex  /* tgmath.h's, a type name of auto_f2c.h */\n")
     return f"""{body}
+typedef {precision} bsq_real;  /* the model's arithmetic */
 /* ---- AUTO-07p user functions (brakesqueal.region.auto) ----
  * {x.name} = {_unit_c(x, "PAR(1)")}
  * {y.name} = {_unit_c(y, "PAR(2)")}
@@ -214,8 +243,9 @@ def auto_source(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0: flo
 #include "auto_f2c.h"
 
 #define BSQ_NP {len(space.model.parameters)}
+#define BSQ_STEP 6.0e-6
 
-static void bsq_parameters(const doublereal *par, double *p)
+static void bsq_parameters(const doublereal *par, bsq_real *p)
 {{
     const double bsq_x = {_unit_c(x, "par[0]")};
     const double bsq_y = {_unit_c(y, "par[1]")};
@@ -224,19 +254,50 @@ static void bsq_parameters(const doublereal *par, double *p)
 {chr(10).join(lines)}
 }}
 
-int func(integer ndim, const doublereal *u, const integer *icp, const doublereal *par, integer ijac,
-         doublereal *f, doublereal *dfdu, doublereal *dfdp)
+static void bsq_field(const doublereal *u, const doublereal *par, doublereal *f)
 {{
     static const double uscale[{n}] = {{{", ".join(repr(v) for v in uscale)}}};
     static const double fscale[{n}] = {{{", ".join(repr(v) for v in fscale)}}};
-    double p[BSQ_NP], y[{n}];
+    bsq_real p[BSQ_NP], y[{n}], dy[{n}];
     bsq_parameters(par, p);
-    for (integer i = 0; i < ndim; ++i) y[i] = u[i] * uscale[i];
-    if (brakesqueal_rhs(0.0, y, p, f) != 0) {{
-        for (integer i = 0; i < ndim; ++i) f[i] = NAN;
-        return 0;
+    for (int i = 0; i < {n}; ++i) y[i] = (bsq_real)u[i] * uscale[i];
+    if (brakesqueal_rhs(0.0, y, p, dy) != 0) {{
+        for (int i = 0; i < {n}; ++i) f[i] = NAN;
+        return;
     }}
-    for (integer i = 0; i < ndim; ++i) f[i] /= fscale[i];
+    for (int i = 0; i < {n}; ++i) f[i] = (doublereal)(dy[i] / fscale[i]);
+}}
+
+/* JAC = 1: the derivatives by central differences with the step (cube root of the rounding unit) x (1 + |v|)
+ * (AUTO's own use 1e-7 (1 + max |u|), whose rounding error grows with the cancellation in the forces) */
+int func(integer ndim, const doublereal *u, const integer *icp, const doublereal *par, integer ijac,
+         doublereal *f, doublereal *dfdu, doublereal *dfdp)
+{{
+    bsq_field(u, par, f);
+    if (ijac >= 1) {{
+        double v[{n}], fp[{n}], fm[{n}];
+        for (int j = 0; j < {n}; ++j) v[j] = u[j];
+        for (int j = 0; j < {n}; ++j) {{
+            const double h = BSQ_STEP * (1.0 + fabs(u[j]));
+            v[j] = u[j] + h;
+            bsq_field(v, par, fp);
+            v[j] = u[j] - h;
+            bsq_field(v, par, fm);
+            v[j] = u[j];
+            for (int i = 0; i < {n}; ++i) dfdu[i + j * {n}] = (fp[i] - fm[i]) / (2.0 * h);
+        }}
+        if (ijac >= 2) {{
+            for (int k = 0; k < 2; ++k) {{
+                const double h = BSQ_STEP * (1.0 + fabs(par[k]));
+                double pp[2] = {{par[0], par[1]}};  /* the field reads PAR(1), PAR(2) only */
+                pp[k] = par[k] + h;
+                bsq_field(u, pp, fp);
+                pp[k] = par[k] - h;
+                bsq_field(u, pp, fm);
+                for (int i = 0; i < {n}; ++i) dfdp[i + k * {n}] = (fp[i] - fm[i]) / (2.0 * h);
+            }}
+        }}
+    }}
     return 0;
 }}
 
@@ -335,7 +396,8 @@ def _constants(**kw: object) -> str:
     return "\n".join(out) + "\n"
 
 
-def _run(workdir: Path, exe: Path, constants: str, restart: Path | None, timeout: float) -> tuple[str, str]:
+def _run(workdir: Path, exe: Path, constants: str, restart: Path | None, timeout: float,
+         exit_crash_ok: bool = False) -> tuple[str, str]:
     (workdir / "fort.2").write_text(constants)
     if restart is not None:
         shutil.copy(restart, workdir / "fort.3")
@@ -350,10 +412,30 @@ def _run(workdir: Path, exe: Path, constants: str, restart: Path | None, timeout
     except subprocess.TimeoutExpired:
         raise BrakesquealError(f"AUTO-07p did not finish within {timeout:g} s") from None
     b7 = (workdir / "fort.7").read_text() if (workdir / "fort.7").exists() else ""
-    if p.returncode != 0 or not b7:
+    # AUTO-07p (Debian's 0.9.x) aborts in its own clean-up (free() in cnrlbv) after a fold continuation of
+    # periodic orbits has written its output: accepted there when the branch's last row is a labelled end point
+    ended = exit_crash_ok and p.returncode < 0 and "cnrlbv" in p.stderr and _labelled_end(b7)
+    if (p.returncode != 0 and not ended) or not b7:
         tail = (p.stderr or p.stdout).strip().splitlines()[-1:] or ["no output"]
         raise BrakesquealError(f"AUTO-07p failed (exit {p.returncode}): {tail[0]}")
     return b7, p.stdout
+
+
+def _labelled_end(b7: str) -> bool:
+    """The last row of ``fort.7`` is a labelled point (AUTO wrote the branch's end before it stopped)."""
+    rows = _parse_fort7(b7)
+    return bool(rows) and int(rows[-1].get("LAB", 0)) > 0 and int(rows[-1].get("TY", 0)) != 0
+
+
+def _join(xs: list[float], ys: list[float], pts: list[tuple[float, float]], sign: int) -> None:
+    """Add one direction's points of a curve continued both ways from its start: ``sign > 0`` after the points
+    so far, ``sign < 0`` reversed before them (so the curve runs in one direction)."""
+    if sign < 0:
+        xs[:0] = [p[0] for p in pts[::-1]]
+        ys[:0] = [p[1] for p in pts[::-1]]
+    else:
+        xs += [p[0] for p in pts]
+        ys += [p[1] for p in pts]
 
 
 def _parse_fort7(text: str) -> list[dict[str, float]]:
@@ -415,12 +497,26 @@ def _to_first_hopf(src: str, tmp: Path, x: Axis, y: Axis, x0: float, y_start: fl
     return exe, common, int(hb[0]["LAB"]), from_unit(y, hb[0].get("PAR(2)", math.nan))
 
 
+def _cycles_to_fold(tmp: Path, exe: Path, common: dict[str, object], lab: int, ntst: int, direction: int,
+                    timeout: float) -> list[dict[str, float]]:
+    """Run 2: the cycles from the Hopf point ``lab`` (branch switching, ``IPS=2``), folds detected, stopping at
+    the first (its ``fort.8`` kept as ``s.cyc``): the rows of ``fort.7``."""
+    c2 = _constants(**{**common, "IPS": 2, "ILP": 1, "ISP": 2, "NTST": ntst, "NPAR": 11, "EPSS": "1e-6",
+                       "DSMIN": "1e-12"}, IRS=lab, ICP="[2, 11]", ISW=1, DS=repr(direction * 1e-4),
+                    DSMAX="0.01", STOP="['LP1']", UZSTOP="{2: [0.0, 1.0]}")
+    b7, _ = _run(tmp, exe, c2, tmp / "s.eq", timeout)
+    shutil.copy(tmp / "fort.8", tmp / "s.cyc")
+    return [r for r in _parse_fort7(b7) if "PAR(2)" in r]
+
+
 @validated
 def auto_cycle_branch(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0: float, y_start: float, *,
                       direction: Annotated[int, Range(-1, 1)] = 1, ntst: Annotated[int, Range(5, 500)] = 40,
                       points: Annotated[int, Range(10, 100000)] = 400,
                       timeout: Annotated[float, Range(1, 3600, open_low=False)] = 300.0,
-                      keep: str | None = None) -> AutoCycles:
+                      time_scale: Annotated[float, Range(0, open_low=True)] | None = None,
+                      state_scale: Sequence[float] | np.ndarray | None = None, scale: float = 1.0,
+                      precision: str = "double", keep: str | None = None) -> AutoCycles:
     """The periodic orbits born at the first Hopf point above ``y_start`` at ``x = x0``, continued in ``y`` by
     AUTO-07p to its first fold of cycles (``LP``) or the box's edge (the check of :func:`~.folds.fold_curves`).
 
@@ -444,6 +540,8 @@ def auto_cycle_branch(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x
         Largest number of steps of each run (``NMX``).
     timeout : float
         Seconds each AUTO run may take.
+    time_scale, state_scale, scale, precision : optional
+        As in :func:`auto_source` (defaults there).
     keep : str, optional
         A directory to keep AUTO's files in.
 
@@ -461,17 +559,13 @@ def auto_cycle_branch(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x
         raise BrakesquealError(why)
     if direction == 0:
         raise ParameterError("The option 'direction' must be 1 or -1; got 0", parameter="direction")
-    src = auto_source(engine, space, x, y, x0, y_start)
+    src = auto_source(engine, space, x, y, x0, y_start, time_scale=time_scale, state_scale=state_scale,
+                      scale=scale, precision=precision)
     tmp = Path(keep) if keep else Path(tempfile.mkdtemp(prefix="brakesqueal-auto-"))
     tmp.mkdir(parents=True, exist_ok=True)
     try:
         exe, common, lab, y_h = _to_first_hopf(src, tmp, x, y, x0, y_start, points, timeout)
-        # run 2: the cycles from the Hopf point (branch switching), folds detected, stop at the first
-        c2 = _constants(**{**common, "IPS": 2, "ILP": 1, "ISP": 2, "NTST": ntst, "NPAR": 11, "EPSS": "1e-6",
-                           "DSMIN": "1e-12"}, IRS=lab, ICP="[2, 11]", ISW=1, DS=repr(direction * 1e-4),
-                        DSMAX="0.01", STOP="['LP1']", UZSTOP="{2: [0.0, 1.0]}")
-        b7, _ = _run(tmp, exe, c2, tmp / "s.eq", timeout)
-        rows = [r for r in _parse_fort7(b7) if "PAR(2)" in r]
+        rows = _cycles_to_fold(tmp, exe, common, lab, ntst, direction, timeout)
         n = int(common["NDIM"])  # type: ignore[call-overload]
         p = np.array([from_unit(y, r["PAR(2)"]) for r in rows])
         mx = np.array([[r.get(f"MAX U({i + 1})", math.nan) for i in range(n)] for r in rows])
@@ -492,6 +586,7 @@ def auto_hopf_curve(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0:
                     state_scale: Sequence[float] | np.ndarray | None = None,
                     points: Annotated[int, Range(10, 100000)] = 400,
                     timeout: Annotated[float, Range(1, 3600, open_low=False)] = 120.0,
+                    jac: Annotated[int, Range(0, 1)] = 0, scale: float = 1.0, precision: str = "double",
                     keep: str | None = None) -> AutoCurve:
     """The Hopf curve through the first Hopf point above ``y_start`` at ``x = x0``, by AUTO-07p.
 
@@ -511,8 +606,10 @@ def auto_hopf_curve(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0:
         Largest number of continuation steps of each run (``NMX``).
     timeout : float
         Seconds each AUTO run may take.
-    time_scale, state_scale : optional
-        ``W`` and ``s`` of :func:`auto_source` (defaults there).
+    time_scale, state_scale, scale, precision : optional
+        As in :func:`auto_source` (defaults there).
+    jac : {0, 1}
+        AUTO's ``JAC``: 1, the Jacobian from the user functions (central differences, see the module).
     keep : str, optional
         A directory to keep the C file and AUTO's output files in.
 
@@ -528,11 +625,13 @@ def auto_hopf_curve(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0:
     why = auto_available()
     if why:
         raise BrakesquealError(why)
-    src = auto_source(engine, space, x, y, x0, y_start, time_scale=time_scale, state_scale=state_scale)
+    src = auto_source(engine, space, x, y, x0, y_start, time_scale=time_scale, state_scale=state_scale,
+                      scale=scale, precision=precision)
     tmp = Path(keep) if keep else Path(tempfile.mkdtemp(prefix="brakesqueal-auto-"))
     tmp.mkdir(parents=True, exist_ok=True)
     try:
         exe, common, lab, y_h = _to_first_hopf(src, tmp, x, y, x0, y_start, points, timeout)
+        common = {**common, "JAC": jac}
         xs: list[float] = []
         ys: list[float] = []
         labels: list[tuple[str, float, float]] = []
@@ -547,15 +646,102 @@ def auto_hopf_curve(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0:
             rows = [r for r in _parse_fort7(b7) if "PAR(1)" in r and "PAR(2)" in r]
             labels += [(t, from_unit(x, r["PAR(1)"]), from_unit(y, r["PAR(2)"]))
                        for t, r in ((_ty(int(r.get("TY", 0)), True), r) for r in rows) if t not in ("", "RG", "EP")]
-            pts = [(from_unit(x, r["PAR(1)"]), from_unit(y, r["PAR(2)"])) for r in rows]
-            if sign < 0:
-                pts = pts[::-1]
-                xs[:0] = [p[0] for p in pts]
-                ys[:0] = [p[1] for p in pts]
-            else:
-                xs += [p[0] for p in pts]
-                ys += [p[1] for p in pts]
+            _join(xs, ys, [(from_unit(x, r["PAR(1)"]), from_unit(y, r["PAR(2)"])) for r in rows], sign)
         return AutoCurve(x.name, y.name, np.array(xs), np.array(ys), (float(x0), float(y_h)), tuple(labels))
+    finally:
+        if not keep:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+@validated
+def auto_fold_curve(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0: float, y_start: float, *,
+                    at: Sequence[float] = (), direction: Annotated[int, Range(-1, 1)] = 1,
+                    ntst: Annotated[int, Range(5, 500)] = 40, points: Annotated[int, Range(10, 100000)] = 400,
+                    timeout: Annotated[float, Range(1, 3600, open_low=False)] = 300.0,
+                    time_scale: Annotated[float, Range(0, open_low=True)] | None = None,
+                    state_scale: Sequence[float] | np.ndarray | None = None, scale: float = 1.0,
+                    precision: str = "double", jac: Annotated[int, Range(0, 1)] = 0,
+                    keep: str | None = None) -> AutoCurve:
+    """The curve of folds of cycles (``LPC``) through the first fold of the cycle branch of
+    :func:`auto_cycle_branch`, continued by AUTO-07p in ``(y, x)`` both ways (``ISW=2``, ``IPS=2``) to the box's
+    edges: the bilateral equations (AUTO knows nothing of contact loss).
+
+    Parameters
+    ----------
+    engine : Engine
+        The model's engine.
+    space : ParameterSpace
+        The model (with nonlinear equations), preset and overrides.
+    x, y : Axis
+        The second parameter of the fold curve (fixed at ``x0`` on the cycle branch) and the cycle branch's
+        parameter, with their boxes (AUTO stops at their edges).
+    x0, y_start : float
+        As in :func:`auto_cycle_branch`.
+    at : sequence of float
+        Values of ``x`` where AUTO locates the curve's points exactly (user points ``UZR``; ``special`` holds
+        them as ``("UZ", x, y)``).
+    direction, ntst, points, timeout, time_scale, state_scale, scale, precision, keep :
+        As in :func:`auto_cycle_branch`.
+    jac : {0, 1}
+        As in :func:`auto_hopf_curve`.
+
+    Returns
+    -------
+    AutoCurve
+        ``hopf_start`` is ``(x0, y)`` of the fold on the cycle branch.
+
+    Raises
+    ------
+    BrakesquealError
+        AUTO-07p is not installed, the build or a run fails, no Hopf point, or no fold on the cycle branch.
+    """
+    why = auto_available()
+    if why:
+        raise BrakesquealError(why)
+    if direction == 0:
+        raise ParameterError("The option 'direction' must be 1 or -1; got 0", parameter="direction")
+    src = auto_source(engine, space, x, y, x0, y_start, time_scale=time_scale, state_scale=state_scale,
+                      scale=scale, precision=precision)
+    tmp = Path(keep) if keep else Path(tempfile.mkdtemp(prefix="brakesqueal-auto-"))
+    tmp.mkdir(parents=True, exist_ok=True)
+    try:
+        exe, common, lab, _y_h = _to_first_hopf(src, tmp, x, y, x0, y_start, points, timeout)
+        common = {**common, "JAC": jac}
+        rows = _cycles_to_fold(tmp, exe, common, lab, ntst, direction, timeout)
+        lps = [r for r in rows if abs(int(r.get("TY", 0))) % 10 in (2, 5)]
+        if not lps:
+            raise BrakesquealError(f"AUTO-07p found no fold of cycles on the branch at {x.name} = {x0:.10g}")
+        lp_lab, y_lp = int(lps[0]["LAB"]), from_unit(y, lps[0]["PAR(2)"])
+        uzr = ", ".join(repr(to_unit(x, float(v))) for v in at)
+        xs: list[float] = []
+        ys: list[float] = []
+        labels: list[tuple[str, float, float]] = []
+        lpc: dict[str, object] = dict(**{**common, "IPS": 2, "ILP": 1, "ISP": 2, "NTST": ntst, "NPAR": 11,
+                                         "EPSS": "1e-6", "DSMIN": "1e-12", "ITMX": 20}, ICP="[2, 1, 11]", ISW=2,
+                                      DSMAX="0.02", UZR=f"{{1: [{uzr}]}}" if uzr else "{}",
+                                      UZSTOP="{1: [0.0, 1.0], 2: [0.0, 1.0]}")
+        # run 3: AUTO's start of a fold continuation of periodic orbits (the null vector; PAR(1) still fixed),
+        # then run 4 from its end, both ways (as AUTO's demo plp)
+        b7, _ = _run(tmp, exe, _constants(**lpc, IRS=lp_lab, DS="0.001"), tmp / "s.cyc", timeout, exit_crash_ok=True)
+        shutil.copy(tmp / "fort.8", tmp / "s.lpstart")
+        start = [int(r["LAB"]) for r in _parse_fort7(b7) if int(r.get("LAB", 0)) > 0]
+        if not start:
+            raise BrakesquealError("AUTO-07p's start of the fold continuation wrote no solution")
+        for sign in (1, -1):
+            c4 = _constants(**lpc, IRS=start[-1], DS=repr(sign * 1e-3))
+            b7, _ = _run(tmp, exe, c4, tmp / "s.lpstart", timeout, exit_crash_ok=True)
+            rows3 = [r for r in _parse_fort7(b7) if "PAR(1)" in r and "PAR(2)" in r]
+            # a user point inside the box is type -4 as the box's edge: the box's edges are 0 and 1 exactly
+            for r in rows3:
+                t = _ty(int(r.get("TY", 0)))
+                if t in ("", "RG", "EP"):
+                    continue
+                if t == "UZ" and min(abs(r["PAR(1)"]), abs(r["PAR(1)"] - 1), abs(r["PAR(2)"]),
+                                     abs(r["PAR(2)"] - 1)) < 1e-12:
+                    t = "EP"  # the box's edge
+                labels.append((t, from_unit(x, r["PAR(1)"]), from_unit(y, r["PAR(2)"])))
+            _join(xs, ys, [(from_unit(x, r["PAR(1)"]), from_unit(y, r["PAR(2)"])) for r in rows3], sign)
+        return AutoCurve(x.name, y.name, np.array(xs), np.array(ys), (float(x0), float(y_lp)), tuple(labels))
     finally:
         if not keep:
             shutil.rmtree(tmp, ignore_errors=True)

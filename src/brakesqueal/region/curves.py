@@ -14,13 +14,19 @@ axis): Newton on the minimally augmented system
 with ``lambda_c`` the tracked critical eigenvalue (continuity of the
 eigenvalue from the predictor, ``omega = Im lambda_c`` along the curve), ``s``
 the modulus of ``lambda_c`` at the start, and ``grad g`` by central
-differences of the exact eigenvalues.  Every point is on the linear stability
-boundary to the rounding of the eigenvalues (``|g| <= 1e-12``).
+differences of the exact eigenvalues (a chord iteration on the previous
+point's ``grad g``, refreshed where a step does not contract).  Every point is
+on the linear stability boundary to the rounding of the eigenvalues
+(``|g| <= 1e-12``).
 
 At each point the first Lyapunov coefficient is the project's
 (:func:`brakesqueal.nonlinear.implicit.exact_lyapunov`: the pads' true
 tangential rates, MatCont's normalisation), with the parameter whose partial
-derivative of ``Re lambda`` is larger as its path.
+derivative of ``Re lambda`` is larger as its path.  The point is already on
+the boundary and ``d lambda / dp`` is the curve's own difference, so the
+normal form is computed there directly
+(:func:`~brakesqueal.nonlinear.implicit.lyapunov_at_hopf`: no re-refinement,
+double-precision eigenvalues where their error bounds decide the checks).
 
 Between consecutive points the test functions of the codimension-2 points are
 watched and a sign change is located by bisection on the chord (each trial
@@ -231,16 +237,25 @@ def _grad(fld: _Field, u: np.ndarray, target: complex, scale: float) -> np.ndarr
 
 
 def _correct(fld: _Field, u0: np.ndarray, normal: np.ndarray | None, target: complex,
-             scale: float) -> tuple[np.ndarray, complex] | None:
-    """Newton on ``g(u) = 0`` and ``normal . (u - u0) = 0`` (``normal=None``: least-change step)."""
+             scale: float, grad0: np.ndarray | None = None) -> tuple[np.ndarray, complex] | None:
+    """Newton on ``g(u) = 0`` and ``normal . (u - u0) = 0`` (``normal=None``: least-change step).
+
+    With ``grad0`` (``grad g`` at a curve point a step away, e.g. the one the predictor left) the iteration is
+    a chord method on it, one eigenvalue evaluation an iteration instead of five; ``grad g`` is evaluated
+    afresh (Newton) wherever a step does not shrink to half the previous one.  Both stop at the same
+    tolerance on the step.
+    """
     u = np.array(u0, dtype=float)
     lam = target
-    for _ in range(16):
+    grad = None if grad0 is None else np.asarray(grad0, dtype=float)
+    prev = math.inf
+    for _ in range(16 if grad0 is None else 24):
         gv = _g(fld, u, lam, scale)
         if gv is None:
             return None
         g, lam = gv
-        grad = _grad(fld, u, lam, scale)
+        if grad is None:
+            grad = _grad(fld, u, lam, scale)
         if grad is None or not np.all(np.isfinite(grad)) or not np.any(grad):
             return None
         if normal is None:
@@ -253,11 +268,15 @@ def _correct(fld: _Field, u0: np.ndarray, normal: np.ndarray | None, target: com
             except np.linalg.LinAlgError:
                 return None
         u = u + du
-        if float(np.max(np.abs(du))) <= _NEWTON_TOL:
+        size = float(np.max(np.abs(du)))
+        if size <= _NEWTON_TOL:
             gv = _g(fld, u, lam, scale)
             if gv is None:
                 return None
             return u, gv[1]
+        if grad0 is None or size > 0.5 * prev:  # Newton, or a chord step that did not contract: a fresh gradient
+            grad = None
+        prev = size
     return None
 
 
@@ -323,6 +342,7 @@ class _Raw:
     u: np.ndarray
     lam: complex
     tangent: np.ndarray
+    grad: np.ndarray | None = None  # grad g at u (the chord corrector's matrix for the next point)
 
 
 def _counts(lams: np.ndarray, lam: complex, scale: float) -> tuple[int, int]:
@@ -346,7 +366,7 @@ def _branch(fld: _Field, start: _Raw, direction: float, scale: float, ds0: float
             return pts, "step too small"
         pred = cur.u + ds * t
         lam_pred = cur.lam
-        res = _correct(fld, pred, t, lam_pred, scale)
+        res = _correct(fld, pred, t, lam_pred, scale, cur.grad)
         if res is not None:
             u, lam = res
             ok = (abs(lam - cur.lam) <= 0.2 * abs(cur.lam) and float(np.linalg.norm(u - cur.u)) <= 2 * ds)
@@ -369,7 +389,7 @@ def _branch(fld: _Field, start: _Raw, direction: float, scale: float, ds0: float
         tn /= np.linalg.norm(tn)
         if float(tn @ t) < 0:
             tn = -tn
-        new = _Raw(u, lam, tn)
+        new = _Raw(u, lam, tn, grad)
         inside = bool(np.all(u >= -1e-12) and np.all(u <= 1 + 1e-12))
         if not inside:
             edge = _to_edge(fld, cur, new, scale)
@@ -403,7 +423,7 @@ def _to_edge(fld: _Field, a: _Raw, b: _Raw, scale: float) -> _Raw | None:
     u0[i] = bound
     normal = np.zeros(2)
     normal[i] = 1.0
-    res = _correct(fld, u0, normal, a.lam + s * (b.lam - a.lam), scale)
+    res = _correct(fld, u0, normal, a.lam + s * (b.lam - a.lam), scale, a.grad)
     if res is None:
         return None
     u, lam = res
@@ -431,7 +451,7 @@ def _bisect_chord(fld: _Field, a: _Raw, b: _Raw, scale: float,
                 s = 0.5 * (lo + hi)
         else:
             s = 0.5 * (lo + hi)
-        res = _correct(fld, a.u + s * chord, n, a.lam + s * (b.lam - a.lam), scale)
+        res = _correct(fld, a.u + s * chord, n, a.lam + s * (b.lam - a.lam), scale, a.grad)
         if res is None:
             return best
         u, lam = res
@@ -456,10 +476,29 @@ def _bisect_chord(fld: _Field, a: _Raw, b: _Raw, scale: float,
     return best
 
 
+def _dlam(fld: _Field, u: np.ndarray, lam: complex, i: int) -> complex | None:
+    """``d lambda / d(axis i)`` [SI] at a curve point: the central difference of :func:`_grad` (the same,
+    cached eigenvalues) in unit coordinates, times ``du/dp`` of the axis."""
+    e = np.zeros(2)
+    e[i] = _FD
+    lp, lm = fld.track(u + e, lam), fld.track(u - e, lam)
+    if lp is None or lm is None:
+        return None
+    ax, v = fld.axes[i], fld.values(u)[i]
+    if ax.log:
+        du_dp = 1.0 / (v * math.log(10.0) * (math.log10(ax.stop) - math.log10(ax.start)))
+    else:
+        du_dp = 1.0 / (ax.stop - ax.start)
+    return complex((lp - lm) / (2 * _FD) * du_dp)
+
+
 def _l1(engine: Engine, space: ParameterSpace, fld: _Field, u: np.ndarray, lam: complex,
         scale: float, use_cache: bool) -> tuple[float | None, float | None, str, str]:
-    """l1 with the pads' true rates (:func:`~brakesqueal.nonlinear.implicit.exact_lyapunov`)."""
-    from ..nonlinear.implicit import exact_lyapunov
+    """l1 with the pads' true rates at a corrected curve point, along the parameter whose partial derivative of
+    ``Re lambda`` is larger: :func:`~brakesqueal.nonlinear.implicit.lyapunov_at_hopf` (the point, its
+    eigenvalue and ``d lambda / dp`` from the curve; no refinement), the normal form of
+    :func:`~brakesqueal.nonlinear.implicit.exact_lyapunov`."""
+    from ..nonlinear.implicit import exact_lyapunov, lyapunov_at_hopf
 
     xv, yv = fld.values(u)
     xa, ya = fld.axes
@@ -467,12 +506,15 @@ def _l1(engine: Engine, space: ParameterSpace, fld: _Field, u: np.ndarray, lam: 
     along_y = grad is None or abs(grad[1]) >= abs(grad[0])
     fixed, path, value = (xa.name, xv) if along_y else (ya.name, yv), ya.name if along_y else xa.name, \
         (yv if along_y else xv)
+    dl = _dlam(fld, u, lam, 1 if along_y else 0)
+    sub = space.with_values({fixed[0]: fixed[1]})
     try:
-        ex = exact_lyapunov(engine, space.with_values({fixed[0]: fixed[1]}), path, value, omega=lam.imag,
-                            use_cache=use_cache)
+        if dl is None:  # no derivative from the curve (a neighbour outside the allowed range): the full route
+            h = exact_lyapunov(engine, sub, path, value, omega=lam.imag, use_cache=use_cache).hopf
+        else:
+            h = lyapunov_at_hopf(engine, sub, path, value, lam, dl, use_cache=use_cache)
     except (BrakesquealError, np.linalg.LinAlgError, ValueError) as exc:
         return None, None, "unknown", f"no l1: {exc}"
-    h = ex.hopf
     return float(h.l1), float(h.l1_error), h.criticality, "; ".join(h.warnings)
 
 
@@ -524,7 +566,7 @@ def continue_hopf_curve(engine: Engine, space: ParameterSpace, x: Axis, y: Axis,
     if grad is None:
         raise BrakesquealError("the Hopf curve's tangent is not defined at the start")
     t = np.array([-grad[1], grad[0]]) / float(np.linalg.norm(grad))
-    start = _Raw(u, lam, t)
+    start = _Raw(u, lam, t, grad)
     fwd, end_f = _branch(fld, start, 1.0, scale, ds, ds_max, max_points, u)
     if end_f == "closed loop":
         bwd: list[_Raw] = []

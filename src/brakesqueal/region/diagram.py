@@ -53,7 +53,8 @@ _SHADED = ("squeal possible although linearly stable: shaded between each fold-o
            "of its cycles where the pads lose contact before the branch folds (the fold is not computed there)")
 _NO_GH = "no generalised-Hopf point in the box: no fold-of-cycles curve, nothing shaded"
 #: Names of the shaded regions (keys of ``regions`` in the JSON).
-REGIONS = {"LPC": "squeal_possible_although_linearly_stable", "contact_loss": "contact_lost"}
+REGIONS = {"LPC": "squeal_possible_although_linearly_stable", "contact_loss": "contact_lost",
+           "LPC_bilateral": "bilateral_equations_fold_band"}
 
 
 def _check(engine: Engine, space: ParameterSpace, x: Axis, y: Axis) -> None:
@@ -303,7 +304,8 @@ class RegionResult:
     def _fold_dict(self, f: FoldCurve) -> dict[str, Any]:
         xn, yn = self.x.name, self.y.name
         pts = [{xn: p.x, yn: p.y, "kind": p.kind, "amplitude": p.amplitude, "period": p.period, "route": p.route,
-                "contact_lost": p.contact_lost, f"hopf_{f.along}": p.hopf, "description": FOLD_KINDS[p.kind],
+                "contact_lost": p.contact_lost, "contact_loss": p.contact_loss, f"hopf_{f.along}": p.hopf,
+                "description": FOLD_KINDS[p.kind],
                 **({"message": p.message} if p.message else {})} for p in f.points]
         return {"curve": f.curve, "gh": {xn: f.gh[0], yn: f.gh[1]}, "along": f.along, "points": pts,
                 "notes": list(f.notes),
@@ -333,12 +335,16 @@ class RegionResult:
             lines.append(f"fold-of-cycles curves: {_NO_GH}")
         for f in self.folds or []:
             n_f = sum(p.kind == "LPC" for p in f.points)
-            n_c = sum(p.kind == "contact_loss" for p in f.points)
+            n_c = sum(p.kind in ("contact_loss", "LPC_bilateral") for p in f.points)
+            n_b = sum(p.kind == "LPC_bilateral" for p in f.points)
             lines.append(f"fold-of-cycles curve from GH at {xn} = {f.gh[0]:.8g}, {yn} = {f.gh[1]:.8g} (branches along "
-                         f"{f.along}): {n_f} fold(s), {n_c} slice(s) where contact is lost before the fold")
+                         f"{f.along}): {n_f} fold(s), {n_c} slice(s) where contact is lost before the fold"
+                         + (f" ({n_b} followed on to the fold of the bilateral equations)" if n_b else ""))
             for p in f.points[1:]:
                 amp = max(p.amplitude.values(), default=float("nan"))
-                what = "fold of cycles" if p.kind == "LPC" else "contact lost (no fold before)"
+                what = {"LPC": "fold of cycles", "contact_loss": "contact lost (no fold before)",
+                        "LPC_bilateral": f"fold of the bilateral equations (contact lost before it, at "
+                                         f"{f.along} = {p.contact_loss:.10g})"}[p.kind]
                 gap = abs((p.x if f.axis == "x" else p.y) - p.hopf)
                 lines.append(f"  {what} at {xn} = {p.x:.10g}, {yn} = {p.y:.10g} ({gap:.3g} from the Hopf point "
                              f"{f.along} = {p.hopf:.10g}; amplitude {amp:.4g}, period {p.period:.6g} s; {p.route})")
@@ -384,7 +390,8 @@ class RegionResult:
         ds[f"fold_{xn}"] = ("fold_point", arr([p.x for _, _, p in fps]), {"units": ux})
         ds[f"fold_{yn}"] = ("fold_point", arr([p.y for _, _, p in fps]), {"units": uy})
         ds["fold_kind"] = ("fold_point", np.array([p.kind for _, _, p in fps], dtype="S"),
-                           {"long_name": "GH, LPC (fold of cycles) or contact_loss (contact lost before the fold)"})
+                           {"long_name": "GH, LPC (fold of cycles), contact_loss (contact lost before the fold) or "
+                                         "LPC_bilateral (fold of the bilateral equations beyond the contact loss)"})
         ds["fold_hopf"] = ("fold_point", arr([p.hopf for _, _, p in fps]),
                            {"long_name": "the slice's subcritical Hopf point on the axis of fold_along"})
         ds["fold_along"] = ("fold_point", np.array([f.along for _, f, _ in fps], dtype="S"))
@@ -393,6 +400,10 @@ class RegionResult:
         ds["fold_period"] = ("fold_point", arr([p.period for _, _, p in fps]), {"units": "s"})
         ds["fold_route"] = ("fold_point", np.array([p.route for _, _, p in fps], dtype="S"))
         ds["fold_contact_lost"] = ("fold_point", np.array([p.contact_lost for _, _, p in fps], dtype=np.int8))
+        ds["fold_contact_loss"] = ("fold_point", arr([math.nan if p.contact_loss is None else p.contact_loss
+                                                      for _, _, p in fps]),
+                                   {"long_name": "where the slice's cycles lose contact, on the axis of fold_along "
+                                                 "(NaN: they do not before the point)"})
         return ds
 
     def plot(self) -> Figure:
@@ -453,7 +464,8 @@ class RegionResult:
                 from matplotlib.patches import Patch
 
                 fills = {"LPC": ("tab:orange", "squeal possible although linearly stable"),
-                         "contact_loss": ("tab:purple", "contact lost (before the fold)")}
+                         "contact_loss": ("tab:purple", "contact lost (before the fold)"),
+                         "LPC_bilateral": ("tab:gray", "cycles of the bilateral equations (contact lost)")}
                 for kind, (col, label) in fills.items():
                     polys = [poly for f in self.folds for poly in f.regions(kind)]
                     for poly in polys:
@@ -467,12 +479,19 @@ class RegionResult:
                     if len(lpc) > 1:
                         ax.plot([p.x for p in lpc], [p.y for p in lpc], color="tab:green", lw=1.6, zorder=4)
                         drawn.add("LPC")
+                    bl = [p for p in f.points if p.kind in ("GH", "LPC_bilateral")]
+                    if len(bl) > 1:
+                        ax.plot([p.x for p in bl], [p.y for p in bl], color="tab:gray", lw=1.2, ls="--", zorder=4)
+                        drawn.add("LPCB")
                     cl = [p for p in f.points if p.kind == "contact_loss"]
                     if cl:
                         ax.plot([p.x for p in cl], [p.y for p in cl], "x", color="tab:purple", ms=4, zorder=4)
                         drawn.add("CL")
                 if "LPC" in drawn:
                     handles.append(Line2D([], [], color="tab:green", lw=1.6, label="fold of cycles"))
+                if "LPCB" in drawn:
+                    handles.append(Line2D([], [], color="tab:gray", lw=1.2, ls="--",
+                                          label="fold of the bilateral equations (beyond contact loss)"))
                 if "CL" in drawn:
                     handles.append(Line2D([], [], color="tab:purple", marker="x", ls="", ms=4,
                                           label="contact loss of the cycles (no fold before)"))
@@ -490,7 +509,7 @@ def region_diagram(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, *, s
            max_points: Annotated[int, Range(2, 10000)] = 200, ds_max: Annotated[float, Range(1e-4, 0.5)] = 0.05,
            grid: Annotated[int, Range(2, 2000)] | None = 41, lyapunov: bool = True,
            use_cache: bool = True, folds: bool = True, fold_points: Annotated[int, Range(1, 50)] = 6,
-           progress: Callable[[float], None] | None = None) -> RegionResult:
+           fold_contact: str = "stop", progress: Callable[[float], None] | None = None) -> RegionResult:
     """The squeal region diagram: Hopf curves with ``l1`` and codimension-2 points, and the certified map.
 
     Parameters
@@ -518,6 +537,10 @@ def region_diagram(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, *, s
         regions (:func:`~.folds.fold_curves`).
     fold_points : int
         Slices (cycle branches) per GH point.
+    fold_contact : {"stop", "bilateral"}
+        ``"stop"``: a slice whose cycles lose contact before folding ends at the contact loss (the brake);
+        ``"bilateral"``: it is followed on to the fold of the smooth bilateral equations (as AUTO-07p does;
+        ``LPC_bilateral``, a fold of the model rather than of the brake) (:func:`~.folds.fold_curves`).
     progress : callable, optional
         ``progress(fraction)`` while the fold-of-cycles curves are computed.
 
@@ -542,6 +565,7 @@ def region_diagram(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, *, s
                           _Axis(y.name, y.start, y.stop, grid, y.log), boundary=True)
     fc = None
     if folds and lyapunov:
-        fc, fnotes = fold_curves(eng, space, x, y, curves, points=fold_points, progress=progress)
+        fc, fnotes = fold_curves(eng, space, x, y, curves, points=fold_points, progress=progress,
+                                 contact=fold_contact)
         notes = notes + fnotes
     return RegionResult(space, x, y, curves, m, notes, time.perf_counter() - t0, fc)

@@ -17,6 +17,15 @@ the degenerate Hopf point, harmonic balance with the exact pads, recorded in ``r
 * where no fold comes first, the located contact loss (``kind = "contact_loss"``, ``contact_lost = True``):
   the bilateral equations no longer describe the brake beyond it, so the fold, if any, is not computed.
 
+With ``contact="bilateral"`` a slice whose branch loses contact first is followed on through the (ignored) contact
+loss to the fold of the smooth bilateral equations, which is what AUTO-07p and other continuation tools compute
+(they know nothing of contact loss): shooting from the branch's last orbit, the parameter's scale growing with the
+distance covered, to the first turning point (``kind = "LPC_bilateral"``, ``contact_lost = True`` and
+``contact_loss`` where the pads would have lifted off).  On the brake models that fold lies orders of magnitude
+beyond the contact loss (Fig. 3's set: 600 to 7500 times farther from the Hopf point), and the first folds of
+neighbouring slices need not lie on one fold-of-cycles curve (AUTO's two-parameter continuation of one slice's
+fold passes other slices at other folds), so the polygons between slices are a sketch there.
+
 Each slice's branch is computed with the slice's only stability crossing inside its range (the range runs
 from the previous to the next crossing along the slice, or the box's edges), so the library's "first Hopf point
 in the range" is the subcritical one.
@@ -47,6 +56,9 @@ FOLD_KINDS: dict[str, str] = {
     "LPC": "fold of cycles: a turning point of the slice's cycle branch, every pad in contact",
     "contact_loss": "the slice's cycle branch loses contact before any fold (the fold is not computed: the "
                     "bilateral equations do not hold beyond)",
+    "LPC_bilateral": "fold of cycles of the bilateral equations beyond the slice's contact loss (contact = "
+                     "'bilateral'): the pads would have lifted off before it (at contact_loss), so it is a fold of "
+                     "the smooth model, not of the brake",
 }
 
 
@@ -74,6 +86,9 @@ class FoldPoint:
         The branch lost contact before folding.
     message : str
         How the route was chosen, when not by the rule of ``cycles``.
+    contact_loss : float or None
+        Where the slice's branch loses contact (value of the slice's axis ``along``), when it does before the
+        point (``kind = "contact_loss"`` or ``"LPC_bilateral"``).
     """
 
     x: float
@@ -85,6 +100,7 @@ class FoldPoint:
     route: str
     contact_lost: bool
     message: str = ""
+    contact_loss: float | None = None
 
 
 @dataclass(frozen=True)
@@ -128,7 +144,7 @@ class FoldCurve:
 
         Parameters
         ----------
-        kind : {"LPC", "contact_loss"}
+        kind : {"LPC", "contact_loss", "LPC_bilateral"}
 
         Returns
         -------
@@ -230,6 +246,115 @@ def _branch_point(b: Any) -> tuple[str, float, dict[str, float], float] | None:
     return None
 
 
+def _first_lpc(ds: Any) -> tuple[int, float, dict[str, float], float] | None:
+    """(index, parameter, first-harmonic amplitude of the displacements, period) of a shooting branch's first fold
+    of cycles (any contact), else ``None``."""
+    coords = [str(c) for c in ds["coord"].values]
+    disp = [j for j, c in enumerate(coords) if not (c.startswith("d") and c[1:] in coords)]
+    amp = ds["amplitude"].values
+    for kind, idx, pv in zip(ds["special_kind"].values, ds["special_index"].values, ds["special_p"].values):
+        if str(kind) == "LPC":
+            i = int(idx)
+            return i, float(pv), {coords[j]: float(amp[i, j]) for j in disp}, float(ds["period"].values[i])
+    return None
+
+
+def _bilateral_fold(engine: Engine, space: ParameterSpace, ax: Axis, b: Any, h: float, passes: int = 6,
+                    points_per_pass: int = 40) -> tuple[float, dict[str, float], float, str]:
+    """The first fold of cycles of the bilateral (smooth) equations on a slice's branch ``b`` past its contact
+    loss: the branch's own when it has one, else a shooting continuation of the smooth system from the branch's
+    last orbit, restarted with the parameter's scale set to the distance covered from the Hopf point ``h`` (so the
+    steps grow geometrically out to a fold far beyond the contact loss).  Returns ``(parameter, amplitude,
+    period, how)``; raises :class:`BrakesquealError` when no fold is found in the slice's range."""
+    from ..nonlinear.continuation import continue_cycles
+    from ..nonlinear.models import model_system
+    from ..nonlinear.periodic import ShootingError, find_periodic_orbit
+
+    system = model_system(engine, space, ax.name)
+    if hasattr(b, "points") and hasattr(b, "folds"):  # harmonic balance: shoot its last orbit
+        from ..nonlinear.harmonic import shooting_flow
+
+        for f in b.folds:
+            pts = list(b.points)
+            i = int(np.argmin([abs(pt.p - f) for pt in pts]))
+            return float(f), dict(pts[i].amplitude), 2 * math.pi / pts[i].omega, "harmonic balance"
+        chk = shooting_flow(engine, space, ax, tuple(b.coords), True)
+        if chk is None:
+            raise BrakesquealError("the bilateral fold needs shooting, which these pads do not allow")
+        pt = list(b.points)[-1]
+        x0, _sc = chk.state(pt.coefficients, pt.omega)
+        try:
+            orbit = find_periodic_orbit(system, x0, period=2 * math.pi / pt.omega, p=float(pt.p))
+        except ShootingError as exc:
+            raise BrakesquealError(f"shooting the harmonic-balance orbit at {ax.name} = {pt.p:.10g} failed: "
+                                   f"{exc}") from None
+    else:
+        r = _first_lpc(b.data)
+        if r is not None:
+            return r[1], r[2], r[3], "shooting"
+        orbit = b.branch.orbits[-1]
+    lo, hi = ax.start, ax.stop
+    for _ in range(passes):
+        d = abs(float(orbit.p) - h)
+        direction = 1 if float(orbit.p) > h else -1
+        br = None
+        # tol 1e-7 (then 1e-6): a state with a large mean (the disk's rate) keeps the shooting's scaled update
+        # above 1e-8 at these small amplitudes
+        for tol in (1e-7, 1e-6):
+            try:
+                br = continue_cycles(system, orbit, (lo, hi), direction=direction, p_scale=20 * d, ds_max=1.0,
+                                     max_points=points_per_pass, detect=("LPC",), tol=tol)
+                break
+            except (ShootingError, BrakesquealError) as exc:
+                err = exc
+        if br is None:
+            raise BrakesquealError(f"the bilateral continuation from {ax.name} = {float(orbit.p):.10g} failed: "
+                                   f"{err}")
+        r = _first_lpc(br.data)
+        if r is not None:
+            return r[1], r[2], r[3], "shooting"
+        if br.status != "max_points" or len(br.orbits) < 2:
+            raise BrakesquealError(f"the bilateral branch ended ({br.message}) before a fold")
+        orbit = br.orbits[-1]
+    raise BrakesquealError(f"no bilateral fold within {passes * points_per_pass} continuation steps past "
+                           f"{ax.name} = {float(orbit.p):.10g}")
+
+
+def _slice_point(engine: Engine, space: ParameterSpace, ax: Axis, h: float, max_branch_points: int,
+                 contact: str) -> tuple[str, float, dict[str, float], float, str, str, float | None]:
+    """One slice's point: ``(kind, parameter, amplitude, period, route, message, contact loss)`` from the cycle
+    branch of the Hopf point ``h``, the only stability crossing in ``ax`` (raises :class:`BrakesquealError` when
+    the branch ends before a fold or a contact loss)."""
+    from ..nonlinear.models import limit_cycles
+
+    msg = ""
+    # the route of `cycles` (limit_cycles owns it, including its fallback to harmonic balance where the shooting
+    # cannot start: the branch's own `route` and `message` say which ran)
+    b = limit_cycles(engine, space, ax, max_points=max_branch_points)
+    route = str(b.to_dict()["route"])
+    r = _branch_point(b)
+    if route == "harmonic balance" and str(b.message).startswith("shooting did not converge"):
+        msg = str(b.message)
+    if r is None and route == "shooting":
+        msg = (f"the shooting branch ended ({b.to_dict()['message']}) before a fold or a contact loss; harmonic "
+               "balance with the exact pads")
+        route = "harmonic balance"
+        b = limit_cycles(engine, space, ax, pads="exact", max_points=max_branch_points)
+        r = _branch_point(b)
+    if r is None:
+        raise BrakesquealError(f"the branch from {ax.name} = {h:.10g} ended ({b.to_dict()['message']}) before a "
+                               "fold or a contact loss")
+    kind, pv, amp, period = r
+    loss = pv if kind == "contact_loss" else None
+    if loss is not None and contact == "bilateral":
+        pv, amp, period, how = _bilateral_fold(engine, space, ax, b, h)
+        kind = "LPC_bilateral"
+        msg = "; ".join(m for m in (msg, f"the pads lift off at {ax.name} = {loss:.10g}; fold of the bilateral "
+                                    f"equations ({how})") if m)
+        route = how
+    return kind, pv, amp, period, route, msg, loss
+
+
 def _slice_range(engine: Engine, space: ParameterSpace, ax: Axis, h_est: float) -> tuple[float, float, float] | None:
     """The slice's crossing nearest ``h_est`` and a range holding it alone (previous/next crossing or the box)."""
     from ..analysis.crossings import crossings
@@ -246,7 +371,7 @@ def _slice_range(engine: Engine, space: ParameterSpace, ax: Axis, h_est: float) 
 
 
 def fold_curves(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, curves: list[HopfCurve], *,
-                points: int = 6, max_branch_points: int = 60,
+                points: int = 6, max_branch_points: int = 60, contact: str = "stop",
                 progress: Callable[[float], None] | None = None) -> tuple[list[FoldCurve], list[str]]:
     """The fold-of-cycles curve of every generalised-Hopf point of ``curves`` (see the module's description).
 
@@ -264,6 +389,12 @@ def fold_curves(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, curves:
         Slices per GH point (each one cycle branch).
     max_branch_points : int
         Largest number of points of each slice's branch.
+    contact : {"stop", "bilateral"}
+        ``"stop"`` (default): the brake, whose pads lift off: a slice whose branch loses contact before folding
+        gives a ``contact_loss`` point.  ``"bilateral"``: the smooth bilateral equations (as AUTO-07p
+        and other tools continue them): such a slice is continued through the ignored contact loss to its fold,
+        an ``LPC_bilateral`` point (``contact_lost = True``, ``contact_loss`` where the pads would have lifted
+        off).
     progress : callable, optional
         ``progress(fraction)`` after each slice.
 
@@ -273,7 +404,11 @@ def fold_curves(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, curves:
         The curves and notes (GH points without a curve and why).
     """
     from ..analysis.maps import Axis as _Axis
-    from ..nonlinear.models import limit_cycles
+    from ..errors import ParameterError
+
+    if contact not in ("stop", "bilateral"):
+        raise ParameterError(f"The option 'contact' must be stop or bilateral; got {contact!r}",
+                             parameter="contact")
 
     ghs = [(i, s) for i, c in enumerate(curves) for s in c.special_points if s.type == "GH"]
     out: list[FoldCurve] = []
@@ -326,27 +461,10 @@ def fold_curves(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, curves:
                     raise BrakesquealError("no stability crossing on the slice")
                 h, lo, hi = rng
                 ax = _Axis(bax.name, lo, hi, 2, bax.log)
-                msg = ""
-                # the route of `cycles` (limit_cycles owns it, including its fallback to harmonic balance where
-                # the shooting cannot start: the branch's own `route` and `message` say which ran)
-                b = limit_cycles(engine, sp, ax, max_points=max_branch_points)
-                route = str(b.to_dict()["route"])
-                r = _branch_point(b)
-                if route == "harmonic balance" and str(b.message).startswith("shooting did not converge"):
-                    msg = str(b.message)
-                if r is None and route == "shooting":
-                    msg = (f"the shooting branch ended ({b.to_dict()['message']}) before a fold or a contact "
-                           "loss; harmonic balance with the exact pads")
-                    route = "harmonic balance"
-                    b = limit_cycles(engine, sp, ax, pads="exact", max_points=max_branch_points)
-                    r = _branch_point(b)
-                if r is None:
-                    fnotes.append(f"slice {where}: the branch from {bax.name} = {h:.10g} ended "
-                                  f"({b.to_dict()['message']}) before a fold or a contact loss")
-                else:
-                    kind, pv, amp, period = r
-                    px, py = (v, pv) if step_i == 0 else (pv, v)
-                    fpts.append(FoldPoint(px, py, kind, h, amp, period, route, kind == "contact_loss", msg))
+                kind, pv, amp, period, route, msg, loss = _slice_point(engine, sp, ax, h, max_branch_points,
+                                                                       contact)
+                px, py = (v, pv) if step_i == 0 else (pv, v)
+                fpts.append(FoldPoint(px, py, kind, h, amp, period, route, kind != "LPC", msg, loss))
             except BrakesquealError as exc:
                 fnotes.append(f"slice {where}: {exc}")
             done += 1
