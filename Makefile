@@ -26,8 +26,11 @@ XDIST = -n $(PYTEST_WORKERS) --dist loadfile
 test: $(STAMP)
 	$(BIN)/python -m pytest -q -m "not slow" $(XDIST)
 
+# the explorer's browser tests time a served page in chromium: they run alone, after the others
+BROWSER_TESTS = tests/explorer/test_browser.py tests/explorer/test_browser_layout.py tests/explorer/test_browser_security.py
 test-slow: $(STAMP)
-	$(BIN)/python -m pytest -q -m slow $(XDIST)
+	$(BIN)/python -m pytest -q -m slow $(XDIST) $(addprefix --ignore=,$(BROWSER_TESTS))
+	$(BIN)/python -m pytest -q -m slow $(BROWSER_TESTS)
 
 test-all: $(STAMP)
 	$(BIN)/python -m pytest -q $(XDIST)

@@ -139,7 +139,7 @@ def _space(models, name: str) -> ParameterSpace:
 
 
 # ------------------------------------------------------------------ mpmath: the laws written out by hand
-mpmath.mp.dps = 50
+# (50 digits inside _linear_twin only: a module-level mpmath.mp.dps would change every later test in the process)
 
 
 def _mu_stribeck(v, mu, mus, vs):
@@ -152,9 +152,10 @@ def _mu_stick(v, mu, vreg, slope):
 
 def _linear_twin(mu_of_v, v_star: float) -> dict[str, float]:
     """``muL``, ``sL`` of the linear law with the same value and slope at ``v*`` (mpmath, 50 digits)."""
-    v = mpmath.mpf(v_star)
-    s = -mpmath.diff(mu_of_v, v)
-    return {"muL": float(mu_of_v(v) + s * v), "sL": float(s)}
+    with mpmath.workdps(50):
+        v = mpmath.mpf(v_star)
+        s = -mpmath.diff(mu_of_v, v)
+        return {"muL": float(mu_of_v(v) + s * v), "sL": float(s)}
 
 
 def _check_finite_verdict(lm) -> tuple[int, float]:
