@@ -36,7 +36,7 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import numpy as np
 
@@ -427,6 +427,19 @@ def _labelled_end(b7: str) -> bool:
     return bool(rows) and int(rows[-1].get("LAB", 0)) > 0 and int(rows[-1].get("TY", 0)) != 0
 
 
+def _prepare(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0: float, y_start: float, keep: str | None,
+             **source: Any) -> tuple[str, Path]:
+    """The checks every AUTO run makes first (AUTO installed), the exported user functions
+    (:func:`auto_source` with ``source``'s options) and the run's directory (``keep``, else a new temporary one)."""
+    why = auto_available()
+    if why:
+        raise BrakesquealError(why)
+    src = auto_source(engine, space, x, y, x0, y_start, **source)
+    tmp = Path(keep) if keep else Path(tempfile.mkdtemp(prefix="brakesqueal-auto-"))
+    tmp.mkdir(parents=True, exist_ok=True)
+    return src, tmp
+
+
 def _join(xs: list[float], ys: list[float], pts: list[tuple[float, float]], sign: int) -> None:
     """Add one direction's points of a curve continued both ways from its start: ``sign > 0`` after the points
     so far, ``sign < 0`` reversed before them (so the curve runs in one direction)."""
@@ -554,15 +567,10 @@ def auto_cycle_branch(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x
     BrakesquealError
         AUTO-07p is not installed, the build or a run fails, or no Hopf point.
     """
-    why = auto_available()
-    if why:
-        raise BrakesquealError(why)
     if direction == 0:
         raise ParameterError("The option 'direction' must be 1 or -1; got 0", parameter="direction")
-    src = auto_source(engine, space, x, y, x0, y_start, time_scale=time_scale, state_scale=state_scale,
-                      scale=scale, precision=precision)
-    tmp = Path(keep) if keep else Path(tempfile.mkdtemp(prefix="brakesqueal-auto-"))
-    tmp.mkdir(parents=True, exist_ok=True)
+    src, tmp = _prepare(engine, space, x, y, x0, y_start, keep, time_scale=time_scale, state_scale=state_scale,
+                        scale=scale, precision=precision)
     try:
         exe, common, lab, y_h = _to_first_hopf(src, tmp, x, y, x0, y_start, points, timeout)
         rows = _cycles_to_fold(tmp, exe, common, lab, ntst, direction, timeout)
@@ -622,13 +630,8 @@ def auto_hopf_curve(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0:
     BrakesquealError
         AUTO-07p is not installed (one line saying what is missing), the build or a run fails, or no Hopf point.
     """
-    why = auto_available()
-    if why:
-        raise BrakesquealError(why)
-    src = auto_source(engine, space, x, y, x0, y_start, time_scale=time_scale, state_scale=state_scale,
-                      scale=scale, precision=precision)
-    tmp = Path(keep) if keep else Path(tempfile.mkdtemp(prefix="brakesqueal-auto-"))
-    tmp.mkdir(parents=True, exist_ok=True)
+    src, tmp = _prepare(engine, space, x, y, x0, y_start, keep, time_scale=time_scale, state_scale=state_scale,
+                        scale=scale, precision=precision)
     try:
         exe, common, lab, y_h = _to_first_hopf(src, tmp, x, y, x0, y_start, points, timeout)
         common = {**common, "JAC": jac}
@@ -695,15 +698,10 @@ def auto_fold_curve(engine: Engine, space: ParameterSpace, x: Axis, y: Axis, x0:
     BrakesquealError
         AUTO-07p is not installed, the build or a run fails, no Hopf point, or no fold on the cycle branch.
     """
-    why = auto_available()
-    if why:
-        raise BrakesquealError(why)
     if direction == 0:
         raise ParameterError("The option 'direction' must be 1 or -1; got 0", parameter="direction")
-    src = auto_source(engine, space, x, y, x0, y_start, time_scale=time_scale, state_scale=state_scale,
-                      scale=scale, precision=precision)
-    tmp = Path(keep) if keep else Path(tempfile.mkdtemp(prefix="brakesqueal-auto-"))
-    tmp.mkdir(parents=True, exist_ok=True)
+    src, tmp = _prepare(engine, space, x, y, x0, y_start, keep, time_scale=time_scale, state_scale=state_scale,
+                        scale=scale, precision=precision)
     try:
         exe, common, lab, _y_h = _to_first_hopf(src, tmp, x, y, x0, y_start, points, timeout)
         common = {**common, "JAC": jac}

@@ -463,9 +463,10 @@ class RegionResult:
             else:
                 from matplotlib.patches import Patch
 
+                # the bilateral folds are drawn as a line only: their band interpolates between slices whose
+                # first folds need not lie on one curve (it would bulge past the folds between far-apart slices)
                 fills = {"LPC": ("tab:orange", "squeal possible although linearly stable"),
-                         "contact_loss": ("tab:purple", "contact lost (before the fold)"),
-                         "LPC_bilateral": ("tab:gray", "cycles of the bilateral equations (contact lost)")}
+                         "contact_loss": ("tab:purple", "contact lost (before the fold)")}
                 for kind, (col, label) in fills.items():
                     polys = [poly for f in self.folds for poly in f.regions(kind)]
                     for poly in polys:
