@@ -65,10 +65,6 @@ def _bt_normal_form(u: np.ndarray) -> np.ndarray:
     return np.linalg.eigvals(np.array([[0.0, 1.0], [b2 + 2 * x0, x0]])).astype(complex)
 
 
-@pytest.mark.xfail(strict=True, reason="known limitation (issue 28): on the true BT normal form the continuation "
-                   "stops with 'step too small' at omega ~ 0.045 (the tracked pair's continuity test shrinks the "
-                   "step as omega -> 0 like sqrt) instead of labelling the BT point; the synthetic unfolding above, "
-                   "whose pair meets on the real axis, is labelled")
 def test_bogdanov_takens_normal_form_hopf_curve_and_point(monkeypatch):
     """On the Bogdanov-Takens normal form the Hopf curve is b1 = 0 for b2 < 0 with omega = sqrt(-b2), ending at
     the BT point b1 = b2 = 0 (closed forms; beyond it b1 = 0 is a neutral saddle, real eigenvalues +-sqrt(b2)):

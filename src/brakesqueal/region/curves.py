@@ -363,7 +363,7 @@ def _branch(fld: _Field, start: _Raw, direction: float, scale: float, ds0: float
     travelled = 0.0
     while len(pts) < max_points:
         if ds < 1e-7:
-            return pts, "step too small"
+            return pts, "Bogdanov-Takens" if _bt_ahead(start, pts, scale) is not None else "step too small"
         pred = cur.u + ds * t
         lam_pred = cur.lam
         res = _correct(fld, pred, t, lam_pred, scale, cur.grad)
@@ -374,8 +374,8 @@ def _branch(fld: _Field, start: _Raw, direction: float, scale: float, ds0: float
             ok = False
         if not ok:
             if ds < 1e-6:
-                if cur.lam.imag < 0.05 * scale:  # the pair meets on the real axis ahead
-                    return pts, "Bogdanov-Takens"
+                if cur.lam.imag < 0.05 * scale or _bt_ahead(start, pts, scale) is not None:
+                    return pts, "Bogdanov-Takens"  # the pair meets on the real axis ahead
                 if fld.eig(cur.u + 2 * ds * t) is None:
                     return pts, "leaves the allowed parameter range"
             ds *= 0.5
@@ -403,6 +403,43 @@ def _branch(fld: _Field, start: _Raw, direction: float, scale: float, ds0: float
         cur, t = new, tn
         ds = min(ds * 1.5, ds_max)
     return pts, "max_points"
+
+
+def _bt_ahead(start: _Raw, pts: list[_Raw], scale: float) -> tuple[np.ndarray, complex] | None:
+    """The Bogdanov-Takens point ahead of a branch that stalls as ``omega -> 0``, or ``None``.
+
+    Near BT, ``omega**2`` is a regular function of the arclength that vanishes there (``omega**2 = -b2`` on
+    the normal form), while ``omega`` itself falls like a square root and the eigenvalue problem may stop
+    being defined just beside the curve (the equilibrium is born on a fold curve tangent to the Hopf curve
+    at BT), so the stepping stalls short of it.  The branch's points with ``omega**2`` up to four times the
+    last one's are fitted by quadratics in arclength (``omega**2`` and each coordinate); BT is where the fitted
+    ``omega**2`` reaches 0.  Accepted only where ``omega`` has fallen below 0.2 of its scale, ``omega**2``
+    falls monotonically over at least three fitted points spanning at least half its last value, and the
+    zero lies within twice the fitted span (the extrapolation error is then of the order of the fit's
+    third-order term).
+    """
+    chain = [start, *pts]
+    w_last = chain[-1].lam.imag
+    if w_last <= 0 or w_last > 0.2 * scale:
+        return None
+    k = len(chain) - 1
+    while k > 0 and chain[k - 1].lam.imag ** 2 <= 4 * w_last ** 2:
+        k -= 1
+    fit = chain[k:]
+    w2 = np.array([r.lam.imag ** 2 for r in fit])
+    if len(fit) < 3 or not np.all(np.diff(w2) < 0) or w2[0] < 1.5 * w2[-1]:
+        return None
+    us = np.array([r.u for r in fit])
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(us, axis=0), axis=1))])
+    c = np.polyfit(s, w2, 2)
+    if float(np.polyval(np.polyder(c), s[-1])) >= 0:
+        return None
+    roots = [float(r.real) for r in np.roots(c) if abs(r.imag) <= 1e-12 * max(1.0, abs(r)) and r.real > s[-1]]
+    if not roots or min(roots) - s[-1] > 2 * s[-1]:
+        return None
+    s_bt = min(roots)
+    u_bt = np.array([np.polyval(np.polyfit(s, us[:, i], 2), s_bt) for i in range(2)])
+    return u_bt, complex(0.0, 0.0)
 
 
 def _to_edge(fld: _Field, a: _Raw, b: _Raw, scale: float) -> _Raw | None:
@@ -624,9 +661,14 @@ def continue_hopf_curve(engine: Engine, space: ParameterSpace, x: Axis, y: Axis,
                         w2 = other[np.argmin(np.abs(other.real))]
                         detail += f" (omega2 = {w2.imag:.9g} rad/s)"
             special("HH", where, detail)
-    for end, r in ((end_b, raw[0]), (end_f, raw[-1])):
+    for end, r, branch in ((end_b, raw[0], bwd), (end_f, raw[-1], fwd)):
         if end == "Bogdanov-Takens":
-            special("BT", (r.u, r.lam), "omega -> 0 at the end of the curve (last point converged)")
+            bt = _bt_ahead(start, branch, scale)
+            if bt is not None and r.lam.imag >= 0.01 * scale:
+                special("BT", bt, f"omega -> 0 ahead of the last converged point (omega = {r.lam.imag:.3g} rad/s "
+                                  "there): omega^2, quadratic in arclength over the last points, extrapolated to 0")
+            else:
+                special("BT", (r.u, r.lam), "omega -> 0 at the end of the curve (last point converged)")
     points = []
     for r, (l1, err, crit, msg) in zip(raw, vals):
         xv, yv = fld.values(r.u)
