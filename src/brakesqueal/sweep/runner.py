@@ -168,6 +168,17 @@ def _quiet(logger: str) -> Iterator[None]:
         log.setLevel(level)
 
 
+@contextlib.contextmanager
+def _silent() -> Iterator[None]:
+    """Every log record dropped (``logging.disable``): the scheduler of a local cluster logs from its own
+    thread and its loggers' levels are its own, so one logger's level does not silence it."""
+    logging.disable(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        logging.disable(logging.NOTSET)
+
+
 def _first_line(exc: BaseException) -> str:
     text = str(exc).strip()
     return text.splitlines()[0] if text else type(exc).__name__
@@ -288,9 +299,13 @@ def _client(workers: int | None, scheduler: str | None, client: Client | None,
         c = Client(cluster, set_as_default=False)
         try:
             yield c
-        finally:
-            c.close()
-            cluster.close()
+        except BaseException:
+            with _silent():  # an interrupted run's cancelled gathers ("Couldn't gather keys") are not news
+                c.close()
+                cluster.close()
+            raise
+        c.close()
+        cluster.close()
         return
     yield None
 
