@@ -192,10 +192,11 @@ def exact_crossings(table: dict[str, Any], lo: float, hi: float, log: bool = Tru
             prev = v
         else:
             prev = None
-    return start, found, _merge_ranges(undecided + partly_invalid)
+    return start, found, merge_ranges(undecided + partly_invalid)
 
 
-def _merge_ranges(r: list[tuple[float, float]]) -> list[tuple[float, float]]:
+def merge_ranges(r: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """The union of closed ranges, sorted, overlapping or touching ones joined (also :mod:`brakesqueal.design`)."""
     out: list[tuple[float, float]] = []
     for a, b in sorted(r):
         if out and a <= out[-1][1]:
@@ -325,7 +326,7 @@ def _numeric(engine: Engine, space: ParameterSpace, axis: Axis, n: int = NUMERIC
     prof = (grid, np.where(ok, mr, np.nan))
     c0 = int(r.carrier.reshape(-1)[0])
     carrier = r.carriers[c0] if 0 <= c0 < len(r.carriers) else ""
-    return bool(st[0]), out, _merge_ranges(undecided), prof, carrier
+    return bool(st[0]), out, merge_ranges(undecided), prof, carrier
 
 
 def _valid_fn(space: Any, name: str) -> Any:

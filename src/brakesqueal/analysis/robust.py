@@ -450,6 +450,19 @@ def descriptor_states(E: np.ndarray, A: np.ndarray) -> tuple[np.ndarray, np.ndar
     return S, good
 
 
+def _usable_state_verdicts(S: np.ndarray, good: np.ndarray, rel_input: float
+                           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`state_verdicts` of the usable state matrices ``S[good]``; :data:`UNDECIDED` and NaN elsewhere."""
+    N = S.shape[0]
+    codes = np.full(N, UNDECIDED, dtype=np.uint8)
+    mr = np.full(N, np.nan)
+    fr = np.full(N, np.nan)
+    idx = np.flatnonzero(good)
+    if idx.size:
+        codes[idx], mr[idx], fr[idx] = state_verdicts(S[idx], rel_input=rel_input)
+    return codes, mr, fr
+
+
 def eigen_verdicts(M: np.ndarray, D: np.ndarray, K: np.ndarray, *, rel_input: float = INPUT_REL
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Verdicts from the eigenvalues of the state matrix of eq. (47) with a condition-number error bound.
@@ -469,14 +482,7 @@ def eigen_verdicts(M: np.ndarray, D: np.ndarray, K: np.ndarray, *, rel_input: fl
         gives :data:`UNDECIDED`.
     """
     S, good = state_matrices(M, D, K)
-    N = S.shape[0]
-    codes = np.full(N, UNDECIDED, dtype=np.uint8)
-    mr = np.full(N, np.nan)
-    fr = np.full(N, np.nan)
-    idx = np.flatnonzero(good)
-    if idx.size:
-        codes[idx], mr[idx], fr[idx] = state_verdicts(S[idx], rel_input=rel_input)
-    return codes, mr, fr
+    return _usable_state_verdicts(S, good, rel_input)
 
 
 def descriptor_verdicts(E: np.ndarray, A: np.ndarray, *, rel_input: float = INPUT_REL
@@ -500,14 +506,7 @@ def descriptor_verdicts(E: np.ndarray, A: np.ndarray, *, rel_input: float = INPU
         (an infinite eigenvalue) gives :data:`UNDECIDED`.
     """
     S, good = descriptor_states(E, A)
-    N = S.shape[0]
-    codes = np.full(N, UNDECIDED, dtype=np.uint8)
-    mr = np.full(N, np.nan)
-    fr = np.full(N, np.nan)
-    idx = np.flatnonzero(good)
-    if idx.size:
-        codes[idx], mr[idx], fr[idx] = state_verdicts(S[idx], rel_input=rel_input)
-    return codes, mr, fr
+    return _usable_state_verdicts(S, good, rel_input)
 
 
 def mp_balanced(S: Any) -> tuple[Any, list[Any]]:

@@ -94,7 +94,11 @@ def _write_crossings(r: CrossingResult, space: ParameterSpace, axis: Axis, fmt: 
         return
     from ..api_nonlinear import hopf_points
 
-    pts = hopf_points(space, axis, result=r)
+    _write_hopf_points(r, hopf_points(space, axis, result=r), fmt)
+
+
+def _write_hopf_points(r: CrossingResult, pts: list[HopfPoint], fmt: OutFormat) -> None:
+    """Text or JSON of a crossing result whose crossings are the Hopf points ``pts`` (their normal forms)."""
     if fmt == OutFormat.json:
         d = r.to_dict()
         d["crossings"] = [hp.to_dict() for hp in pts]
@@ -263,13 +267,7 @@ def hopf(
     space = pads_option(base, None, None, pad_damping)
     engine = build(space.model)  # the entry point's engine, passed down
     r: CrossingResult = _crossings(engine, space, axis)
-    pts = hopf_points(engine, space, axis, result=r)
-    if fmt == OutFormat.json:
-        d = r.to_dict()
-        d["crossings"] = [hp.to_dict() for hp in pts]
-        sys.stdout.write(json.dumps(d, indent=2, default=float) + "\n")
-    else:
-        sys.stdout.write(r.text() + _hopf_text(pts))
+    _write_hopf_points(r, hopf_points(engine, space, axis, result=r), fmt)
 
 
 def cycles(

@@ -158,6 +158,17 @@ def _check_surrogate(study: str, degree: int, sparse: bool, runs: int) -> None:
                              "or --sparse")
 
 
+def _index_lines(v: dict[str, Any], inputs: list[str], width: int) -> list[str]:
+    """One line per input: its first and total Sobol' indices of one quantity ``v``, with their intervals."""
+    lines = []
+    for nm in inputs:
+        lo, hi = v["first_ci"][nm]
+        tlo, thi = v["total_ci"][nm]
+        lines.append(f"  {nm:<{width}}  first {_f(v['first'][nm])} [{_f(lo)}, {_f(hi)}]   "
+                     f"total {_f(v['total'][nm])} [{_f(tlo)}, {_f(thi)}]")
+    return lines
+
+
 def _text(s: dict[str, Any]) -> str:
     lines = [f"{s['study']}: {s['evaluations']} evaluations (N = {s['n_base']}, {len(s['inputs'])} inputs), "
              f"backend {s['backend']}, {100 * s['confidence']:g} % intervals"]
@@ -171,22 +182,14 @@ def _text(s: dict[str, Any]) -> str:
     width = max(len(n) for n in s["inputs"])
     for q, v in s["quantities"].items():
         lines.append(f"{q} ({v['rows']} rows):")
-        for nm in s["inputs"]:
-            lo, hi = v["first_ci"][nm]
-            tlo, thi = v["total_ci"][nm]
-            lines.append(f"  {nm:<{width}}  first {_f(v['first'][nm])} [{_f(lo)}, {_f(hi)}]   "
-                         f"total {_f(v['total'][nm])} [{_f(tlo)}, {_f(thi)}]")
+        lines += _index_lines(v, s["inputs"], width)
     modes = s.get("modes", [])
     for m in modes[:TEXT_MODES]:
         for part in ("real", "frequency"):
             v = m[part]
             lo_f, hi_f = m["frequency_range"]
             lines.append(f"mode {m['mode']} {part} ({v['rows']} rows; {_f(lo_f)} to {_f(hi_f)} Hz):")
-            for nm in s["inputs"]:
-                lo, hi = v["first_ci"][nm]
-                tlo, thi = v["total_ci"][nm]
-                lines.append(f"  {nm:<{width}}  first {_f(v['first'][nm])} [{_f(lo)}, {_f(hi)}]   "
-                             f"total {_f(v['total'][nm])} [{_f(tlo)}, {_f(thi)}]")
+            lines += _index_lines(v, s["inputs"], width)
     if len(modes) > TEXT_MODES:
         lines.append(f"({len(modes) - TEXT_MODES} more modes in --format json and --out)")
     sur = s.get("surrogate")

@@ -69,6 +69,7 @@ def stable_windows(engine: Engine, space: ParameterSpace, name: str, within: Seq
         ``name`` not settable, an empty, reversed or non-finite ``within``, ``name`` also in ``box``, a model
         without a closed-form quartic or a silent motion that is not trivial (certified decisions need both).
     """
+    from ..analysis.crossings import merge_ranges
     from ..robust import decide_boxes, stable_margins
 
     space.check_axis(name)
@@ -126,13 +127,7 @@ def stable_windows(engine: Engine, space: ParameterSpace, name: str, within: Seq
         win = _bisect_window(engine, space, name, x0, lo, hi, bx, steps, max_boxes, log)
         if win is not None:
             out.append(win)
-    merged: list[tuple[float, float]] = []
-    for w0, w1 in sorted(out):
-        if merged and w0 <= merged[-1][1]:
-            merged[-1] = (merged[-1][0], max(merged[-1][1], w1))
-        else:
-            merged.append((w0, w1))
-    return merged
+    return merge_ranges(out)
 
 
 def _bisect_window(engine: Engine, space: ParameterSpace, name: str, x0: float, lo: float, hi: float,

@@ -174,6 +174,11 @@ def _criticality_runs(x: np.ndarray, y: np.ndarray, crit: list[str]) -> list[tup
     return runs
 
 
+def _percent(fraction: float) -> int:
+    """A progress fraction as a whole percentage, clipped to [0, 100]."""
+    return int(100 * min(max(fraction, 0.0), 1.0))
+
+
 def _with_axis(state: ViewState, key: str, name: str) -> ViewState:
     """``state`` with its axis ``key`` (``"along"``, ``"x"`` or ``"y"``) set to ``name``."""
     if key == "along":
@@ -960,14 +965,12 @@ class Explorer:
         return self._in_child(self.cycles_child, self.cycles_lane, cycles_view, (space, state.along, rng), check)
 
     def _cycles_progress(self, fraction: float) -> None:
-        self.cycles_progress.value = int(100 * min(max(fraction, 0.0), 1.0))
+        self.cycles_progress.value = _percent(fraction)
 
     def _show_cycles(self, state: ViewState, cv: CyclesView | None, error: BaseException | None) -> None:
         self.cycles_progress.visible = False
         if error is not None or cv is None:  # (a delivered view comes with no error)
-            msg = "cancelled" if isinstance(error, Cancelled) else str(error)
-            self.cycles_text.object = f"<b>limit cycles:</b> {html.escape(msg)}"
-            self.shown["cycles"] = {"state": state.to_query(), "error": msg}
+            self._show_failure("cycles", self.cycles_text, "limit cycles", state, error)
         else:
             self._ensure_dynamics()
             lifted = np.zeros(cv.p.size, dtype=bool)
@@ -998,7 +1001,7 @@ class Explorer:
 
     def _region_progress(self, fraction: float) -> None:
         self.region_progress.visible = fraction < 1.0
-        self.region_progress.value = int(100 * min(max(fraction, 0.0), 1.0)) if fraction > 0 else None
+        self.region_progress.value = _percent(fraction) if fraction > 0 else None
 
     def _clear_region(self) -> None:
         self.src_hopf.data = {"xs": [], "ys": [], "color": []}
@@ -1010,9 +1013,7 @@ class Explorer:
     def _show_region(self, state: ViewState, rv: RegionView | None, error: BaseException | None) -> None:
         self.region_progress.visible = False
         if error is not None or rv is None:  # (a delivered view comes with no error)
-            msg = "cancelled" if isinstance(error, Cancelled) else str(error)
-            self.region_text.object = f"<b>squeal region:</b> {html.escape(msg)}"
-            self.shown["region"] = {"state": state.to_query(), "error": msg}
+            self._show_failure("region", self.region_text, "squeal region", state, error)
             self._mark()
             return
         x_log, y_log = self._map_logs
@@ -1289,14 +1290,18 @@ class Explorer:
                               (self.origin.space_of(state), state.t_end), check)
 
     def _sim_progress(self, fraction: float) -> None:
-        self.sim_progress.value = int(100 * min(max(fraction, 0.0), 1.0))
+        self.sim_progress.value = _percent(fraction)
+
+    def _show_failure(self, key: str, text: Any, title: str, state: ViewState, error: BaseException | None) -> None:
+        """Show a lane's error (or its cancellation) in its ``text`` pane and record it as ``shown[key]``."""
+        msg = "cancelled" if isinstance(error, Cancelled) else str(error)
+        text.object = f"<b>{title}:</b> {html.escape(msg)}"
+        self.shown[key] = {"state": state.to_query(), "error": msg}
 
     def _show_sim(self, state: ViewState, sv: SimulationView | None, error: BaseException | None) -> None:
         self.sim_progress.visible = False
         if error is not None or sv is None:  # (a delivered view comes with no error)
-            msg = "cancelled" if isinstance(error, Cancelled) else str(error)
-            self.sim_text.object = f"<b>simulation:</b> {html.escape(msg)}"
-            self.shown["sim"] = {"state": state.to_query(), "error": msg}
+            self._show_failure("sim", self.sim_text, "simulation", state, error)
             self._mark()
             return
         self._ensure_dynamics()

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
-from .model import NEWTON_MAXIT, NEWTON_RTOL, RESIDUAL_FLOOR, ExportFunction, ExportModel
+from .model import NEWTON_MAXIT, NEWTON_RTOL, RESIDUAL_FLOOR, ExportFunction, ExportModel, temporary_name
 
 __all__ = ["fmt_float", "comment", "used_inputs", "unused_arguments", "flat_outputs", "grouped", "function_names",
-           "is_number", "RTOL", "FLOOR", "MAXIT"]
+           "is_number", "with_temporaries", "RTOL", "FLOOR", "MAXIT"]
 
 #: Newton settings as source text (identical in every language).
 RTOL = repr(NEWTON_RTOL)
@@ -67,3 +68,38 @@ def function_names(model: ExportModel) -> list[str]:
 def is_number(e: Any) -> bool:
     """Whether a SymPy expression is a plain number (printed without a temporary)."""
     return bool(getattr(e, "is_Number", False))
+
+
+def with_temporaries(output: str, exprs: list[Any], code: Callable[[Any], str],
+                     assign: str) -> tuple[list[str], list[str]]:
+    """One temporary per entry of an output that is not a plain number, for array literals.
+
+    No expression then stands inside ``[...]``, where spaces may separate elements (Julia, Octave).
+
+    Parameters
+    ----------
+    output : str
+        Name of the output (the temporaries are named after it, :func:`~.model.temporary_name`).
+    exprs : list
+        Its entries (SymPy expressions).
+    code : callable
+        ``code(expr) -> str``, the language's printer.
+    assign : str
+        Format of one assignment, ``assign.format(temporary, value)``.
+
+    Returns
+    -------
+    lines : list of str
+        The assignments of the temporaries, in order.
+    entries : list of str
+        The text of each entry: the number or its temporary.
+    """
+    lines, entries = [], []
+    for i, e in enumerate(exprs):
+        if is_number(e):
+            entries.append(code(e))
+        else:
+            t = temporary_name(output, i)
+            lines.append(assign.format(t, code(e)))
+            entries.append(t)
+    return lines, entries

@@ -8,8 +8,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from ._common import FLOOR, MAXIT, RTOL, comment, fmt_float, function_names, grouped, is_number, used_inputs
-from .model import ExportModel, temporary_name
+from ._common import (FLOOR, MAXIT, RTOL, comment, fmt_float, function_names, grouped, is_number, used_inputs,
+                      with_temporaries)
+from .model import ExportModel
 
 __all__ = ["print_julia"]
 
@@ -103,15 +104,8 @@ def print_julia(model: ExportModel, out_name: str = "brakesqueal_model") -> str:
         lines += [f"    {s} = {julia_code(e)}" for s, e in fn.replacements]
         results = []
         for o, shape, exprs in grouped(fn):
-            # one temporary per entry: no expression inside [...], where spaces separate elements
-            entries = []
-            for i, e in enumerate(exprs):
-                if is_number(e):
-                    entries.append(code(e))
-                else:
-                    t = temporary_name(o, i)
-                    lines.append(f"    {t} = {code(e)}")
-                    entries.append(t)
+            assigns, entries = with_temporaries(o, exprs, code, "    {} = {}")
+            lines += assigns
             lines.append(_assemble(o, shape, entries))
             results.append(o)
         lines += [f"    return {', '.join(results)}", "end", ""]

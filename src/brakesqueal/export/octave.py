@@ -10,8 +10,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from ._common import FLOOR, MAXIT, RTOL, comment, fmt_float, function_names, grouped, is_number, used_inputs
-from .model import ExportModel, temporary_name
+from ._common import (FLOOR, MAXIT, RTOL, comment, fmt_float, function_names, grouped, is_number, used_inputs,
+                      with_temporaries)
+from .model import ExportModel
 
 __all__ = ["print_octave"]
 
@@ -104,15 +105,8 @@ def print_octave(model: ExportModel, out_name: str = "brakesqueal_model") -> str
         lines += [f"  {n} = {a}({i + 1});" for a, i, n in used_inputs(fn)]
         lines += [f"  {s} = {code(e)};" for s, e in fn.replacements]
         for o, shape, exprs in grouped(fn):
-            # one temporary per entry: no expression inside [...], where spaces may separate elements
-            entries = []
-            for i, e in enumerate(exprs):
-                if is_number(e):
-                    entries.append(code(e))
-                else:
-                    t = temporary_name(o, i)
-                    lines.append(f"  {t} = {code(e)};")
-                    entries.append(t)
+            assigns, entries = with_temporaries(o, exprs, code, "  {} = {};")
+            lines += assigns
             lines.append(_assemble(o, shape, entries))
         lines += ["end", ""]
     if model.what == "nonlinear":

@@ -24,7 +24,6 @@ events are not supported here: use :class:`~.flow.ScipyFlow` for a
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable
 
@@ -33,7 +32,7 @@ import numpy as np
 from numba import types
 
 from ..errors import ParameterError
-from .flow import FlowError, FlowResult
+from .flow import FlowError, FlowResult, _check_duration, _check_rtol, _flow_atol, _flow_start
 from .system import SmoothSystem
 
 if TYPE_CHECKING:
@@ -138,8 +137,7 @@ class CompiledFlow:
             raise ParameterError("CompiledFlow: give kernels=(f, jac, dfdp) or a system from compiled_system()")
         th = getattr(self.system, "_theta", np.empty(0)) if self.theta is None else self.theta
         self.theta = np.ascontiguousarray(np.asarray(th, dtype=float).ravel())
-        if not (isinstance(self.rtol, (int, float)) and 1e-13 <= self.rtol <= 1e-3):
-            raise ParameterError(f"The option 'rtol' must be in [1e-13, 1e-3]; got {self.rtol!r}")
+        _check_rtol(self.rtol)
         from ..codegen.simulation import flow_kernel
 
         self._kernel = flow_kernel(self.use_cache).dop853
@@ -175,23 +173,9 @@ class CompiledFlow:
         """
         n = self.system.n
         x0 = np.asarray(x0, dtype=float)
-        if not (math.isfinite(T) and T > 0):
-            raise FlowError(f"flow duration must be positive and finite; got T = {T!r}")
-        if self.atol is not None:
-            ax = np.broadcast_to(np.asarray(self.atol, dtype=float), (n,)).copy()
-        else:
-            s = (
-                np.asarray(scale, dtype=float)
-                if scale is not None
-                else np.full(n, max(float(np.max(np.abs(x0))), 1e-300))
-            )
-            ax = 1e-3 * self.rtol * np.maximum(s, 1e-300)
-        if sensitivities:
-            y = np.concatenate([x0, np.hstack([np.eye(n), np.zeros((n, 1))]).ravel()])
-            atol = np.concatenate([ax, np.column_stack([np.full((n, n), 1e-3 * self.rtol), ax]).ravel()])
-        else:
-            y = x0.copy()
-            atol = ax
+        _check_duration(T)
+        y = _flow_start(x0, n, sensitivities)
+        atol = _flow_atol(self.atol, self.rtol, n, x0, scale, sensitivities)
         ts = T * np.arange(n_samples) / n_samples if n_samples else np.empty(0)
         S = np.empty((n_samples, n))
         f, jac, dfdp = self.kernels  # type: ignore[misc]
@@ -244,30 +228,26 @@ def model_flow(engine: Engine, space: ParameterSpace, name: str, *, system: Smoo
         Bilateral contact (every pad pressed); for unilateral contact use the piecewise system's ScipyFlow.
     """
     from ..simulation import simulation_model
-    from .models import model_system
+    from .models import _recent, model_system
 
     if system is None:
         system = model_system(engine, space, name, use_cache=use_cache)
     sim = simulation_model(engine, use_cache=use_cache)
     mod = sim.variational_kernels()
-    thetas: dict[float, np.ndarray] = {}
 
-    def theta_of(p: float) -> np.ndarray:
-        th = thetas.get(p)
-        if th is None:
-            if len(thetas) > 16:
-                thetas.clear()
-            params = space.resolve({name: p})
-            h = 1e-3 * max(abs(p), 1e-300)
-            v = [sim.parameter_vector(space.resolve({name: p + k * h})) for k in (-2, -1, 1, 2)]
-            with np.errstate(invalid="ignore"):
-                dp = (8 * (v[2] - v[1]) - (v[3] - v[0])) / (12 * h)
-            same = (v[0] == v[1]) & (v[1] == v[2]) & (v[2] == v[3])
-            dp = np.where(same, 0.0, dp)
-            if not np.all(np.isfinite(dp)):
-                raise ParameterError(f"the model parameters are not differentiable along {name!r} at {p:.12g}")
-            th = thetas[p] = sim.variational_theta(params, dp)
-        return th
+    def theta_at(p: float) -> np.ndarray:
+        params = space.resolve({name: p})
+        h = 1e-3 * max(abs(p), 1e-300)
+        v = [sim.parameter_vector(space.resolve({name: p + k * h})) for k in (-2, -1, 1, 2)]
+        with np.errstate(invalid="ignore"):
+            dp = (8 * (v[2] - v[1]) - (v[3] - v[0])) / (12 * h)
+        same = (v[0] == v[1]) & (v[1] == v[2]) & (v[2] == v[3])
+        dp = np.where(same, 0.0, dp)
+        if not np.all(np.isfinite(dp)):
+            raise ParameterError(f"the model parameters are not differentiable along {name!r} at {p:.12g}")
+        return sim.variational_theta(params, dp)
+
+    theta_of = _recent(theta_at, 16)
 
     return CompiledFlow(system, kernels=(mod.nl_f, mod.nl_jac, mod.nl_dfdp), theta=np.empty(0), rtol=rtol,
                         theta_of=theta_of, use_cache=use_cache)

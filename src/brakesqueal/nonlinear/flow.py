@@ -220,8 +220,7 @@ class ScipyFlow:
             raise ParameterError(
                 f"ScipyFlow: 'system' must be a SmoothSystem or PiecewiseSystem; got {type(self.system).__name__}"
             )
-        if not (isinstance(self.rtol, (int, float)) and 1e-13 <= self.rtol <= 1e-3):
-            raise ParameterError(f"The option 'rtol' must be in [1e-13, 1e-3]; got {self.rtol!r}")
+        _check_rtol(self.rtol)
         if self.monodromy not in ("variational", "finite-difference"):
             raise ParameterError(
                 f"The option 'monodromy' must be 'variational' or 'finite-difference'; got {self.monodromy!r}"
@@ -269,8 +268,7 @@ class ScipyFlow:
             End state and sensitivities.
         """
         x0 = np.asarray(x0, dtype=float)
-        if not (math.isfinite(T) and T > 0):
-            raise FlowError(f"flow duration must be positive and finite; got T = {T!r}")
+        _check_duration(T)
         if not sensitivities:
             return self._integrate(x0, T, p, False, n_samples, scale)
         if self.monodromy == "variational":
@@ -278,30 +276,13 @@ class ScipyFlow:
         return self._fd(x0, T, p, n_samples, scale)
 
     # ------------------------------------------------------------ internals
-    def _atol(self, n: int, x0: np.ndarray, scale: np.ndarray | None, sens: bool) -> np.ndarray:
-        if self.atol is not None:
-            ax = np.broadcast_to(np.asarray(self.atol, dtype=float), (n,)).copy()
-        else:
-            s = (
-                np.asarray(scale, dtype=float)
-                if scale is not None
-                else np.full(n, max(float(np.max(np.abs(x0))), 1e-300))
-            )
-            ax = 1e-3 * self.rtol * np.maximum(s, 1e-300)
-        if not sens:
-            return ax
-        # Z = [M | x_p]: M entries are O(1); x_p scaled like x per unit of p (rtol dominates in practice)
-        am = 1e-3 * self.rtol if self.atol_monodromy is None else float(self.atol_monodromy)
-        Z = np.column_stack([np.full((n, n), am), ax])
-        return np.concatenate([ax, Z.ravel()])
-
     def _integrate(self, x0: np.ndarray, T: float, p: float, sens: bool, n_samples: int,
                    scale: np.ndarray | None) -> FlowResult:  # fmt: skip
         pw = self._pw
         n = pw.n
         mode = int(pw.mode_of(x0, p))
-        y = np.concatenate([x0, np.hstack([np.eye(n), np.zeros((n, 1))]).ravel()]) if sens else x0.copy()
-        atol = self._atol(n, x0, scale, sens)
+        y = _flow_start(x0, n, sens)
+        atol = _flow_atol(self.atol, self.rtol, n, x0, scale, sens, self.atol_monodromy)
         t_samp = T * np.arange(n_samples) / n_samples if n_samples else None
         xs = np.empty((n_samples, n)) if n_samples else None
         smodes: list[int] = []
@@ -446,6 +427,43 @@ class ScipyFlow:
         base.nfev += a.nfev + b.nfev
         base.monodromy_method = "finite-difference"
         return base
+
+
+def _check_rtol(rtol: Any) -> None:
+    """Refuse a relative tolerance outside ``[1e-13, 1e-3]`` (one line naming the option)."""
+    if not (isinstance(rtol, (int, float)) and 1e-13 <= rtol <= 1e-3):
+        raise ParameterError(f"The option 'rtol' must be in [1e-13, 1e-3]; got {rtol!r}")
+
+
+def _check_duration(T: float) -> None:
+    """Refuse a flow duration that is not positive and finite."""
+    if not (math.isfinite(T) and T > 0):
+        raise FlowError(f"flow duration must be positive and finite; got T = {T!r}")
+
+
+def _flow_start(x0: np.ndarray, n: int, sens: bool) -> np.ndarray:
+    """The initial state of a flow: ``x0``, followed with sensitivities by ``Z = [I | 0]`` (row-major)."""
+    return np.concatenate([x0, np.hstack([np.eye(n), np.zeros((n, 1))]).ravel()]) if sens else x0.copy()
+
+
+def _flow_atol(atol: Any, rtol: float, n: int, x0: np.ndarray, scale: np.ndarray | None, sens: bool,
+               atol_monodromy: float | None = None) -> np.ndarray:
+    """Absolute tolerances of a flow's state (and with sensitivities of ``Z = [M | x_p]``, row-major).
+
+    The state's: ``atol`` when given, else ``1e-3 rtol scale`` (``scale`` default ``max(|x0|_inf, 1e-300)``);
+    the monodromy's entries: ``atol_monodromy`` (default ``1e-3 rtol``); ``x_p``'s: those of the state.
+    """
+    if atol is not None:
+        ax = np.broadcast_to(np.asarray(atol, dtype=float), (n,)).copy()
+    else:
+        s = np.asarray(scale, dtype=float) if scale is not None else np.full(n, max(float(np.max(np.abs(x0))), 1e-300))
+        ax = 1e-3 * rtol * np.maximum(s, 1e-300)
+    if not sens:
+        return ax
+    # Z = [M | x_p]: M entries are O(1); x_p scaled like x per unit of p (rtol dominates in practice)
+    am = 1e-3 * rtol if atol_monodromy is None else float(atol_monodromy)
+    Z = np.column_stack([np.full((n, n), am), ax])
+    return np.concatenate([ax, Z.ravel()])
 
 
 def _true_root(sol: Any, tr: Transition, direction: float, n: int, p: float, t0: float, te: float) -> float:

@@ -38,7 +38,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
@@ -57,6 +57,24 @@ __all__ = ["model_system", "model_piecewise_system", "hopf_points", "HopfPoint",
 
 #: Pad treatments a limit-cycle computation can be asked for (:func:`cycle_route`).
 PAD_TREATMENTS: tuple[str, ...] = ("auto", "exact", "quasi-static")
+
+
+_K = TypeVar("_K")
+_V = TypeVar("_V")
+
+
+def _recent(compute: Callable[[_K], _V], keep: int = 8) -> Callable[[_K], _V]:
+    """``compute(key)`` memoized; the memo is emptied before a new value when it holds more than ``keep``."""
+    memo: dict[_K, _V] = {}
+
+    def get(key: _K) -> _V:
+        if key not in memo:
+            if len(memo) > keep:
+                memo.clear()
+            memo[key] = compute(key)
+        return memo[key]
+
+    return get
 
 
 def model_system(engine: Engine, space: ParameterSpace, name: str, *, use_cache: bool = True) -> SmoothSystem:
@@ -89,22 +107,17 @@ def model_system(engine: Engine, space: ParameterSpace, name: str, *, use_cache:
         space.resolve({name: 1.0})  # raises the one message for unknown or tied names
     sim = simulation_model(engine, use_cache=use_cache)
     sim.parameters(space.resolve({}))  # the space is of the engine's model
-    cache: dict[float, tuple[Any, Any]] = {}
 
-    def fields(p: float) -> tuple[Any, Any]:
-        key = float(p)
-        if key not in cache:
-            if len(cache) > 8:
-                cache.clear()
-            params = space.resolve({name: key})
-            cache[key] = sim.vector_field(params)
-        return cache[key]
+    def fields_at(p: float) -> tuple[Any, Any]:
+        return sim.vector_field(space.resolve({name: p}))
+
+    fields = _recent(fields_at)
 
     def f(x: np.ndarray, p: float) -> np.ndarray:
-        return fields(p)[0](x)
+        return fields(float(p))[0](x)
 
     def jac(x: np.ndarray, p: float) -> np.ndarray:
-        return fields(p)[1](x)
+        return fields(float(p))[1](x)
 
     system = SmoothSystem(f=f, jac=jac, n=len(sim.state_names), state_names=tuple(sim.state_names),
                           parameter_name=name)
@@ -165,26 +178,24 @@ def model_piecewise_system(engine: Engine, space: ParameterSpace, name: str, *,
                              "not determined down to lift-off (docs/simulation.md, unilateral contact)")
     pads = sim.pads
     npad = len(pads)
-    cache: dict[tuple[float, int], Any] = {}
-    states: dict[float, tuple[Any, Any]] = {}
+
+    def state_at(p: float) -> tuple[Any, Any]:
+        params = space.resolve({name: p})
+        return params, sim.silent(params)
+
+    def fields_at(key: tuple[float, int]) -> Any:
+        p, mode = key
+        params, st = state(p)
+        return sim.vector_field(params, st, engaged=[not (mode >> j) & 1 for j in range(npad)])
+
+    states = _recent(state_at)
+    mode_fields = _recent(fields_at, 8 * 2**npad)
 
     def state(p: float) -> tuple[Any, Any]:
-        key = float(p)
-        if key not in states:
-            if len(states) > 8:
-                states.clear()
-            params = space.resolve({name: key})
-            states[key] = (params, sim.silent(params))
-        return states[key]
+        return states(float(p))
 
     def fields(p: float, mode: int) -> Any:
-        key = (float(p), mode)
-        if key not in cache:
-            if len(cache) > 8 * 2 ** npad:
-                cache.clear()
-            params, st = state(p)
-            cache[key] = sim.vector_field(params, st, engaged=[not (mode >> j) & 1 for j in range(npad)])
-        return cache[key]
+        return mode_fields((float(p), mode))
 
     def normal_force(j: int, mode: int) -> Any:
         # the bilateral normal force of pad j with the pads' rates of `mode` (a lifted pad with a damper relaxes)

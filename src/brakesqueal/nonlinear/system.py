@@ -283,6 +283,26 @@ def fd_dp(fun: Callable[[np.ndarray, float], Any], x: Vec, p: float, *, step: fl
     return (8 * a - b) / (12 * h)
 
 
+def _central_dx(fun: Callable[[np.ndarray, float], Any], x: np.ndarray, p: float) -> np.ndarray:
+    """``d fun / dx`` by second-order central differences, step ``eps**(1/3) max(1, |x_i|)`` a coordinate.
+
+    Column ``i`` is the derivative in ``x_i``: shape ``(n,)`` for a scalar ``fun``, ``(m, n)`` for ``fun -> (m,)``.
+    """
+    cols = []
+    for i in range(x.size):
+        h = EPS ** (1 / 3) * max(1.0, abs(x[i]))
+        e = np.zeros(x.size)
+        e[i] = h
+        cols.append((np.asarray(fun(x + e, p), dtype=float) - np.asarray(fun(x - e, p), dtype=float)) / (2 * h))
+    return np.stack(cols, axis=-1)
+
+
+def _central_dp(fun: Callable[[np.ndarray, float], Any], x: np.ndarray, p: float) -> np.ndarray:
+    """``d fun / dp`` by the second-order central difference, step ``eps**(1/3) max(1, |p|)``."""
+    h = EPS ** (1 / 3) * max(1.0, abs(p))
+    return (np.asarray(fun(x, p + h), dtype=float) - np.asarray(fun(x, p - h), dtype=float)) / (2 * h)
+
+
 @dataclass(frozen=True)
 class SmoothSystem:
     r"""A smooth autonomous system ``x' = f(x, p)`` with one continuation parameter ``p``.
@@ -534,14 +554,7 @@ class Transition:
         """
         if self.guard_grad is not None:
             return np.asarray(self.guard_grad(x, p), dtype=float)
-        x = np.asarray(x, dtype=float)
-        g = np.empty(x.size)
-        for i in range(x.size):
-            h = EPS ** (1 / 3) * max(1.0, abs(x[i]))
-            e = np.zeros(x.size)
-            e[i] = h
-            g[i] = (self.guard(x + e, p) - self.guard(x - e, p)) / (2 * h)
-        return g
+        return _central_dx(self.guard, np.asarray(x, dtype=float), p)
 
     def h_p(self, x: Vec, p: float) -> float:
         """``dh/dp`` (exact or central differences).
@@ -560,8 +573,7 @@ class Transition:
         """
         if self.guard_dp is not None:
             return float(self.guard_dp(x, p))
-        h = EPS ** (1 / 3) * max(1.0, abs(p))
-        return float((self.guard(x, p + h) - self.guard(x, p - h)) / (2 * h))
+        return float(_central_dp(self.guard, x, p))
 
     def apply(self, x: Vec, p: float) -> tuple[Vec, Vec, Vec]:
         """``(g(x), dg/dx, dg/dp)`` of the reset (identity when there is none).
@@ -583,20 +595,9 @@ class Transition:
         if self.reset is None:
             return x.copy(), np.eye(n), np.zeros(n)
         xp = np.asarray(self.reset(x, p), dtype=float)
-        if self.reset_jac is not None:
-            G = np.asarray(self.reset_jac(x, p), dtype=float)
-        else:
-            G = np.empty((n, n))
-            for i in range(n):
-                h = EPS ** (1 / 3) * max(1.0, abs(x[i]))
-                e = np.zeros(n)
-                e[i] = h
-                G[:, i] = (np.asarray(self.reset(x + e, p)) - np.asarray(self.reset(x - e, p))) / (2 * h)
-        if self.reset_dp is not None:
-            Gp = np.asarray(self.reset_dp(x, p), dtype=float)
-        else:
-            h = EPS ** (1 / 3) * max(1.0, abs(p))
-            Gp = (np.asarray(self.reset(x, p + h)) - np.asarray(self.reset(x, p - h))) / (2 * h)
+        reset = self.reset
+        G = _central_dx(reset, x, p) if self.reset_jac is None else np.asarray(self.reset_jac(x, p), dtype=float)
+        Gp = _central_dp(reset, x, p) if self.reset_dp is None else np.asarray(self.reset_dp(x, p), dtype=float)
         return xp, G, Gp
 
 

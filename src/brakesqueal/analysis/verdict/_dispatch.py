@@ -36,6 +36,7 @@ Adding a route is one module with a :class:`~._base.Route` subclass and one
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -139,10 +140,17 @@ def decide(engine: Engine, space: ParameterSpace, points: Points, *, eigen: bool
     chunk = batch_points(engine)
     if points.size > chunk:  # large systems: bounded memory, the points decided in flat chunks
         return _decide_chunks(engine, space, points, chunk, eigen=eigen, modes=modes, carriers=carriers)
-    ctx = Context(engine, space, points, points.size, eigen=eigen, modes=modes, carriers_wanted=carriers)
+    ctx = _operating(engine, space, points, eigen=eigen, modes=modes, carriers_wanted=carriers)
+    return _choose(ctx).reshape(points.shape)
+
+
+def _operating(engine: Engine, space: ParameterSpace, points: Points, **kw: Any) -> Context:
+    """The context of deciding ``points`` (``kw`` as :class:`~._base.Context`), whether the closed-form routes
+    apply to them, and their operating points (:func:`~._linear.operating_points`)."""
+    ctx = Context(engine, space, points, points.size, **kw)
     ctx.closed = bool(engine.closed_route(space, points.names)) if engine.caps.closed_form else False
     operating_points(ctx)
-    return _choose(ctx).reshape(points.shape)
+    return ctx
 
 
 #: Memory the linear systems of one batch of points may take (a model's batch size follows from its size).
@@ -158,18 +166,23 @@ def batch_points(engine: Engine) -> int:
     return max(1, BATCH_BYTES // (8 * 20 * m * m))
 
 
-def _decide_chunks(engine: Engine, space: ParameterSpace, points: Points, chunk: int, **kw: Any) -> Verdicts:
-    """:func:`decide` on flat slices of ``points`` (no grid route applies to such large systems)."""
+def _flat_chunks(space: ParameterSpace, points: Points, chunk: int) -> Iterator[tuple[int, Points]]:
+    """``points`` in flat slices of ``chunk`` points, each with the flat index of its first point."""
     shape = points.shape
     flat = {k: np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for k, v in points.arrays.items()}
     sett = {k: np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for k, v in points.settable.items()}
     valid = np.broadcast_to(points.valid, shape).reshape(-1)
-    parts = []
     for s0 in range(0, points.size, chunk):
         sl = slice(s0, s0 + chunk)
-        sub = Points(space, {k: v[sl] for k, v in flat.items()}, points.names, valid=valid[sl],
-                     settable={k: v[sl] for k, v in sett.items()})
-        parts.append(decide(engine, space, sub, **kw))
+        yield s0, Points(space, {k: v[sl] for k, v in flat.items()}, points.names, valid=valid[sl],
+                         settable={k: v[sl] for k, v in sett.items()})
+
+
+def _decide_chunks(engine: Engine, space: ParameterSpace, points: Points, chunk: int, **kw: Any) -> Verdicts:
+    """:func:`decide` on flat slices of ``points`` (no grid route applies to such large systems)."""
+    shape = points.shape
+    parts = [decide(engine, space, sub, **kw) for _, sub in _flat_chunks(space, points, chunk)]
+
     def cat(f: str) -> np.ndarray:
         return np.concatenate([getattr(p, f) for p in parts]).reshape(shape)
 
@@ -203,20 +216,9 @@ def point_eigenvalues(engine: Engine, space: ParameterSpace, points: Points) -> 
     size = points.size
     chunk = batch_points(engine)
     parts: list[tuple[np.ndarray, np.ndarray]] = []
-    if size > chunk:
-        shape = points.shape
-        flat = {k: np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for k, v in points.arrays.items()}
-        sett = {k: np.broadcast_to(np.asarray(v, dtype=float), shape).reshape(-1) for k, v in points.settable.items()}
-        valid = np.broadcast_to(points.valid, shape).reshape(-1)
-        subs = [(s0, Points(space, {k: v[s0:s0 + chunk] for k, v in flat.items()}, points.names,
-                            valid=valid[s0:s0 + chunk], settable={k: v[s0:s0 + chunk] for k, v in sett.items()}))
-                for s0 in range(0, size, chunk)]
-    else:
-        subs = [(0, points)]
+    subs = _flat_chunks(space, points, chunk) if size > chunk else iter([(0, points)])
     for s0, sub in subs:
-        ctx = Context(engine, space, sub, sub.size, eigen=True, modes="all")
-        ctx.closed = bool(engine.closed_route(space, sub.names)) if engine.caps.closed_form else False
-        operating_points(ctx)
+        ctx = _operating(engine, space, sub, eigen=True, modes="all")
         idx = np.flatnonzero(np.isin(ctx.status, DECIDED))
         for g in linear_groups(ctx, idx) if idx.size else []:
             S, good = g.states_matrices()

@@ -14,6 +14,8 @@ by a massless pad's own tangential rate are left out of the verdict.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from ..robust import state_analysis
@@ -38,6 +40,31 @@ def excluded(ctx: Context) -> np.ndarray | None:
     if ctx.modes != "disk" or not ctx.pad_label.size:
         return None
     return np.unique(ctx.pad_label)
+
+
+#: A verdict of one system from its pencil ``(E, A)``, its count ``k`` of pad states, its states' carrier labels
+#: and the labels left out: ``(code, max_real, frequency, bound, carrier)``.
+PencilVerdict = Callable[[np.ndarray, np.ndarray, int, np.ndarray, "np.ndarray | None"],
+                         tuple[int, float, float, float, int]]
+
+
+def pencil_route(ctx: Context, idx: np.ndarray, max_size: int, verdict: PencilVerdict) -> Result:
+    """A route's result deciding each point's pencil ``A - λE`` alone (the systems of at most ``max_size`` states;
+    the larger ones left undecided): the per-point routes :mod:`.extended` and :mod:`.pencil_refined`."""
+    res = Result.empty(idx.size)
+    pos = {int(i): j for j, i in enumerate(idx)}
+    skip = excluded(ctx)
+    for g in linear_groups(ctx, idx):
+        E, A = g.descriptor()
+        if E.shape[-1] > max_size:
+            continue
+        k = E.shape[-1] - 2 * g.n
+        labels = state_labels(ctx, g)
+        for q, i in enumerate(g.idx):
+            code, mr, fr, bd, car = verdict(E[q], A[q], k, labels, skip)
+            j = pos[int(i)]
+            res.code[j], res.max_real[j], res.frequency[j], res.bound[j], res.carrier[j] = code, mr, fr, bd, car
+    return res
 
 
 class EigenBounds(Route):

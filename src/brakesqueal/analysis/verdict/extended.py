@@ -17,8 +17,7 @@ import numpy as np
 
 from ..robust import EXTENDED_VERDICT_MAX_SIZE, UNDECIDED, extended_analysis
 from ._base import Context, Result, Route
-from ._linear import linear_groups
-from .eigen_bounds import excluded, state_labels
+from .eigen_bounds import pencil_route
 
 __all__ = ["Extended"]
 
@@ -33,18 +32,13 @@ class Extended(Route):
         return True
 
     def run(self, ctx: Context, idx: np.ndarray) -> Result:
-        res = Result.empty(idx.size)
-        pos = {int(i): j for j, i in enumerate(idx)}
-        for g in linear_groups(ctx, idx):
-            E, A = g.descriptor()
-            if E.shape[-1] > EXTENDED_VERDICT_MAX_SIZE:
-                continue
-            k = E.shape[-1] - 2 * g.n
-            labels, skip = state_labels(ctx, g), excluded(ctx)
-            for q, i in enumerate(g.idx):
-                code, mr, fr, bd, lam, car = extended_analysis(E[q], A[q], k, labels, skip)
-                if not lam.size:
-                    code = UNDECIDED
-                j = pos[int(i)]
-                res.code[j], res.max_real[j], res.frequency[j], res.bound[j], res.carrier[j] = code, mr, fr, bd, car
-        return res
+        return pencil_route(ctx, idx, EXTENDED_VERDICT_MAX_SIZE, _verdict)
+
+
+def _verdict(E: np.ndarray, A: np.ndarray, k: int, labels: np.ndarray, skip: np.ndarray | None
+             ) -> tuple[int, float, float, float, int]:
+    """:func:`~..robust.extended_analysis` of one pencil; undecided without a finite eigenvalue."""
+    code, mr, fr, bd, lam, car = extended_analysis(E, A, k, labels, skip)
+    if not lam.size:
+        code = UNDECIDED
+    return code, mr, fr, bd, car

@@ -34,8 +34,7 @@ import numpy as np
 
 from ..robust import INPUT_REL, UNDECIDED, bounded_verdict
 from ._base import Context, Result, Route
-from ._linear import linear_groups
-from .eigen_bounds import excluded, state_labels
+from .eigen_bounds import pencil_route
 
 __all__ = ["PencilRefined", "pencil_analysis", "PENCIL_MAX_SIZE"]
 
@@ -183,16 +182,5 @@ class PencilRefined(Route):
         return True
 
     def run(self, ctx: Context, idx: np.ndarray) -> Result:
-        res = Result.empty(idx.size)
-        pos = {int(i): j for j, i in enumerate(idx)}
-        skip = excluded(ctx)
-        for g in linear_groups(ctx, idx):
-            E, A = g.descriptor()
-            if E.shape[-1] > PENCIL_MAX_SIZE:
-                continue
-            labels = state_labels(ctx, g)
-            for q, i in enumerate(g.idx):
-                code, mr, fr, bd, car = pencil_analysis(E[q], A[q], labels, skip)
-                j = pos[int(i)]
-                res.code[j], res.max_real[j], res.frequency[j], res.bound[j], res.carrier[j] = code, mr, fr, bd, car
-        return res
+        return pencil_route(ctx, idx, PENCIL_MAX_SIZE,
+                            lambda E, A, k, labels, skip: pencil_analysis(E, A, labels, skip))
