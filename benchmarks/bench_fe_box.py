@@ -140,7 +140,9 @@ def run(omega: float = 2 * math.pi, dense: str = "extrapolated", sub: int = 1167
 
     t0 = time.perf_counter()
     samples = [2 * math.pi, 4 * math.pi, 6 * math.pi, 8 * math.pi]
-    basis = reduce_qep(qep, samples, re=(-100.0, 50.0), freq=(0.0, 21000.0), r=r)
+    # the right eigenvectors alone, as measured before the default basis took the left ones too (r = 100 of the
+    # right ones keeps the box eigenvalues to ~5e-5; the map's speed depends on r only)
+    basis = reduce_qep(qep, samples, re=(-100.0, 50.0), freq=(0.0, 21000.0), r=r, left=False)
     t_basis = time.perf_counter() - t0
     P = project(basis.V, mats)
     # accuracy of the reduced model at a speed between the samples

@@ -403,7 +403,8 @@ def box_eigenvalues(params: Parameters, *, re: tuple[float, float], freq: tuple[
 @validated
 def reduce_matrix_model(space: ParameterSpace, samples: Sequence[float], *, re: tuple[float, float],
                         freq: tuple[float, float], r: int | None = None, tol: float = 1e-10, checks: int = 2,
-                        name: str | None = None, progress: Callable[[int, int], Any] | None = None) -> Reduction:
+                        name: str | None = None, left: bool = True,
+                        progress: Callable[[int, int], Any] | None = None) -> Reduction:
     """Parametric reduction of a matrix model along its spin (``brakesqueal reduce``).
 
     Parameters
@@ -422,6 +423,8 @@ def reduce_matrix_model(space: ParameterSpace, samples: Sequence[float], *, re: 
         Spins between the samples where the reduced model is checked against the full one.
     name : str, optional
         Name of the reduced model.
+    left : bool
+        The left eigenvectors in the basis too (the default; see :mod:`brakesqueal.analysis.reduction`).
     progress : callable, optional
         ``progress(done, total)``.
 
@@ -433,7 +436,7 @@ def reduce_matrix_model(space: ParameterSpace, samples: Sequence[float], *, re: 
     from .analysis.matrix_analysis import reduce_model
 
     return reduce_model(engine(space), space, samples, re=re, freq=freq, r=r, tol=tol, checks=checks, name=name,
-                        progress=progress)
+                        left=left, progress=progress)
 
 
 @validated

@@ -93,12 +93,15 @@ class Reduction:
         eigenvalues), ``max_rel_error`` and ``max_re_error`` (of every full box eigenvalue against the nearest
         reduced one: relative, and the absolute error of its real part), ``min_abs_re`` (the smallest
         ``|Re λ|`` of the full box: the margin a verdict needs).
+    basis : str
+        What the POD basis was made of: ``"right and left eigenvectors"`` or ``"right eigenvectors"``.
     """
 
     spec: MatrixSpec
     samples: np.ndarray
     singular_values: np.ndarray
     checks: tuple[dict[str, float], ...]
+    basis: str = "right and left eigenvectors"
 
     @property
     def reliable(self) -> bool:
@@ -116,14 +119,17 @@ class Reduction:
         """JSON-ready summary."""
         return {"model": self.spec.name, "dimension": self.spec.n, "samples": [float(v) for v in self.samples],
                 "singular_values": [float(v) for v in self.singular_values[:self.spec.n]],
-                "checks": [dict(c) for c in self.checks], "max_rel_error": self.max_rel_error,
+                "basis": self.basis, "checks": [dict(c) for c in self.checks],
+                "max_rel_error": self.max_rel_error,
                 "reliable": self.reliable}
 
 
 def reduce_model(engine: Engine, space: ParameterSpace, samples: Sequence[float], *, re: tuple[float, float],
                  freq: tuple[float, float], r: int | None = None, tol: float = 1e-10, checks: int = 2,
-                 name: str | None = None, progress: Callable[[int, int], Any] | None = None) -> Reduction:
-    """Parametric reduction of a matrix model along its spin (POD of the box eigenvectors, Galerkin projection).
+                 name: str | None = None, left: bool = True,
+                 progress: Callable[[int, int], Any] | None = None) -> Reduction:
+    """Parametric reduction of a matrix model along its spin (POD of the box eigenvectors, right and left,
+    Galerkin projection: :mod:`.reduction`).
 
     Parameters
     ----------
@@ -144,6 +150,9 @@ def reduce_model(engine: Engine, space: ParameterSpace, samples: Sequence[float]
         with the full model's at (0: none; at most one per gap).
     name : str, optional
         The reduced model's name (default ``<model>-r<r>``).
+    left : bool
+        The left eigenvectors in the basis too (default; eigenvalue errors the product of the right and left
+        vectors' distances from the basis, instead of first order in the right ones'; a larger basis).
     progress : callable, optional
         ``progress(done, total)`` over samples and checks.
 
@@ -171,14 +180,15 @@ def reduce_model(engine: Engine, space: ParameterSpace, samples: Sequence[float]
     def step(done: int) -> Callable[[int, int], Any] | None:
         return None if progress is None else (lambda i, n: progress(done + i, total))
 
-    basis = reduce_qep(qep, list(w), re=re, freq=freq, r=r, tol=tol, progress=step(0))
+    basis = reduce_qep(qep, list(w), re=re, freq=freq, r=r, tol=tol, left=left, progress=step(0))
     mats = project(basis.V, spec.matrices)
+    what = "right and left eigenvectors" if left else "right eigenvectors"
     rdim = basis.r
     red = MatrixSpec(name=name or f"{spec.name}-r{rdim}", matrices=mats, coefficients=dict(spec.coefficients),
                      parameters={k: float(v) for k, v in space.resolve({}).items()}, ranges=dict(spec.ranges),
                      units=dict(spec.units), descriptions=dict(spec.descriptions),
                      dofs=tuple(f"z{i + 1}" for i in range(rdim)), spin=spec.spin, presets=(),
-                     description=f"{spec.name} reduced to {rdim} DOF: POD of the eigenvectors in Re lambda in "
+                     description=f"{spec.name} reduced to {rdim} DOF: POD of the {what} in Re lambda in "
                                  f"[{re[0]:g}, {re[1]:g}] 1/s, f in [{freq[0]:g}, {freq[1]:g}] Hz at {spin} = "
                                  + ", ".join(f"{v:.6g}" for v in w),
                      reference="Graebner, Mehrmann, Quraishi, Schroeder, von Wagner, ZAMM 96(12) (2016) 1388-1405")
@@ -209,4 +219,5 @@ def reduce_model(engine: Engine, space: ParameterSpace, samples: Sequence[float]
                          else math.inf, "complete": bool(full.complete)})
             if progress is not None:
                 progress(w.size + i + 1, total)
-    return Reduction(spec=red, samples=w, singular_values=basis.singular_values, checks=tuple(rows))
+    return Reduction(spec=red, samples=w, singular_values=basis.singular_values, checks=tuple(rows),
+                     basis=what)

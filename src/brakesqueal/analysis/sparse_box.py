@@ -152,6 +152,9 @@ class BoxResult:
         Per shift: radius, Ritz values, convergence (diagnostics).
     notes : tuple of str
         What prevented completeness, if anything.
+    left_vectors : numpy.ndarray or None
+        Left eigenvectors ``y`` (``y^H Q(λ) = 0``; ``n × len(eigenvalues)``, unit 2-norm; a column of NaN
+        where the transposed run found none), when ``vectors`` are requested.
     """
 
     eigenvalues: np.ndarray
@@ -165,6 +168,7 @@ class BoxResult:
     shifts: tuple[complex, ...]
     records: tuple[ShiftRecord, ...] = field(default=(), repr=False)
     notes: tuple[str, ...] = ()
+    left_vectors: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def frequencies(self) -> np.ndarray:
@@ -519,7 +523,7 @@ def box_eigenvalues(M: Matrix, D: Matrix, K: Matrix, *, re: tuple[float, float],
         for i in np.flatnonzero((np.abs(lam.real) <= bound) & np.isfinite(bound)):
             lam[i], X[:, i], bound[i] = _polish(Ms, Ds, Ks, lam[i], X[:, i], Yb[:, i], bound[i])
     order = np.argsort(-lam.real, kind="stable")
-    lam, bound, X = lam[order], bound[order], X[:, order]
+    lam, bound, X, Y = lam[order], bound[order], X[:, order], Y[:, order]
     complete = not notes
     unstable = int(np.count_nonzero(lam.real - bound > 0))
     undecided = int(np.count_nonzero(np.abs(lam.real) <= bound))
@@ -528,7 +532,8 @@ def box_eigenvalues(M: Matrix, D: Matrix, K: Matrix, *, re: tuple[float, float],
         progress(len(records), len(records))
     return BoxResult(eigenvalues=lam, bounds=bound, vectors=X if vectors else None, box=box, complete=complete,
                      unstable=unstable, undecided=undecided, verdict=verdict,
-                     shifts=tuple(r.sigma for r in records), records=tuple(records), notes=tuple(notes))
+                     shifts=tuple(r.sigma for r in records), records=tuple(records), notes=tuple(notes),
+                     left_vectors=Y if vectors else None)
 
 
 def _one_shift(M: sp.csc_matrix, D: sp.csc_matrix, K: sp.csc_matrix, sigma: complex, k: int, tol: float,

@@ -154,6 +154,8 @@ def reduce_cmd(
     tol: Annotated[float, typer.Option("--tol", **NUMBER, help="Relative singular-value cut-off, in [0, 1].")] = 1e-10,
     checks: Annotated[int, typer.Option("--checks", min=0, max=50, help="Speeds between the samples at which "
                                         "the reduced model is compared with the full one.")] = 2,
+    right_only: Annotated[bool, typer.Option("--right-only", help="A basis of the right eigenvectors alone "
+                                             "(smaller, but its eigenvalue errors are first order).")] = False,
     fmt: FormatOpt = OutFormat.text, progress: ProgressOpt = None,
 ) -> None:
     """Reduce a large matrix model along its spin (POD of its box eigenvectors, the published method) and write
@@ -179,7 +181,8 @@ def reduce_cmd(
     samples = [float(v) for v in ax.values()]
     with _progress("reduce", progress) as cb:
         red = reduce_matrix_model(space, samples, re=_range(re, "--re"), freq=_range(freq, "--freq"), r=dim,
-                                  tol=tol, checks=checks, progress=lambda i, n: cb(i / max(n, 1)))
+                                  tol=tol, checks=checks, left=not right_only,
+                                  progress=lambda i, n: cb(i / max(n, 1)))
     write_matrix_model(red.spec, out)
     if fmt == OutFormat.json:
         sys.stdout.write(json.dumps({**red.to_dict(), "out": out}, indent=2, allow_nan=False,
@@ -187,7 +190,7 @@ def reduce_cmd(
         return
     sys.stdout.write(f"wrote {out}: model '{red.spec.name}', {red.spec.n} DOF (from {engine.caps.n}), basis from "
                      f"{len(samples)} samples of {ax.name} in [{float(np.min(samples)):g}, {float(np.max(samples)):g}]"
-                     "\n")
+                     f" ({red.basis})\n")
     for c in red.checks:
         sys.stdout.write(f"  check at {ax.name} = {c['Omega']:.6g}: {c['count_full']} box eigenvalues (full), "
                          f"{c['count_reduced']} (reduced), largest relative error {c['max_rel_error']:.1e}, "
