@@ -7,6 +7,7 @@ of the same parameters) and compared with what the page renders.
 from __future__ import annotations
 
 import math
+import time
 from urllib.parse import parse_qs, urlparse
 
 import numpy as np
@@ -36,9 +37,14 @@ def test_slider_moves_the_leading_eigenvalue(page):
     assert page.page.locator("#bs-leading").text_content() == library_leading([])
     handle = page.page.locator(".bs-slider-mu .noUi-handle")
     handle.focus()
-    for _ in range(5):
-        page.page.keyboard.press("ArrowLeft")
     typed = page.page.locator(".bs-input-mu input")
+    for _ in range(5):  # each press seen in the typed value before the next (else the state read below can be one
+        before = typed.input_value()  # the slider passes on its way, and the link then holds a later one)
+        page.page.keyboard.press("ArrowLeft")
+        deadline = time.monotonic() + 30  # (the input sits in a shadow root: polled from here)
+        while typed.input_value() == before and time.monotonic() < deadline:
+            page.page.wait_for_timeout(50)
+        assert typed.input_value() != before
     page.wait(lambda s: s["locus"]["state"]["set"] == f"mu={typed.input_value()}")
     value = typed.input_value()
     assert float(value) < 0.5
