@@ -28,14 +28,14 @@ from the left vectors alone was tried: as accurate, but it made spurious eigenva
 to 6e5 1/s, one inside the box).  Measured on the 4669-DOF brake (4 samples over 2π…8π, box
 eigenvalues at 3π, 5π, 7π against the full model's, whose smallest growth rate is 8.6e-5 1/s):
 
-====================  =========================  ==========================
-basis                 largest relative error      largest real-part error
-====================  =========================  ==========================
-right, r = 200        9.9e-9                      7.7e-5 1/s
-right + left, r = 200 4.5e-7                      2.0e-4 1/s
-right + left, r = 280 1.6e-10                     5.8e-7 1/s
-right + left, r = 320 4.6e-11                     5.9e-8 1/s
-====================  =========================  ==========================
+======================  ======================  =========================
+basis                   largest relative error  largest real-part error
+======================  ======================  =========================
+right, r = 200          9.9e-9                  7.7e-5 1/s
+right + left, r = 200   4.5e-7                  2.0e-4 1/s
+right + left, r = 280   1.6e-10                 5.8e-7 1/s
+right + left, r = 320   4.6e-11                 5.9e-8 1/s
+======================  ======================  =========================
 
 and no spurious eigenvalue in either.
 """
